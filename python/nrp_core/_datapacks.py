@@ -1,0 +1,96 @@
+"""Datapack value classes seen by transceiver functions and engine scripts."""
+
+
+class DataPackIdentifier:
+    """Identifies a datapack: its name, the engine it belongs to, and its type."""
+
+    __slots__ = ("dataPackName", "engineName", "dataPackType")
+
+    def __init__(self, name, engine_name, type=""):
+        self.dataPackName = name
+        self.engineName = engine_name
+        self.dataPackType = type
+
+    # Convenience aliases.
+    name = property(lambda self: self.dataPackName)
+    engine_name = property(lambda self: self.engineName)
+
+    def __eq__(self, other):
+        return (isinstance(other, DataPackIdentifier) and self.dataPackName == other.dataPackName
+                and self.engineName == other.engineName)
+
+    def __hash__(self):
+        return hash((self.dataPackName, self.engineName))
+
+    def __repr__(self):
+        return "DataPackIdentifier(%r, %r)" % (self.dataPackName, self.engineName)
+
+
+class EmptyDataPackError(RuntimeError):
+    pass
+
+
+class DataPack:
+    """Base of all datapacks: an identifier and, unless empty, data."""
+
+    __slots__ = ("_id", "_data")
+    _type = ""
+
+    def __init__(self, name, engine_name):
+        self._id = DataPackIdentifier(name, engine_name, self._type)
+        self._data = None
+
+    @property
+    def id(self):
+        return self._id
+
+    @property
+    def name(self):
+        return self._id.dataPackName
+
+    @property
+    def engine_name(self):
+        return self._id.engineName
+
+    def isEmpty(self):
+        return self._data is None
+
+    def isUpdated(self):
+        return self._data is not None
+
+    @property
+    def data(self):
+        if self._data is None:
+            raise EmptyDataPackError("datapack '%s' of engine '%s' is empty: check isEmpty() first"
+                                     % (self._id.dataPackName, self._id.engineName))
+        return self._data
+
+    @data.setter
+    def data(self, value):
+        self._data = value
+
+    def __repr__(self):
+        return "%s(%r, %r%s)" % (type(self).__name__, self.name, self.engine_name,
+                                 ", empty" if self._data is None else "")
+
+
+class JsonDataPack(DataPack):
+    """A datapack whose data is a JSON value (a dict, usually). numpy arrays are allowed
+    inside and travel as binary blobs."""
+
+    __slots__ = ()
+    _type = "json"
+
+    def __init__(self, name, engine_name, data=None):
+        DataPack.__init__(self, name, engine_name)
+        self._data = {} if data is None else data
+
+
+class EmptyDataPack(DataPack):
+    """A datapack that carries no data (not produced yet, or unknown to its engine)."""
+
+    __slots__ = ()
+
+    def __init__(self, name, engine_name, type=""):
+        DataPack.__init__(self, name, engine_name)
+        self._id.dataPackType = type

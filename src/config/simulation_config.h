@@ -1,0 +1,83 @@
+// The simulation config (NRP-Core's simulation_config.json): loaded once, validated against
+// JSON Schemas, defaults filled, paths made absolute, and parsed into typed structs.
+//
+// Schemas live in the share directory:
+//   <share>/schemas/simulation.schema.json   top-level keys and EngineBase (seed tables A1/A2)
+//   <share>/engines/<type>.schema.json       extra keys of one engine type, merged with EngineBase
+//   <share>/engines/<alias>.alias            file whose content is the real type name
+// Properties marked "x-convoy-path" are resolved against the config file's directory;
+// "x-convoy-path-must-exist" makes a missing file an error.
+//
+// Every error reads `<config file>: <JSON pointer>: <message>`, for example
+//   simulation_config.json: /EngineConfigs/2/EngineTimestep: must be > 0, got 0
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace convoy::config {
+
+struct EngineConfig {
+  std::string name;
+  std::string type;            // after alias resolution
+  std::string requested_type;  // as written in the file
+  std::string proc_cmd;        // EngineProcCmd, empty = engine default
+  std::vector<std::string> proc_start_params;
+  std::vector<std::string> env_params;    // "KEY=VALUE"
+  std::string launch_type = "BasicFork";  // or "EmptyLaunchCommand"
+  int64_t timestep_ns = 10'000'000;
+  double command_timeout_s = 0;  // <= 0: no timeout
+  std::string server_address;    // "" = none
+  std::string pointer;           // e.g. "/EngineConfigs/1", for error messages
+  nlohmann::json json;           // the full engine object, defaults filled, paths absolute
+};
+
+struct FunctionConfig {
+  std::string name;
+  std::filesystem::path file;  // absolute
+  bool active = true;
+  std::string pointer;  // e.g. "/DataPackProcessingFunctions/0"
+};
+
+struct SimulationConfig {
+  std::filesystem::path file, dir;  // absolute
+  std::string name, description;
+  std::string loop;                   // "FTILoop" or "EventLoop"
+  std::string process_launcher_type;  // "Basic"
+  std::string datapack_processor;     // "tf" or "cg"
+  std::string argument_passing;       // "value" or "reference"
+  int64_t timeout_ns = 0;             // 0 = run until interrupted
+  int64_t timestep_ns = 10'000'000;
+  std::vector<EngineConfig> engines;
+  std::vector<FunctionConfig> functions;  // DataPackProcessingFunctions, in config order
+  std::optional<FunctionConfig> status_function;
+  nlohmann::json json;                // whole config after overrides, defaults, path resolution
+  std::vector<std::string> warnings;  // e.g. unknown keys, same format as errors
+};
+
+// A user mistake in the config; what() holds one line per problem.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Loads `file`, applies `overrides` ("Key=Value", Key a top-level key or a path such as
+// "EngineConfigs/0/EngineTimestep" or "EngineConfigs.0.EngineTimestep"; Value parsed as JSON
+// when it parses, else taken as a string), validates, fills defaults and resolves paths.
+// Throws ConfigError listing every problem found.
+SimulationConfig load_simulation_config(const std::filesystem::path& file,
+                                        const std::vector<std::string>& overrides,
+                                        const std::filesystem::path& share_dir);
+
+// Applies one "Key=Value" override to `config`. Throws ConfigError on bad syntax.
+void apply_override(nlohmann::json& config, const std::string& override_text);
+
+// Converts seconds to nanoseconds, rounded to the nearest nanosecond.
+int64_t seconds_to_ns(double seconds);
+
+}  // namespace convoy::config

@@ -1,0 +1,53 @@
+// What an engine type implements, and how it registers itself.
+//
+// An engine is a simulator that advances in fixed steps of simulated time and exchanges
+// datapacks with the coordinator. A new engine type is one class deriving from Engine plus
+// one CONVOY_REGISTER_ENGINE line; convoy_add_engine() in CMake builds its server binary
+// bin/convoy-engine-<type>.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "convoy/engine.pb.h"
+
+namespace convoy::engines {
+
+class Engine {
+ public:
+  virtual ~Engine() = default;
+
+  // Start-up. `config` is the engine's object from the simulation config (paths absolute).
+  // Returns the ids of the datapacks the engine provides.
+  virtual std::vector<engine::DataPackId> initialize(const std::string& name,
+                                                     const nlohmann::json& config,
+                                                     int64_t timestep_ns) = 0;
+  // Advances by `duration_ns`; returns the engine's time afterwards.
+  virtual int64_t step(int64_t duration_ns) = 0;
+  // Accepts a datapack sent by a transceiver function.
+  virtual void set_datapack(const engine::DataPack& datapack) = 0;
+  // Fills `out` with the datapack `id`; leaves its payload unset if there is none.
+  virtual void get_datapack(const engine::DataPackId& id, engine::DataPack* out) = 0;
+  virtual void reset() {}
+  virtual void shutdown() {}
+};
+
+using EngineFactory = std::function<std::unique_ptr<Engine>()>;
+
+// Registry of engine types linked into this binary.
+bool register_engine(const std::string& type, EngineFactory factory);
+std::unique_ptr<Engine> create_engine(const std::string& type);
+std::vector<std::string> registered_engine_types();
+
+}  // namespace convoy::engines
+
+#define CONVOY_REGISTER_ENGINE(type_name, Class)                                \
+  static const bool convoy_engine_registered_##Class =                          \
+      ::convoy::engines::register_engine(type_name, [] {                        \
+        return std::unique_ptr<::convoy::engines::Engine>(std::make_unique<Class>()); \
+      })

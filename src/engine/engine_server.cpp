@@ -1,0 +1,257 @@
+#include "engine/engine_server.h"
+
+#include <grpcpp/grpcpp.h>
+
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "convoy/engine.grpc.pb.h"
+#include "core/clock.h"
+#include "transport/frame_socket.h"
+
+namespace convoy::engines {
+
+namespace {
+std::map<std::string, EngineFactory>& registry() {
+  static std::map<std::string, EngineFactory> r;
+  return r;
+}
+}  // namespace
+
+bool register_engine(const std::string& type, EngineFactory factory) {
+  registry()[type] = std::move(factory);
+  return true;
+}
+
+std::unique_ptr<Engine> create_engine(const std::string& type) {
+  auto it = registry().find(type);
+  if (it == registry().end()) return nullptr;
+  return it->second();
+}
+
+std::vector<std::string> registered_engine_types() {
+  std::vector<std::string> out;
+  for (auto& [k, v] : registry()) out.push_back(k);
+  return out;
+}
+
+void EngineServer::do_step(const engine::StepRequest& request, engine::StepReply* reply) {
+  int64_t t0 = now_ns();
+  for (const auto& dp : request.inputs()) engine_.set_datapack(dp);
+  reply->set_time_ns(engine_.step(request.duration_ns()));
+  for (const auto& id : request.wanted()) {
+    auto* out = reply->add_outputs();
+    *out->mutable_id() = id;
+    engine_.get_datapack(id, out);
+  }
+  reply->set_compute_ns(now_ns() - t0);
+}
+
+bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) {
+  try {
+    switch (request.kind_case()) {
+      case engine::Request::kInitialize: {
+        const auto& init = request.initialize();
+        nlohmann::json config = nlohmann::json::parse(init.config_json());
+        auto ids = engine_.initialize(init.engine_name(), config, init.timestep_ns());
+        initialized_ = true;
+        for (auto& id : ids) *reply->mutable_initialize()->add_registered() = id;
+        break;
+      }
+      case engine::Request::kStep:
+        do_step(request.step(), reply->mutable_step());
+        break;
+      case engine::Request::kGetDatapacks:
+        for (const auto& id : request.get_datapacks().ids()) {
+          auto* out = reply->mutable_get_datapacks()->add_datapacks();
+          *out->mutable_id() = id;
+          engine_.get_datapack(id, out);
+        }
+        break;
+      case engine::Request::kSetDatapacks:
+        for (const auto& dp : request.set_datapacks().datapacks()) engine_.set_datapack(dp);
+        reply->mutable_done();
+        break;
+      case engine::Request::kReset:
+        engine_.reset();
+        reply->mutable_done();
+        break;
+      case engine::Request::kShutdown:
+        shut_down_ = true;
+        engine_.shutdown();
+        reply->mutable_done();
+        return false;
+      default:
+        reply->set_error("empty request");
+    }
+  } catch (const std::exception& e) {
+    reply->set_error(e.what());
+    if (request.kind_case() == engine::Request::kShutdown) return false;
+  }
+  return true;
+}
+
+void EngineServer::serve_socket(int fd) {
+  transport::FrameSocket socket(fd);
+  std::string in, out;
+  engine::Request request;
+  engine::Reply reply;
+  for (;;) {
+    if (socket.recv(&in, Deadline::max()) != transport::RecvStatus::kOk) break;
+    request.Clear();
+    reply.Clear();
+    if (!request.ParseFromString(in)) {
+      reply.set_error("malformed request frame");
+      reply.SerializeToString(&out);
+      socket.send(out);
+      continue;
+    }
+    bool more = handle(request, &reply);
+    out.clear();
+    reply.SerializeToString(&out);
+    if (!socket.send(out) || !more) break;
+  }
+  // The coordinator went away without a Shutdown: still let the engine clean up.
+  if (initialized_ && !shut_down_) {
+    shut_down_ = true;
+    try {
+      engine_.shutdown();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "shutdown after disconnect failed: %s\n", e.what());
+    }
+  }
+}
+
+namespace {
+
+class GrpcService final : public engine::Engine::Service {
+ public:
+  explicit GrpcService(EngineServer& server) : server_(server) {}
+  std::function<void()> on_shutdown;
+
+  grpc::Status Initialize(grpc::ServerContext*, const engine::InitializeRequest* req,
+                          engine::InitializeReply* out) override {
+    engine::Request r;
+    *r.mutable_initialize() = *req;
+    return run(r, [&](engine::Reply& rep) { *out = rep.initialize(); });
+  }
+  grpc::Status Step(grpc::ServerContext*, const engine::StepRequest* req,
+                    engine::StepReply* out) override {
+    engine::Request r;
+    *r.mutable_step() = *req;
+    return run(r, [&](engine::Reply& rep) { *out = std::move(*rep.mutable_step()); });
+  }
+  grpc::Status RunLoopStep(grpc::ServerContext* c, const engine::StepRequest* req,
+                           engine::StepReply* out) override {
+    return Step(c, req, out);
+  }
+  grpc::Status GetDataPacks(grpc::ServerContext*, const engine::GetDataPacksRequest* req,
+                            engine::GetDataPacksReply* out) override {
+    engine::Request r;
+    *r.mutable_get_datapacks() = *req;
+    return run(r, [&](engine::Reply& rep) { *out = std::move(*rep.mutable_get_datapacks()); });
+  }
+  grpc::Status SetDataPacks(grpc::ServerContext*, const engine::SetDataPacksRequest* req,
+                            engine::Empty*) override {
+    engine::Request r;
+    *r.mutable_set_datapacks() = *req;
+    return run(r, [](engine::Reply&) {});
+  }
+  grpc::Status Reset(grpc::ServerContext*, const engine::Empty*, engine::Empty*) override {
+    engine::Request r;
+    r.mutable_reset();
+    return run(r, [](engine::Reply&) {});
+  }
+  grpc::Status Shutdown(grpc::ServerContext*, const engine::Empty*, engine::Empty*) override {
+    engine::Request r;
+    r.mutable_shutdown();
+    auto status = run(r, [](engine::Reply&) {});
+    if (on_shutdown) on_shutdown();
+    return status;
+  }
+
+ private:
+  template <typename F>
+  grpc::Status run(const engine::Request& request, F&& take) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    engine::Reply reply;
+    server_.handle(request, &reply);
+    if (!reply.error().empty()) return grpc::Status(grpc::StatusCode::INTERNAL, reply.error());
+    take(reply);
+    return grpc::Status::OK;
+  }
+  EngineServer& server_;
+  std::mutex mutex_;
+};
+
+}  // namespace
+
+void EngineServer::serve_grpc(const std::string& address) {
+  GrpcService service(*this);
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &port);
+  builder.SetMaxReceiveMessageSize(-1);
+  builder.SetMaxSendMessageSize(-1);
+  builder.RegisterService(&service);
+  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  if (!server) throw std::runtime_error("cannot listen for gRPC at " + address);
+  std::fprintf(stderr, "serving gRPC at %s\n", address.c_str());
+  std::fflush(stderr);
+  std::thread stopper;
+  service.on_shutdown = [&] {
+    stopper = std::thread([&] { server->Shutdown(std::chrono::system_clock::now() +
+                                                 std::chrono::seconds(1)); });
+  };
+  server->Wait();
+  if (stopper.joinable()) stopper.join();
+}
+
+int engine_main(int argc, char** argv) {
+  std::string type, address;
+  int fd = -1;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&](const char* flag) -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", flag);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--type") type = value("--type");
+    else if (a == "--convoy-fd") fd = std::stoi(value("--convoy-fd"));
+    else if (a == "--address" || a == "--serverurl") address = value("--address");
+    else if (a == "-h" || a == "--help") {
+      std::printf("usage: %s [--type T] (--convoy-fd N | --address host:port)\n", argv[0]);
+      return 0;
+    } else {
+      std::fprintf(stderr, "note: ignoring argument %s\n", a.c_str());
+    }
+  }
+  auto types = registered_engine_types();
+  if (type.empty() && types.size() == 1) type = types.front();
+  auto engine = create_engine(type);
+  if (!engine) {
+    std::fprintf(stderr, "unknown engine type '%s'\n", type.c_str());
+    return 2;
+  }
+  if (fd < 0 && address.empty()) {
+    std::fprintf(stderr, "give --convoy-fd N or --address host:port\n");
+    return 2;
+  }
+  EngineServer server(*engine);
+  try {
+    if (fd >= 0) server.serve_socket(fd);
+    else server.serve_grpc(address);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "engine server error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace convoy::engines

@@ -1,0 +1,33 @@
+// Serves one Engine over the engine protocol: on an inherited socket (local engines) or as
+// a gRPC server (remote engines). Exceptions thrown by the engine become error replies.
+#pragma once
+
+#include <string>
+
+#include "engine/engine.h"
+
+namespace convoy::engines {
+
+class EngineServer {
+ public:
+  explicit EngineServer(Engine& engine) : engine_(engine) {}
+
+  // Handles one request. Returns false once the engine has been shut down.
+  bool handle(const engine::Request& request, engine::Reply* reply);
+
+  // Serves requests on a connected stream socket until Shutdown or until the peer closes.
+  void serve_socket(int fd);
+  // Serves gRPC at `address` until Shutdown.
+  void serve_grpc(const std::string& address);
+
+ private:
+  void do_step(const engine::StepRequest& request, engine::StepReply* reply);
+  Engine& engine_;
+  bool initialized_ = false;
+  bool shut_down_ = false;
+};
+
+// main() of every convoy-engine-<type> binary.
+int engine_main(int argc, char** argv);
+
+}  // namespace convoy::engines

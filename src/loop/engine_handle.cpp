@@ -1,0 +1,121 @@
+#include "loop/engine_handle.h"
+
+#include <deque>
+#include <fstream>
+#include <sstream>
+
+#include "core/clock.h"
+#include "core/error.h"
+
+namespace convoy::loop {
+
+void EngineHandle::attach(std::unique_ptr<transport::EngineChannel> channel,
+                          launch::ChildProcess process) {
+  channel_ = std::move(channel);
+  process_ = process;
+}
+
+void EngineHandle::start(const engine::Request& request, const char* what, double timeout_s) {
+  if (!channel_) throw EngineError(name(), "engine '" + name() + "' is not connected");
+  timeout_s_ = timeout_s > 0 ? timeout_s : config_.command_timeout_s;
+  what_ = what;
+  call_started_ns = now_ns();
+  channel_->start(request, deadline_after(timeout_s_));
+  busy_ = true;
+}
+
+void EngineHandle::finish(engine::Reply* reply) {
+  busy_ = false;
+  auto status = channel_->finish(reply);
+  last_roundtrip_ns = now_ns() - call_started_ns;
+  std::string prefix = "engine '" + name() + "' ";
+  switch (status) {
+    case transport::CallStatus::kOk:
+      if (!reply->error().empty()) {
+        throw EngineError(name(), prefix + "failed in " + what_ + ":\n" + reply->error());
+      }
+      return;
+    case transport::CallStatus::kClosed: {
+      std::string how = "closed its connection";
+      if (process_.pid() > 0) {
+        process_.wait_for(1.0);
+        how = process_.describe();
+        if (how == "still running") how = "closed its connection";
+      }
+      channel_.reset();
+      throw EngineError(name(), prefix + "died during " + what_ + ": " + how + "\n--- " +
+                                    log_file_.string() + " (last lines) ---\n" + log_tail());
+    }
+    case transport::CallStatus::kTimeout: {
+      std::ostringstream s;
+      s << prefix << "did not answer " << what_ << " within " << timeout_s_
+        << " s (EngineCommandTimeout); it is considered hung\n--- " << log_file_.string()
+        << " (last lines) ---\n"
+        << log_tail();
+      channel_.reset();  // the stream is out of step now
+      throw EngineError(name(), s.str());
+    }
+    case transport::CallStatus::kInterrupted:
+      busy_ = true;  // the reply may still come; shutdown() drains it
+      throw EngineError(name(), "interrupted while waiting for engine '" + name() + "'");
+  }
+}
+
+void EngineHandle::call(const engine::Request& request, const char* what, engine::Reply* reply,
+                        double timeout_s) {
+  start(request, what, timeout_s);
+  finish(reply);
+}
+
+std::string EngineHandle::shutdown(double timeout_s) {
+  std::string error;
+  if (channel_) {
+    try {
+      engine::Reply reply;
+      if (busy_) {
+        // Drain the call in flight, briefly.
+        busy_ = false;
+        auto status = channel_->finish(&reply);
+        if (status != transport::CallStatus::kOk) channel_.reset();
+      }
+      if (channel_) {
+        engine::Request request;
+        request.mutable_shutdown();
+        channel_->start(request, deadline_after(timeout_s));
+        reply.Clear();
+        auto status = channel_->finish(&reply);
+        if (status == transport::CallStatus::kOk && !reply.error().empty()) {
+          error = "engine '" + name() + "' failed in shutdown:\n" + reply.error();
+        } else if (status == transport::CallStatus::kTimeout) {
+          error = "engine '" + name() + "' did not shut down within " +
+                  std::to_string(timeout_s) + " s";
+        }
+      }
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    if (channel_) channel_->close();
+    channel_.reset();
+  }
+  if (process_.pid() > 0) {
+    if (!process_.wait_for(2.0)) process_.terminate(1.0);
+    process_.terminate(0);  // reaps, and clears the process group
+  }
+  return error;
+}
+
+std::string EngineHandle::log_tail(size_t lines) const {
+  std::ifstream in(log_file_);
+  std::deque<std::string> tail;
+  std::string line;
+  while (std::getline(in, line)) {
+    tail.push_back(line);
+    if (tail.size() > lines) tail.pop_front();
+  }
+  std::string out;
+  for (auto& l : tail) out += l + "\n";
+  if (out.empty()) out = "(empty)\n";
+  return out;
+}
+
+}  // namespace convoy::loop

@@ -1,0 +1,61 @@
+// The coordinator's view of one running engine: its channel, its process, its clock.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "config/simulation_config.h"
+#include "convoy/engine.pb.h"
+#include "launch/process_launcher.h"
+#include "transport/engine_channel.h"
+
+namespace convoy::loop {
+
+class EngineHandle {
+ public:
+  EngineHandle(const config::EngineConfig& config, std::filesystem::path log_file)
+      : config_(config), log_file_(std::move(log_file)) {}
+
+  const std::string& name() const { return config_.name; }
+  const config::EngineConfig& config() const { return config_; }
+  const std::filesystem::path& log_file() const { return log_file_; }
+  launch::ChildProcess& process() { return process_; }
+
+  void attach(std::unique_ptr<transport::EngineChannel> channel, launch::ChildProcess process);
+  bool connected() const { return channel_ != nullptr; }
+  bool busy() const { return busy_; }
+
+  // Starts a call bounded by EngineCommandTimeout (or `timeout_s` when > 0).
+  void start(const engine::Request& request, const char* what, double timeout_s = 0);
+  // Collects the reply. Throws EngineError on an engine error, crash, hang, or interrupt.
+  void finish(engine::Reply* reply);
+  // start() + finish().
+  void call(const engine::Request& request, const char* what, engine::Reply* reply,
+            double timeout_s = 0);
+
+  // Shuts the engine down: drains a call in flight, sends Shutdown, then reaps the process
+  // (terminating it if it does not exit). Never throws; returns an error text or "".
+  std::string shutdown(double timeout_s);
+  // Last lines of the engine's log, for error messages.
+  std::string log_tail(size_t lines = 20) const;
+
+  // Loop bookkeeping.
+  int64_t time_ns = 0;
+  std::vector<engine::DataPackId> wanted;          // datapacks the functions read from it
+  std::vector<engine::DataPack> pending_inputs;    // TF outputs for its next step
+  int64_t call_started_ns = 0;
+  int64_t last_roundtrip_ns = -1, last_compute_ns = -1;
+
+ private:
+  const config::EngineConfig& config_;
+  std::filesystem::path log_file_;
+  std::unique_ptr<transport::EngineChannel> channel_;
+  launch::ChildProcess process_;
+  bool busy_ = false;
+  std::string what_;
+  double timeout_s_ = 0;
+};
+
+}  // namespace convoy::loop

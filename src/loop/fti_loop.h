@@ -1,0 +1,57 @@
+// FTILoop: NRP-Core's fixed-time-increment loop.
+//
+// Engines step concurrently, each with its own timestep. Each cycle the loop waits for the
+// engines whose next completion time comes first ("due" engines), takes the datapacks the
+// functions read from them, runs the preprocessing functions then the transceiver
+// functions linked to them (config order), and restarts them with the functions' outputs.
+// Everything the loop decides depends on simulated time only, so runs are deterministic.
+#pragma once
+
+#include <cstdio>
+#include <map>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "loop/engine_handle.h"
+#include "python/function_runtime.h"
+
+namespace convoy::loop {
+
+class FtiLoop {
+ public:
+  FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& runtime,
+          const std::vector<python::LoadedFunction>& functions);
+
+  // Writes one CSV row per cycle (wall times per engine) to `csv` (may be null).
+  void set_step_log(std::FILE* csv);
+
+  // Fetches the functions' inputs from every engine (after Initialize).
+  void prime();
+  // Runs until every engine has reached `until_ns` (0: until interrupted).
+  void run(int64_t until_ns);
+
+  int64_t sim_time_ns() const { return sim_time_ns_; }
+  uint64_t cycles() const { return cycles_; }
+
+ private:
+  void take_outputs(EngineHandle& e, engine::StepReply* reply);
+  void run_functions(const std::vector<EngineHandle*>& due);
+  void route(std::vector<engine::DataPack>& outputs, const python::LoadedFunction& fn);
+  void write_row(const std::vector<EngineHandle*>& due, int64_t cycle_wall_ns);
+
+  std::vector<EngineHandle*> engines_;
+  std::unordered_map<std::string, EngineHandle*> by_name_;
+  std::unordered_map<std::string, size_t> index_;
+  python::FunctionRuntime& runtime_;
+  const std::vector<python::LoadedFunction>& functions_;
+  python::InputSource source_;
+  std::unordered_map<std::string, engine::DataPack> pool_;  // "engine\0name" -> latest
+  std::multimap<int64_t, size_t> queue_;                     // completion time -> engine
+  std::vector<engine::DataPack> outputs_;
+  std::FILE* csv_ = nullptr;
+  int64_t sim_time_ns_ = 0;
+  uint64_t cycles_ = 0;
+};
+
+}  // namespace convoy::loop

@@ -1,0 +1,53 @@
+#include "python/interpreter.h"
+
+#include <cstdlib>
+
+#include "python/msgpack_codec.h"
+
+namespace convoy::python {
+
+std::filesystem::path package_dir() {
+  if (const char* p = std::getenv("CONVOY_PYTHON_PATH"); p && *p) return p;
+  return CONVOY_PYTHON_DIR;
+}
+
+Interpreter::Interpreter() {
+  // Engines and TFs print progress; flush it line by line into the logs.
+  setenv("PYTHONUNBUFFERED", "1", 0);
+  guard_ = std::make_unique<py::scoped_interpreter>(false);
+  add_path(package_dir());
+}
+
+Interpreter::~Interpreter() = default;
+
+void Interpreter::add_path(const std::filesystem::path& dir) {
+  py::list path = py::module_::import("sys").attr("path");
+  py::str entry(dir.string());
+  if (!path.contains(entry)) path.insert(0, entry);
+}
+
+std::string format_exception(py::error_already_set& e) {
+  try {
+    py::module_ tb = py::module_::import("traceback");
+    py::list lines = tb.attr("format_exception")(e.type(), e.value(), e.trace());
+    std::string out;
+    for (auto& l : lines) out += l.cast<std::string>();
+    while (!out.empty() && out.back() == '\n') out.pop_back();
+    return out;
+  } catch (...) {
+    return e.what();
+  }
+}
+
+py::module_ load_module_from_file(const std::filesystem::path& file) {
+  py::module_ util = py::module_::import("importlib.util");
+  std::string name = file.stem().string();
+  py::object spec = util.attr("spec_from_file_location")(name, file.string());
+  if (spec.is_none()) throw std::runtime_error("cannot load Python file " + file.string());
+  py::object module = util.attr("module_from_spec")(spec);
+  py::module_::import("sys").attr("modules")[py::str(name)] = module;
+  spec.attr("loader").attr("exec_module")(module);
+  return module.cast<py::module_>();
+}
+
+}  // namespace convoy::python

@@ -1,0 +1,35 @@
+// The coordinator's end of a connection to one engine server.
+//
+// A call is split in start() and finish() so that the coordinator can have every due
+// engine working at once: it starts the step on all of them, then collects the replies.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "convoy/engine.pb.h"
+#include "core/clock.h"
+
+namespace convoy::transport {
+
+enum class CallStatus { kOk, kClosed, kTimeout, kInterrupted };
+
+class EngineChannel {
+ public:
+  virtual ~EngineChannel() = default;
+  // Starts a call. At most one call is in flight per channel.
+  virtual void start(const engine::Request& request, Deadline deadline) = 0;
+  // Waits for the reply of the call in flight, until the deadline given to start().
+  virtual CallStatus finish(engine::Reply* reply) = 0;
+  // Closes the connection; a local engine server exits when it sees this.
+  virtual void close() = 0;
+  // Human-readable transport, for logs ("socket fd 7", "grpc localhost:23001").
+  virtual std::string describe() const = 0;
+};
+
+// Local engine on an inherited stream socket (see FrameSocket).
+std::unique_ptr<EngineChannel> make_socket_channel(int fd);
+// Engine serving gRPC at `address` (host:port or unix:path). Waits until `deadline` for it.
+std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline);
+
+}  // namespace convoy::transport
