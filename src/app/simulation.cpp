@@ -96,6 +96,14 @@ void check_functions(const std::vector<python::LoadedFunction>& functions,
   }
 }
 
+// Engines wait for the coordinator by yielding the CPU for a while before they sleep, but
+// only while there is a core for each of them; otherwise they would slow each other down.
+int engine_spin_us(const config::SimulationConfig& cfg) {
+  if (const char* s = std::getenv("CONVOY_ENGINE_SPIN_US")) return std::atoi(s);
+  long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  return static_cast<long>(cfg.engines.size()) <= cores ? 20 : 0;
+}
+
 void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& cfg) {
   const auto& ec = handle.config();
   if (ec.launch_type == "EmptyLaunchCommand") {
@@ -117,7 +125,8 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   launch::LaunchSpec spec;
   spec.program = ec.proc_cmd.empty() ? "convoy-engine-" + ec.type : ec.proc_cmd;
   spec.args = ec.proc_start_params;
-  spec.args.insert(spec.args.end(), {"--convoy-fd", "3"});
+  spec.args.insert(spec.args.end(), {"--convoy-fd", "3", "--convoy-spin-us",
+                                     std::to_string(engine_spin_us(cfg))});
   spec.env = ec.env_params;
   spec.log_file = handle.log_file();
   spec.working_dir = cfg.dir;

@@ -96,6 +96,7 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
 
 void EngineServer::serve_socket(int fd) {
   transport::FrameSocket socket(fd);
+  if (spin_us_ > 0) socket.set_spin(spin_us_ * 1000, true);
   std::string in, out;
   engine::Request request;
   engine::Reply reply;
@@ -213,6 +214,7 @@ void EngineServer::serve_grpc(const std::string& address) {
 int engine_main(int argc, char** argv) {
   std::string type, address;
   int fd = -1;
+  int64_t spin_us = 0;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto value = [&](const char* flag) -> std::string {
@@ -224,6 +226,7 @@ int engine_main(int argc, char** argv) {
     };
     if (a == "--type") type = value("--type");
     else if (a == "--convoy-fd") fd = std::stoi(value("--convoy-fd"));
+    else if (a == "--convoy-spin-us") spin_us = std::stoll(value("--convoy-spin-us"));
     else if (a == "--address" || a == "--serverurl") address = value("--address");
     else if (a == "-h" || a == "--help") {
       std::printf("usage: %s [--type T] (--convoy-fd N | --address host:port)\n", argv[0]);
@@ -244,6 +247,7 @@ int engine_main(int argc, char** argv) {
     return 2;
   }
   EngineServer server(*engine);
+  server.set_spin_us(spin_us);
   try {
     if (fd >= 0) server.serve_socket(fd);
     else server.serve_grpc(address);

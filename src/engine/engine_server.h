@@ -15,6 +15,10 @@ class EngineServer {
   // Handles one request. Returns false once the engine has been shut down.
   bool handle(const engine::Request& request, engine::Reply* reply);
 
+  // Waiting for the next request, yield the CPU in a loop for this long before sleeping
+  // (cheaper than a wake-up when there are cores to spare).
+  void set_spin_us(int64_t us) { spin_us_ = us; }
+
   // Serves requests on a connected stream socket until Shutdown or until the peer closes.
   void serve_socket(int fd);
   // Serves gRPC at `address` until Shutdown.
@@ -25,6 +29,7 @@ class EngineServer {
   Engine& engine_;
   bool initialized_ = false;
   bool shut_down_ = false;
+  int64_t spin_us_ = 0;
 };
 
 // main() of every convoy-engine-<type> binary.

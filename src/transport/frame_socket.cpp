@@ -3,6 +3,7 @@
 #include "core/interrupt.h"
 
 #include <poll.h>
+#include <sched.h>
 #include <sys/socket.h>
 #include <sys/uio.h>
 #include <unistd.h>
@@ -12,6 +13,8 @@
 #include <stdexcept>
 
 namespace convoy::transport {
+
+FrameSocket::FrameSocket(int fd) : fd_(fd) {}
 
 FrameSocket::~FrameSocket() { close(); }
 
@@ -51,56 +54,83 @@ bool FrameSocket::send(const std::string& payload) {
   return true;
 }
 
-bool FrameSocket::read_exact(char* dst, size_t n, Deadline deadline, RecvStatus* status) {
-  size_t got = 0;
-  while (got < n) {
-    ssize_t r = ::recv(fd_, dst + got, n - got, MSG_DONTWAIT);
-    if (r > 0) {
-      got += static_cast<size_t>(r);
+size_t FrameSocket::read_some(char* dst, size_t n, Deadline deadline, RecvStatus* status) {
+  int64_t spin_until = spin_ns_ > 0 ? now_ns() + spin_ns_ : 0;
+  for (;;) {
+    ssize_t r = ::recv(fd_, dst, n, MSG_DONTWAIT);
+    if (r > 0) return static_cast<size_t>(r);
+    if (r < 0 && errno == EAGAIN && spin_until && now_ns() < spin_until) {
+      if (spin_yield_) sched_yield();
+      else __builtin_ia32_pause();
       continue;
     }
     if (r == 0) {
       *status = RecvStatus::kClosed;
-      return false;
+      return 0;
     }
-    if (errno == EINTR) continue;
-    if (errno != EAGAIN && errno != EWOULDBLOCK) {
+    if (errno != EINTR && errno != EAGAIN && errno != EWOULDBLOCK) {
       *status = RecvStatus::kClosed;
-      return false;
+      return 0;
     }
     if (interrupted()) {
       *status = RecvStatus::kInterrupted;
-      return false;
+      return 0;
     }
     int timeout_ms = 100;  // wake now and then to notice an interrupt
     if (deadline != Deadline::max()) {
-      auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
+      auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - SteadyClock::now());
       if (left.count() <= 0) {
         *status = RecvStatus::kTimeout;
-        return false;
+        return 0;
       }
       timeout_ms = static_cast<int>(std::min<int64_t>(left.count() + 1, 100));
     }
     pollfd p{fd_, POLLIN, 0};
-    int pr = ::poll(&p, 1, timeout_ms);
-    if (pr < 0 && errno != EINTR) {
-      *status = RecvStatus::kClosed;
-      return false;
-    }
+    ::poll(&p, 1, timeout_ms);
   }
-  return true;
 }
 
 RecvStatus FrameSocket::recv(std::string* payload, Deadline deadline) {
   if (fd_ < 0) return RecvStatus::kClosed;
   RecvStatus status = RecvStatus::kOk;
-  unsigned char header[4];
-  if (!read_exact(reinterpret_cast<char*>(header), 4, deadline, &status)) return status;
-  uint32_t len = header[0] | (header[1] << 8) | (header[2] << 16) |
-                 (static_cast<uint32_t>(header[3]) << 24);
-  payload->resize(len);
-  if (len > 0 && !read_exact(payload->data(), len, deadline, &status)) return status;
-  return RecvStatus::kOk;
+  constexpr size_t kChunk = 1 << 16;
+  for (;;) {
+    size_t avail = buffer_len_ - buffer_pos_;
+    if (avail >= 4) {
+      const auto* h = reinterpret_cast<const unsigned char*>(buffer_.data() + buffer_pos_);
+      size_t len = h[0] | (h[1] << 8) | (h[2] << 16) | (static_cast<size_t>(h[3]) << 24);
+      if (avail >= 4 + len) {
+        payload->assign(buffer_.data() + buffer_pos_ + 4, len);
+        buffer_pos_ += 4 + len;
+        if (buffer_pos_ == buffer_len_) buffer_pos_ = buffer_len_ = 0;
+        return RecvStatus::kOk;
+      }
+      if (len > kChunk) {
+        // A large frame: read the rest straight into the payload.
+        payload->resize(len);
+        size_t have = avail - 4;
+        std::memcpy(payload->data(), buffer_.data() + buffer_pos_ + 4, have);
+        buffer_pos_ = buffer_len_ = 0;
+        while (have < len) {
+          size_t r = read_some(payload->data() + have, len - have, deadline, &status);
+          if (r == 0) return status;
+          have += r;
+        }
+        return RecvStatus::kOk;
+      }
+    }
+    if (buffer_pos_ > 0) {
+      std::memmove(buffer_.data(), buffer_.data() + buffer_pos_, avail);
+      buffer_pos_ = 0;
+      buffer_len_ = avail;
+    }
+    if (buffer_.size() < buffer_len_ + kChunk) buffer_.resize(buffer_len_ + kChunk);
+    size_t r = read_some(buffer_.data() + buffer_len_, buffer_.size() - buffer_len_, deadline,
+                         &status);
+    if (r == 0) return status;
+    buffer_len_ += r;
+  }
 }
 
 void make_socket_pair(int fds[2]) {

@@ -1,12 +1,17 @@
 #include "transport/engine_channel.h"
 #include "transport/frame_socket.h"
 
+#include <cstdlib>
+
 namespace convoy::transport {
 namespace {
 
 class SocketChannel final : public EngineChannel {
  public:
-  explicit SocketChannel(int fd) : socket_(fd) {}
+  explicit SocketChannel(int fd) : socket_(fd) {
+    const char* spin = std::getenv("CONVOY_SPIN_US");
+    socket_.set_spin(spin ? std::atoll(spin) * 1000 : 50'000);
+  }
 
   void start(const engine::Request& request, Deadline deadline) override {
     deadline_ = deadline;
