@@ -6,6 +6,9 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <condition_variable>
+#include <deque>
+#include <future>
 #include <thread>
 
 #include "convoy/engine.grpc.pb.h"
@@ -128,10 +131,50 @@ void EngineServer::serve_socket(int fd) {
 
 namespace {
 
+// Engines (an embedded Python, say) must be driven from one thread: gRPC's handler threads
+// hand each request to the thread that runs serve_grpc() and wait for its reply.
+class RequestQueue {
+ public:
+  engine::Reply submit(const engine::Request& request) {
+    Job job{&request, {}};
+    auto done = job.reply.get_future();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      jobs_.push_back(&job);
+    }
+    cv_.notify_one();
+    return done.get();
+  }
+  // Runs jobs until `handle` returns false (Shutdown).
+  void run(const std::function<bool(const engine::Request&, engine::Reply*)>& handle) {
+    for (;;) {
+      Job* job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [&] { return !jobs_.empty(); });
+        job = jobs_.front();
+        jobs_.pop_front();
+      }
+      engine::Reply reply;
+      bool more = handle(*job->request, &reply);
+      job->reply.set_value(std::move(reply));
+      if (!more) return;
+    }
+  }
+
+ private:
+  struct Job {
+    const engine::Request* request;
+    std::promise<engine::Reply> reply;
+  };
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Job*> jobs_;
+};
+
 class GrpcService final : public engine::Engine::Service {
  public:
-  explicit GrpcService(EngineServer& server) : server_(server) {}
-  std::function<void()> on_shutdown;
+  explicit GrpcService(RequestQueue& queue) : queue_(queue) {}
 
   grpc::Status Initialize(grpc::ServerContext*, const engine::InitializeRequest* req,
                           engine::InitializeReply* out) override {
@@ -169,29 +212,27 @@ class GrpcService final : public engine::Engine::Service {
   grpc::Status Shutdown(grpc::ServerContext*, const engine::Empty*, engine::Empty*) override {
     engine::Request r;
     r.mutable_shutdown();
-    auto status = run(r, [](engine::Reply&) {});
-    if (on_shutdown) on_shutdown();
-    return status;
+    return run(r, [](engine::Reply&) {});
   }
 
  private:
   template <typename F>
   grpc::Status run(const engine::Request& request, F&& take) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    engine::Reply reply;
-    server_.handle(request, &reply);
+    std::lock_guard<std::mutex> lock(mutex_);  // one call at a time, in arrival order
+    engine::Reply reply = queue_.submit(request);
     if (!reply.error().empty()) return grpc::Status(grpc::StatusCode::INTERNAL, reply.error());
     take(reply);
     return grpc::Status::OK;
   }
-  EngineServer& server_;
+  RequestQueue& queue_;
   std::mutex mutex_;
 };
 
 }  // namespace
 
 void EngineServer::serve_grpc(const std::string& address) {
-  GrpcService service(*this);
+  RequestQueue queue;
+  GrpcService service(queue);
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &port);
@@ -199,16 +240,13 @@ void EngineServer::serve_grpc(const std::string& address) {
   builder.SetMaxSendMessageSize(-1);
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
-  if (!server) throw std::runtime_error("cannot listen for gRPC at " + address);
+  if (!server || port == 0) throw std::runtime_error("cannot listen for gRPC at " + address);
   std::fprintf(stderr, "serving gRPC at %s\n", address.c_str());
   std::fflush(stderr);
-  std::thread stopper;
-  service.on_shutdown = [&] {
-    stopper = std::thread([&] { server->Shutdown(std::chrono::system_clock::now() +
-                                                 std::chrono::seconds(1)); });
-  };
+  queue.run([this](const engine::Request& r, engine::Reply* reply) { return handle(r, reply); });
+  // Let the Shutdown reply go out, then stop.
+  server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(1));
   server->Wait();
-  if (stopper.joinable()) stopper.join();
 }
 
 int engine_main(int argc, char** argv) {

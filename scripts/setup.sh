@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs Convoy's dependencies from Debian bookworm (idempotent) and builds it into build/.
+#   scripts/setup.sh            install + build
+#   CONVOY_SKIP_APT=1 ...       build only
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  build-essential cmake ccache pkg-config
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
+  pybind11-dev nlohmann-json3-dev python3-dev python3-numpy
+  libgtest-dev
+)
+
+if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
+  missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if ((${#missing[@]})); then
+    SUDO=""
+    [[ $(id -u) -ne 0 ]] && SUDO=sudo
+    echo "== installing: ${missing[*]}"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  fi
+fi
+
+echo "== building (Release) into build/"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build -j"$(nproc)"
+echo "== built: build/bin/convoy, build/bin/NRPCoreSim"
