@@ -1,0 +1,73 @@
+#include "python/msgpack_codec.h"
+
+#include <gtest/gtest.h>
+
+#include "python/interpreter.h"
+
+using namespace pybind11::literals;
+
+namespace convoy::python {
+namespace {
+
+class MsgpackCodec : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { interpreter_ = new Interpreter(); }
+  static void TearDownTestSuite() {
+    delete interpreter_;
+    interpreter_ = nullptr;
+  }
+  static py::object roundtrip(py::handle obj) {
+    std::string bytes;
+    if (!msgpack_encode(obj.ptr(), &bytes)) throw py::error_already_set();
+    PyObject* v = msgpack_decode(bytes);
+    if (!v) throw py::error_already_set();
+    return py::reinterpret_steal<py::object>(v);
+  }
+  static Interpreter* interpreter_;
+};
+Interpreter* MsgpackCodec::interpreter_ = nullptr;
+
+TEST_F(MsgpackCodec, JsonValuesRoundTrip) {
+  py::object v = py::eval(
+      "{'a': 1, 'neg': -5, 'big': 2**63 + 7, 'small': -2**62, 'f': 0.1, 's': 'é' * 40,"
+      " 'l': [None, True, False, [1, 2.5]], 'b': b'\\x00\\x01', 'd': {'x': {'y': []}},"
+      " 'n': list(range(70000))}");
+  EXPECT_TRUE(roundtrip(v).equal(v));
+}
+
+TEST_F(MsgpackCodec, TuplesBecomeListsAndKeysStrings) {
+  py::object v = py::eval("{1: (1, 2)}");
+  EXPECT_TRUE(roundtrip(v).equal(py::eval("{'1': [1, 2]}")));
+}
+
+TEST_F(MsgpackCodec, NumpyArraysKeepDtypeAndShape) {
+  py::module_ np = py::module_::import("numpy");
+  py::object a = np.attr("arange")(60, "dtype"_a = "float32").attr("reshape")(3, 4, 5);
+  py::object back = roundtrip(a);
+  EXPECT_EQ(py::str(back.attr("dtype")).cast<std::string>(), "float32");
+  EXPECT_TRUE(py::object(back.attr("shape")).equal(py::make_tuple(3, 4, 5)));
+  EXPECT_TRUE(np.attr("array_equal")(a, back).cast<bool>());
+  // A transposed (non-contiguous) view is sent in C order.
+  py::object t = a.attr("T");
+  EXPECT_TRUE(np.attr("array_equal")(t, roundtrip(t)).cast<bool>());
+  // The encoding is the raw bytes plus a small header, not a list of numbers.
+  std::string bytes;
+  ASSERT_TRUE(msgpack_encode(a.ptr(), &bytes));
+  EXPECT_LT(bytes.size(), 60 * 4 + 64u);
+}
+
+TEST_F(MsgpackCodec, UnsupportedTypeRaisesTypeError) {
+  py::object v = py::eval("{'f': object()}");
+  std::string bytes;
+  EXPECT_FALSE(msgpack_encode(v.ptr(), &bytes));
+  ASSERT_TRUE(PyErr_ExceptionMatches(PyExc_TypeError));
+  PyErr_Clear();
+}
+
+TEST_F(MsgpackCodec, TruncatedInputRaises) {
+  EXPECT_EQ(msgpack_decode(std::string_view("\x92\x01", 2)), nullptr);
+  PyErr_Clear();
+}
+
+}  // namespace
+}  // namespace convoy::python
