@@ -101,7 +101,7 @@ void check_functions(const std::vector<python::LoadedFunction>& functions,
 int engine_spin_us(const config::SimulationConfig& cfg) {
   if (const char* s = std::getenv("CONVOY_ENGINE_SPIN_US")) return std::atoi(s);
   long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  return static_cast<long>(cfg.engines.size()) <= cores ? 20 : 0;
+  return static_cast<long>(cfg.engines.size()) <= cores ? 50 : 0;
 }
 
 void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& cfg) {

@@ -9,11 +9,13 @@ the module is imported, and a marker `<tmp>/shutdown_<name>` in shutdown(), so t
 can check which processes ran and that they are gone.
 
 Run with Debian's /usr/bin/python3. The binaries come from $CONVOY_BIN_DIR (default
-<repo>/build/bin).
+<repo>/build/bin). Set CONVOY_E2E_KEEP=1 to keep the temp folders, CONVOY_E2E_SHOW=1 to print
+every run's stderr.
 """
 
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -151,7 +153,7 @@ class E2ETestCase(unittest.TestCase):
         for p in self._procs:
             if p.poll() is None:
                 p.kill()
-                p.wait()
+            p.communicate()
         for pid in self.engine_pids().values():
             if pid_alive(pid):
                 try:
@@ -163,9 +165,7 @@ class E2ETestCase(unittest.TestCase):
                 os.kill(pid, signal.SIGKILL)
             except ProcessLookupError:
                 pass
-        failed = any(err for _, err in getattr(self._outcome, "errors", []) if err) \
-            if hasattr(self, "_outcome") else False
-        if os.environ.get("CONVOY_E2E_KEEP") or failed:
+        if os.environ.get("CONVOY_E2E_KEEP"):
             print("\n[kept %s]" % self.dir)
         else:
             shutil.rmtree(self.dir, ignore_errors=True)
@@ -206,7 +206,10 @@ class E2ETestCase(unittest.TestCase):
             p.kill()
             out, err = p.communicate()
             self.fail("coordinator did not end within %.0f s\n--- stderr ---\n%s" % (timeout, err))
-        return Result(p, out, err, time.monotonic() - p._t0)
+        r = Result(p, out, err, time.monotonic() - p._t0)
+        if os.environ.get("CONVOY_E2E_SHOW"):
+            print("\n[%s] %s" % (self._testMethodName, r))
+        return r
 
     def run_convoy(self, *args, binary=None, timeout=RUN_TIMEOUT_S, run_dir=True):
         return self.finish(self.start(args, binary=binary, run_dir=run_dir), timeout)
@@ -252,6 +255,11 @@ class E2ETestCase(unittest.TestCase):
     def assertStderrHas(self, r, *needles):
         for n in needles:
             self.assertIn(n, r.stderr, "stderr lacks %r: %r" % (n, r))
+
+    def assertOneError(self, r):
+        """Exactly one "error:" message on stderr (it may span several lines)."""
+        n = len(re.findall(r"(?m)^error:", r.stderr))
+        self.assertEqual(n, 1, "expected one error message, got %d: %r" % (n, r))
 
     def assertNoEngineLeft(self, within=2.0, expect_pids=()):
         """Every engine process is gone (after at most `within` s)."""

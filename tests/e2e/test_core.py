@@ -287,6 +287,41 @@ class Determinism(unittest.TestCase):
         self.assertEqual(len(ex.records("c")), 100)
 
 
+class Launcher(unittest.TestCase):
+    def test_proc_cmd_start_params_and_env_params(self):
+        ex = Experiment(self)
+        ex.file("wrapper.sh", "#!/bin/sh\necho \"$@\" > \"$(dirname \"$0\")/args.txt\"\n"
+                              "exec \"$CONVOY_TEST_BIN/convoy-engine-python_json\" \"$@\"\n")
+        os.chmod(os.path.join(ex.dir, "wrapper.sh"), 0o755)
+        ex.engine("e", textwrap.dedent("""\
+            import os
+            from nrp_core.engines.python_json import EngineScript
+            class Script(EngineScript):
+                def initialize(self):
+                    with open(os.path.join(os.path.dirname(__file__), "env.txt"), "w") as f:
+                        f.write(os.environ.get("MY_VAR", "unset") + " " + os.getcwd())
+            """), EngineProcCmd=os.path.join(ex.dir, "wrapper.sh"),
+                  EngineProcStartParams=["--type", "python_json"],
+                  EngineEnvParams=["MY_VAR=hello world", "CONVOY_TEST_BIN=" + BIN_DIR])
+        ex.run(0.01)
+        with open(os.path.join(ex.dir, "args.txt")) as f:
+            self.assertTrue(f.read().startswith("--type python_json --convoy-fd 3"))
+        with open(os.path.join(ex.dir, "env.txt")) as f:
+            self.assertEqual(f.read(), "hello world " + os.path.realpath(ex.dir))
+
+    def test_engines_get_their_own_logs_and_no_port_is_needed(self):
+        ex = Experiment(self)
+        for name in ("a", "b", "c"):
+            ex.engine(name, "from nrp_core.engines.python_json import EngineScript\n"
+                            "class Script(EngineScript):\n"
+                            "    def initialize(self):\n"
+                            "        print('hello from', self._name)\n")
+        ex.run(0.01)
+        for name in ("a", "b", "c"):
+            with open(os.path.join(ex.dir, "run", "logs", name + ".log")) as f:
+                self.assertIn("hello from " + name, f.read())
+
+
 class RemoteEngine(unittest.TestCase):
     def test_empty_launch_command_connects_over_grpc(self):
         ex = Experiment(self)
