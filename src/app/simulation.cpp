@@ -132,6 +132,7 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   spec.working_dir = cfg.dir;
   spec.pass_fd = fds[1];
   spec.search_dirs = {bin_dir()};
+
   launch::ChildProcess child;
   try {
     child = launch::launch(spec);
@@ -209,6 +210,7 @@ int run_simulation(const RunOptions& options) {
       for (const auto& ec : cfg.engines) {
         engines.push_back(
             std::make_unique<loop::EngineHandle>(ec, run_dir / "logs" / (ec.name + ".log")));
+        engines.back()->index = engines.size() - 1;
       }
       for (auto& e : engines) launch_engine(*e, cfg);
       log.info("started " + std::to_string(engines.size()) + " engines");

@@ -69,14 +69,17 @@ void EngineHandle::call(const engine::Request& request, const char* what, engine
 
 std::string EngineHandle::shutdown(double timeout_s) {
   std::string error;
+  bool responsive = channel_ != nullptr;  // false after a crash or a hang
   if (channel_) {
     try {
       engine::Reply reply;
       if (busy_) {
-        // Drain the call in flight, briefly.
+        // A call is still in flight (interrupt, or another engine failed): give it a moment.
         busy_ = false;
-        auto status = channel_->finish(&reply);
-        if (status != transport::CallStatus::kOk) channel_.reset();
+        if (channel_->finish(&reply, deadline_after(1.0)) != transport::CallStatus::kOk) {
+          responsive = false;
+          channel_.reset();
+        }
       }
       if (channel_) {
         engine::Request request;
@@ -86,9 +89,11 @@ std::string EngineHandle::shutdown(double timeout_s) {
         auto status = channel_->finish(&reply);
         if (status == transport::CallStatus::kOk && !reply.error().empty()) {
           error = "engine '" + name() + "' failed in shutdown:\n" + reply.error();
-        } else if (status == transport::CallStatus::kTimeout) {
-          error = "engine '" + name() + "' did not shut down within " +
-                  std::to_string(timeout_s) + " s";
+        } else if (status != transport::CallStatus::kOk) {
+          responsive = false;
+          if (status == transport::CallStatus::kTimeout)
+            error = "engine '" + name() + "' did not shut down within " +
+                    std::to_string(timeout_s) + " s";
         }
       }
     } catch (const std::exception& e) {
@@ -98,7 +103,8 @@ std::string EngineHandle::shutdown(double timeout_s) {
     channel_.reset();
   }
   if (process_.pid() > 0) {
-    if (!process_.wait_for(2.0)) process_.terminate(1.0);
+    // A responsive engine exits by itself after Shutdown; a hung or broken one is ended.
+    if (!responsive || !process_.wait_for(2.0)) process_.terminate(0.5);
     process_.terminate(0);  // reaps, and clears the process group
   }
   return error;

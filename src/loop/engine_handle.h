@@ -42,6 +42,7 @@ class EngineHandle {
   std::string log_tail(size_t lines = 20) const;
 
   // Loop bookkeeping.
+  size_t index = 0;                                // position in the config
   int64_t time_ns = 0;
   std::vector<engine::DataPackId> wanted;          // datapacks the functions read from it
   std::vector<engine::DataPack> pending_inputs;    // TF outputs for its next step

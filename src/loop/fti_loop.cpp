@@ -1,6 +1,7 @@
 #include "loop/fti_loop.h"
 
 #include <algorithm>
+#include <charconv>
 
 #include "core/clock.h"
 #include "core/error.h"
@@ -24,8 +25,10 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
     : engines_(std::move(engines)), runtime_(runtime), functions_(functions) {
   for (size_t i = 0; i < engines_.size(); ++i) {
     by_name_[engines_[i]->name()] = engines_[i];
-    index_[engines_[i]->name()] = i;
+    engines_[i]->index = i;
   }
+  due_mask_.assign(engines_.size(), 0);
+  for (const auto& fn : functions_) function_engine_.push_back(by_name_.at(fn.engine)->index);
   // Which datapacks each engine must hand over after its steps.
   for (const auto& fn : functions_) {
     for (const auto& in : fn.inputs) {
@@ -98,35 +101,59 @@ void FtiLoop::route(std::vector<engine::DataPack>& outputs, const python::Loaded
   outputs.clear();
 }
 
-void FtiLoop::run_functions(const std::vector<EngineHandle*>& due) {
+void FtiLoop::run_functions() {
   runtime_.begin_cycle();
-  auto is_due = [&](const std::string& engine) {
-    return std::any_of(due.begin(), due.end(), [&](EngineHandle* e) { return e->name() == engine; });
-  };
-  for (const auto& fn : functions_) {
-    if (fn.preprocessing && is_due(fn.engine)) runtime_.run_preprocessing(fn, source_);
+  for (size_t i = 0; i < functions_.size(); ++i) {
+    if (functions_[i].preprocessing && due_mask_[function_engine_[i]])
+      runtime_.run_preprocessing(functions_[i], source_);
   }
-  for (const auto& fn : functions_) {
-    if (fn.preprocessing || !is_due(fn.engine)) continue;
+  for (size_t i = 0; i < functions_.size(); ++i) {
+    const auto& fn = functions_[i];
+    if (fn.preprocessing || !due_mask_[function_engine_[i]]) continue;
     runtime_.run_transceiver(fn, source_, &outputs_);
     route(outputs_, fn);
   }
 }
 
-void FtiLoop::write_row(const std::vector<EngineHandle*>& due, int64_t cycle_wall_ns) {
+namespace {
+// Appends ns as microseconds with three decimals ("12.345"), without printf's float path.
+void append_us(std::string* row, int64_t ns) {
+  char buf[32];
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, ns / 1000);
+  *p++ = '.';
+  int64_t frac = ns % 1000;
+  *p++ = static_cast<char>('0' + frac / 100);
+  *p++ = static_cast<char>('0' + frac / 10 % 10);
+  *p++ = static_cast<char>('0' + frac % 10);
+  row->append(buf, p);
+}
+}  // namespace
+
+void FtiLoop::write_row(int64_t cycle_wall_ns) {
   if (!csv_) return;
-  std::fprintf(csv_, "%llu,%.9g,%.3f", static_cast<unsigned long long>(cycles_),
-               static_cast<double>(sim_time_ns_) * 1e-9, static_cast<double>(cycle_wall_ns) * 1e-3);
-  for (auto* e : engines_) {
-    bool stepped = std::find(due.begin(), due.end(), e) != due.end() && e->last_compute_ns >= 0;
-    if (stepped) {
-      std::fprintf(csv_, ",%.3f,%.3f", static_cast<double>(e->last_compute_ns) * 1e-3,
-                   static_cast<double>(e->last_roundtrip_ns) * 1e-3);
+  row_.clear();
+  char buf[32];
+  row_.append(buf, std::to_chars(buf, buf + sizeof buf, cycles_).ptr);
+  row_ += ',';
+  row_.append(buf, std::to_chars(buf, buf + sizeof buf, sim_time_ns_ / 1'000'000'000).ptr);
+  row_ += '.';
+  std::snprintf(buf, sizeof buf, "%09lld", static_cast<long long>(sim_time_ns_ % 1'000'000'000));
+  row_ += buf;
+  row_ += ',';
+  append_us(&row_, cycle_wall_ns);
+  for (size_t i = 0; i < engines_.size(); ++i) {
+    const auto* e = engines_[i];
+    row_ += ',';
+    if (due_mask_[i] && e->last_compute_ns >= 0) {
+      append_us(&row_, e->last_compute_ns);
+      row_ += ',';
+      append_us(&row_, e->last_roundtrip_ns);
     } else {
-      std::fprintf(csv_, ",,");
+      row_ += ',';
     }
   }
-  std::fputc('\n', csv_);
+  row_ += '\n';
+  std::fwrite(row_.data(), 1, row_.size(), csv_);
 }
 
 void FtiLoop::run(int64_t until_ns) {
@@ -143,8 +170,10 @@ void FtiLoop::run(int64_t until_ns) {
       queue_.erase(queue_.begin());
     }
     std::sort(due.begin(), due.end(), [&](EngineHandle* a, EngineHandle* b) {
-      return index_[a->name()] < index_[b->name()];
+      return a->index < b->index;
     });
+    std::fill(due_mask_.begin(), due_mask_.end(), 0);
+    for (auto* e : due) due_mask_[e->index] = 1;
     for (auto* e : due) {
       e->last_compute_ns = -1;
       if (!e->busy()) continue;
@@ -154,7 +183,7 @@ void FtiLoop::run(int64_t until_ns) {
       e->time_ns = next;  // the schedule, not the engine's clock, drives the loop
     }
     sim_time_ns_ = next;
-    run_functions(due);
+    run_functions();
     if (interrupted()) break;
     for (auto* e : due) {
       const int64_t ts = e->config().timestep_ns;
@@ -166,10 +195,10 @@ void FtiLoop::run(int64_t until_ns) {
       e->pending_inputs.clear();
       for (const auto& id : e->wanted) *step->add_wanted() = id;
       e->start(request, "Step");
-      queue_.emplace(next + ts, index_[e->name()]);
+      queue_.emplace(next + ts, e->index);
     }
     int64_t t = now_ns();
-    write_row(due, t - last_cycle_ns);
+    write_row(t - last_cycle_ns);
     last_cycle_ns = t;
     ++cycles_;
   }

@@ -36,13 +36,15 @@ class FtiLoop {
 
  private:
   void take_outputs(EngineHandle& e, engine::StepReply* reply);
-  void run_functions(const std::vector<EngineHandle*>& due);
+  void run_functions();
   void route(std::vector<engine::DataPack>& outputs, const python::LoadedFunction& fn);
-  void write_row(const std::vector<EngineHandle*>& due, int64_t cycle_wall_ns);
+  void write_row(int64_t cycle_wall_ns);
 
   std::vector<EngineHandle*> engines_;
   std::unordered_map<std::string, EngineHandle*> by_name_;
-  std::unordered_map<std::string, size_t> index_;
+  std::vector<char> due_mask_;            // by engine index: due this cycle
+  std::vector<size_t> function_engine_;   // by function: index of its engine
+  std::string row_;
   python::FunctionRuntime& runtime_;
   const std::vector<python::LoadedFunction>& functions_;
   python::InputSource source_;

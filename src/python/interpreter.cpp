@@ -31,7 +31,12 @@ std::string format_exception(py::error_already_set& e) {
     py::module_ tb = py::module_::import("traceback");
     py::list lines = tb.attr("format_exception")(e.type(), e.value(), e.trace());
     std::string out;
-    for (auto& l : lines) out += l.cast<std::string>();
+    for (auto& l : lines) {
+      std::string line = l.cast<std::string>();
+      // Frames of Python's import machinery say nothing about the user's code.
+      if (line.rfind("  File \"<frozen importlib", 0) == 0) continue;
+      out += line;
+    }
     while (!out.empty() && out.back() == '\n') out.pop_back();
     return out;
   } catch (...) {

@@ -19,8 +19,9 @@ class EngineChannel {
   virtual ~EngineChannel() = default;
   // Starts a call. At most one call is in flight per channel.
   virtual void start(const engine::Request& request, Deadline deadline) = 0;
-  // Waits for the reply of the call in flight, until the deadline given to start().
-  virtual CallStatus finish(engine::Reply* reply) = 0;
+  // Waits for the reply of the call in flight, until the deadline given to start() or
+  // `limit`, whichever comes first.
+  virtual CallStatus finish(engine::Reply* reply, Deadline limit = Deadline::max()) = 0;
   // Closes the connection; a local engine server exits when it sees this.
   virtual void close() = 0;
   // Human-readable transport, for logs ("socket fd 7", "grpc localhost:23001").

@@ -28,11 +28,12 @@ class GrpcChannel final : public EngineChannel {
     pending_ = std::async(std::launch::async, [this, request] { return call(request); });
   }
 
-  CallStatus finish(engine::Reply* reply) override {
+  CallStatus finish(engine::Reply* reply, Deadline limit) override {
+    Deadline deadline = std::min(deadline_, limit);
     for (;;) {
       auto slice = SteadyClock::now() + std::chrono::milliseconds(100);
-      if (pending_.wait_until(std::min(slice, deadline_)) == std::future_status::ready) break;
-      if (interrupted() || SteadyClock::now() >= deadline_) {
+      if (pending_.wait_until(std::min(slice, deadline)) == std::future_status::ready) break;
+      if (interrupted() || SteadyClock::now() >= deadline) {
         context_->TryCancel();
         pending_.wait();
         pending_.get();

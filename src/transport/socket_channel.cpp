@@ -20,9 +20,9 @@ class SocketChannel final : public EngineChannel {
     send_failed_ = !socket_.send(out_);
   }
 
-  CallStatus finish(engine::Reply* reply) override {
+  CallStatus finish(engine::Reply* reply, Deadline limit) override {
     if (send_failed_) return CallStatus::kClosed;
-    switch (socket_.recv(&in_, deadline_)) {
+    switch (socket_.recv(&in_, std::min(deadline_, limit))) {
       case RecvStatus::kClosed:
         return CallStatus::kClosed;
       case RecvStatus::kTimeout:
