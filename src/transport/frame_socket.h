@@ -26,8 +26,9 @@ class FrameSocket {
   // Receives one frame into `payload`.
   RecvStatus recv(std::string* payload, Deadline deadline);
   void close();
-  // Busy-waits up to `ns` for data before sleeping: a reply that comes within that time is
-  // seen without a scheduler wake-up, which costs tens of microseconds on some VMs.
+  // Polls up to `ns` for data before sleeping, pausing or (yield) giving up the CPU between
+  // polls: a reply that comes within that time is seen without a scheduler wake-up, which
+  // costs tens of microseconds on some VMs.
   void set_spin(int64_t ns, bool yield = false) {
     spin_ns_ = ns;
     spin_yield_ = yield;

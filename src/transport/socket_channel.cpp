@@ -10,7 +10,7 @@ class SocketChannel final : public EngineChannel {
  public:
   explicit SocketChannel(int fd) : socket_(fd) {
     const char* spin = std::getenv("CONVOY_SPIN_US");
-    socket_.set_spin(spin ? std::atoll(spin) * 1000 : 0);
+    socket_.set_spin(spin ? std::atoll(spin) * 1000 : 100'000, true);
   }
 
   void start(const engine::Request& request, Deadline deadline) override {
