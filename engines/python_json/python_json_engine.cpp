@@ -66,14 +66,8 @@ class PythonJsonEngine final : public Engine {
                                "', which engine '" + name_ + "' has not registered");
     }
     try {
-      if (dp.payload_case() == engine::DataPack::kJsonMsgpack) {
-        datapacks[key] = python::decode_json(dp.json_msgpack());
-      } else if (dp.payload_case() == engine::DataPack::PAYLOAD_NOT_SET) {
-        datapacks[key] = py::none();
-      } else {
-        throw std::runtime_error("datapack '" + dp.id().name() +
-                                 "' is not JSON; python_json engines take JSON datapacks");
-      }
+      // Copies of images: the engine keeps its datapacks across steps.
+      datapacks[key] = python::data_to_python(dp, python::ImageAccess::kCopy);
     } catch (py::error_already_set& e) {
       throw std::runtime_error("cannot decode datapack '" + dp.id().name() + "': " + e.what());
     }
@@ -84,13 +78,9 @@ class PythonJsonEngine final : public Engine {
     py::str key(id.name());
     if (!datapacks.contains(key)) return;  // unknown id: empty datapack
     py::object data = datapacks[key];
-    if (data.is_none()) return;
-    out->mutable_id()->set_type("json");
-    try {
-      python::encode_json(data, out->mutable_json_msgpack());
-    } catch (py::error_already_set& e) {
-      throw std::runtime_error("datapack '" + id.name() + "': " + e.what());
-    }
+    // A datapack object (e.g. a GazeboCameraDataPack) sends its data.
+    if (py::hasattr(data, "_id") && py::hasattr(data, "_data")) data = data.attr("_data");
+    python::data_from_python(data, out);
   }
 
   void reset() override { call("reset"); }

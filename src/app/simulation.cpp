@@ -104,6 +104,12 @@ int engine_spin_us(const config::SimulationConfig& cfg) {
   return static_cast<long>(cfg.engines.size()) <= cores ? 50 : 0;
 }
 
+// Each local engine gets two arenas of this size (virtual: pages are used once written).
+size_t shm_arena_bytes() {
+  if (const char* s = std::getenv("CONVOY_SHM_MB")) return std::strtoull(s, nullptr, 10) << 20;
+  return size_t{512} << 20;
+}
+
 void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& cfg) {
   const auto& ec = handle.config();
   if (ec.launch_type == "EmptyLaunchCommand") {
@@ -127,10 +133,16 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   spec.args = ec.proc_start_params;
   spec.args.insert(spec.args.end(), {"--convoy-fd", "3", "--convoy-spin-us",
                                      std::to_string(engine_spin_us(cfg))});
+  spec.pass_fds = {fds[1]};
+  if (size_t bytes = shm_arena_bytes(); bytes > 0) {  // CONVOY_SHM_MB=0: blobs inline
+    handle.create_arenas(bytes);
+    spec.args.insert(spec.args.end(), {"--convoy-shm-out", "4", "--convoy-shm-in", "5"});
+    spec.pass_fds.push_back(handle.out_arena_fd());
+    spec.pass_fds.push_back(handle.in_arena_fd());
+  }
   spec.env = ec.env_params;
   spec.log_file = handle.log_file();
   spec.working_dir = cfg.dir;
-  spec.pass_fd = fds[1];
   spec.search_dirs = {bin_dir()};
 
   launch::ChildProcess child;

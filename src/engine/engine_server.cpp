@@ -13,6 +13,7 @@
 
 #include "convoy/engine.grpc.pb.h"
 #include "core/clock.h"
+#include "transport/blobs.h"
 #include "transport/frame_socket.h"
 
 namespace convoy::engines {
@@ -97,8 +98,17 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
   return true;
 }
 
-void EngineServer::serve_socket(int fd) {
+void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
   transport::FrameSocket socket(fd);
+  transport::ShmArena out_arena, in_arena;
+  std::unique_ptr<transport::ShmBlobWriter> writer;
+  if (shm_out_fd >= 0) {
+    out_arena.attach(shm_out_fd);
+    writer = std::make_unique<transport::ShmBlobWriter>(out_arena);
+  }
+  if (shm_in_fd >= 0) in_arena.attach(shm_in_fd);
+  transport::ShmBlobReader reader(shm_in_fd >= 0 ? &in_arena : nullptr);
+  transport::ScopedBlobContext blobs(writer.get(), &reader);
   if (spin_us_ > 0) socket.set_spin(spin_us_ * 1000, true);
   std::string in, out;
   engine::Request request;
@@ -113,6 +123,7 @@ void EngineServer::serve_socket(int fd) {
       socket.send(out);
       continue;
     }
+    if (writer) writer->next_message();
     bool more = handle(request, &reply);
     out.clear();
     reply.SerializeToString(&out);
@@ -253,6 +264,7 @@ int engine_main(int argc, char** argv) {
   std::string type, address;
   int fd = -1;
   int64_t spin_us = 0;
+  int shm_out = -1, shm_in = -1;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto value = [&](const char* flag) -> std::string {
@@ -264,6 +276,8 @@ int engine_main(int argc, char** argv) {
     };
     if (a == "--type") type = value("--type");
     else if (a == "--convoy-fd") fd = std::stoi(value("--convoy-fd"));
+    else if (a == "--convoy-shm-out") shm_out = std::stoi(value("--convoy-shm-out"));
+    else if (a == "--convoy-shm-in") shm_in = std::stoi(value("--convoy-shm-in"));
     else if (a == "--convoy-spin-us") spin_us = std::stoll(value("--convoy-spin-us"));
     else if (a == "--address" || a == "--serverurl") address = value("--address");
     else if (a == "-h" || a == "--help") {
@@ -287,7 +301,7 @@ int engine_main(int argc, char** argv) {
   EngineServer server(*engine);
   server.set_spin_us(spin_us);
   try {
-    if (fd >= 0) server.serve_socket(fd);
+    if (fd >= 0) server.serve_socket(fd, shm_out, shm_in);
     else server.serve_grpc(address);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "engine server error: %s\n", e.what());

@@ -20,7 +20,9 @@ class EngineServer {
   void set_spin_us(int64_t us) { spin_us_ = us; }
 
   // Serves requests on a connected stream socket until Shutdown or until the peer closes.
-  void serve_socket(int fd);
+  // Blobs of replies go into the arena `shm_out_fd`, those of requests come from `shm_in_fd`
+  // (-1: inline).
+  void serve_socket(int fd, int shm_out_fd = -1, int shm_in_fd = -1);
   // Serves gRPC at `address` until Shutdown.
   void serve_grpc(const std::string& address);
 

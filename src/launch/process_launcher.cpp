@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -98,7 +99,17 @@ ChildProcess launch(const LaunchSpec& spec) {
     int devnull = open("/dev/null", O_RDONLY);
     if (devnull >= 0) dup2(devnull, 0);
     if (dup2(log_fd, 1) < 0 || dup2(log_fd, 2) < 0) child_fail(err_pipe[1], errno);
-    if (spec.pass_fd >= 0 && dup2(spec.pass_fd, 3) < 0) child_fail(err_pipe[1], errno);
+    // Move the passed fds out of the way first, then into place (3, 4, ...).
+    // (No allocation here: the parent may have threads.)
+    int moved[16];
+    size_t n_moved = std::min<size_t>(spec.pass_fds.size(), 16);
+    for (size_t i = 0; i < n_moved; ++i) {
+      moved[i] = fcntl(spec.pass_fds[i], F_DUPFD_CLOEXEC, 64);
+      if (moved[i] < 0) child_fail(err_pipe[1], errno);
+    }
+    for (size_t i = 0; i < n_moved; ++i) {
+      if (dup2(moved[i], static_cast<int>(3 + i)) < 0) child_fail(err_pipe[1], errno);
+    }
     if (!spec.working_dir.empty() && chdir(spec.working_dir.c_str()) != 0)
       child_fail(err_pipe[1], errno);
     execve(program.c_str(), argv.data(), envp.data());

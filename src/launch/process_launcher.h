@@ -19,7 +19,7 @@ struct LaunchSpec {
   std::vector<std::string> env;   // extra "KEY=VALUE" entries
   std::filesystem::path log_file;
   std::filesystem::path working_dir;
-  int pass_fd = -1;  // becomes fd 3 in the child
+  std::vector<int> pass_fds;  // become fds 3, 4, ... in the child
   std::vector<std::filesystem::path> search_dirs;
 };
 

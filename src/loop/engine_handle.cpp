@@ -15,12 +15,24 @@ void EngineHandle::attach(std::unique_ptr<transport::EngineChannel> channel,
   process_ = process;
 }
 
+void EngineHandle::create_arenas(size_t bytes_each) {
+  out_arena_.create("convoy-" + name() + "-out", bytes_each);
+  in_arena_.create("convoy-" + name() + "-in", bytes_each);
+  shm_writer_ = std::make_unique<transport::ShmBlobWriter>(in_arena_);
+}
+
+transport::BlobWriter* EngineHandle::blob_writer() {
+  if (shm_writer_) return shm_writer_.get();
+  return &inline_writer_;
+}
+
 void EngineHandle::start(const engine::Request& request, const char* what, double timeout_s) {
   if (!channel_) throw EngineError(name(), "engine '" + name() + "' is not connected");
   timeout_s_ = timeout_s > 0 ? timeout_s : config_.command_timeout_s;
   what_ = what;
   call_started_ns = now_ns();
   channel_->start(request, deadline_after(timeout_s_));
+  if (shm_writer_) shm_writer_->next_message();  // blobs of the next request go elsewhere
   busy_ = true;
 }
 

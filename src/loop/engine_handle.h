@@ -9,6 +9,7 @@
 #include "config/simulation_config.h"
 #include "convoy/engine.pb.h"
 #include "launch/process_launcher.h"
+#include "transport/blobs.h"
 #include "transport/engine_channel.h"
 
 namespace convoy::loop {
@@ -24,6 +25,13 @@ class EngineHandle {
   launch::ChildProcess& process() { return process_; }
 
   void attach(std::unique_ptr<transport::EngineChannel> channel, launch::ChildProcess process);
+  // Shared-memory arenas for blobs to and from a local engine (see transport/blobs.h).
+  void create_arenas(size_t bytes_each);
+  int out_arena_fd() const { return out_arena_.fd(); }
+  int in_arena_fd() const { return in_arena_.fd(); }
+  // Reads blobs of this engine's replies; writes blobs of datapacks sent to it.
+  const transport::BlobReader* blob_reader() const { return &reader_; }
+  transport::BlobWriter* blob_writer();
   bool connected() const { return channel_ != nullptr; }
   bool busy() const { return busy_; }
 
@@ -54,6 +62,10 @@ class EngineHandle {
   std::filesystem::path log_file_;
   std::unique_ptr<transport::EngineChannel> channel_;
   launch::ChildProcess process_;
+  transport::ShmArena out_arena_, in_arena_;
+  transport::ShmBlobReader reader_{&out_arena_};
+  std::unique_ptr<transport::ShmBlobWriter> shm_writer_;
+  transport::InlineBlobWriter inline_writer_;
   bool busy_ = false;
   std::string what_;
   double timeout_s_ = 0;

@@ -49,6 +49,14 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
     auto it = pool_.find(key(engine, name));
     return it == pool_.end() ? nullptr : &it->second;
   };
+  source_.reader_for = [this](const std::string& engine) -> const transport::BlobReader* {
+    auto it = by_name_.find(engine);
+    return it == by_name_.end() ? nullptr : it->second->blob_reader();
+  };
+  source_.writer_for = [this](const std::string& engine) -> transport::BlobWriter* {
+    auto it = by_name_.find(engine);
+    return it == by_name_.end() ? nullptr : it->second->blob_writer();
+  };
 }
 
 void FtiLoop::set_step_log(std::FILE* csv) {

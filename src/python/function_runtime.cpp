@@ -68,6 +68,7 @@ py::object FunctionRuntime::input_object(const FunctionInput& in, const InputSou
   const engine::DataPack* dp = src.engine_datapack(in.engine, in.datapack);
   py::object obj;
   if (dp) {
+    transport::ScopedBlobContext blobs(nullptr, src.reader_for ? src.reader_for(in.engine) : nullptr);
     obj = to_python(*dp);
   } else {
     obj = py::module_::import("nrp_core._datapacks").attr("EmptyDataPack")(in.datapack, in.engine);
@@ -101,7 +102,14 @@ void FunctionRuntime::run_transceiver(const LoadedFunction& fn, const InputSourc
   for (auto item : result) {
     outputs->emplace_back();
     try {
+      transport::BlobWriter* writer = nullptr;
+      if (src.writer_for && py::hasattr(item, "_id")) {
+        writer = src.writer_for(item.attr("_id").attr("engineName").cast<std::string>());
+      }
+      transport::ScopedBlobContext blobs(writer, nullptr);
       from_python(item, &outputs->back());
+    } catch (py::error_already_set& e) {
+      throw FunctionError(fn.label() + ": " + format_exception(e));
     } catch (const std::exception& e) {
       throw FunctionError(fn.label() + ": " + e.what());
     }

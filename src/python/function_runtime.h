@@ -8,6 +8,7 @@
 
 #include "convoy/engine.pb.h"
 #include "python/interpreter.h"
+#include "transport/blobs.h"
 
 namespace convoy::python {
 
@@ -33,6 +34,9 @@ struct InputSource {
   // Returns the latest datapack read from an engine, or nullptr if none yet.
   std::function<const engine::DataPack*(const std::string& engine, const std::string& name)>
       engine_datapack;
+  // Reads the blobs of datapacks from `engine`; writes those of datapacks sent to it.
+  std::function<const transport::BlobReader*(const std::string& engine)> reader_for;
+  std::function<transport::BlobWriter*(const std::string& engine)> writer_for;
 };
 
 class FunctionRuntime {

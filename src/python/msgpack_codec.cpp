@@ -3,6 +3,8 @@
 #include <cstring>
 #include <vector>
 
+#include "transport/blobs.h"
+
 namespace convoy::python {
 namespace {
 
@@ -51,7 +53,7 @@ bool is_ndarray(PyObject* obj) {
   return std::strcmp(Py_TYPE(obj)->tp_name, "numpy.ndarray") == 0;
 }
 
-bool encode_ndarray(PyObject* obj, std::string* out) {
+bool encode_ndarray(PyObject* obj, std::string* out, engine::DataPack* owner) {
   Py_buffer view;
   // C-contiguous view; non-contiguous arrays are copied by numpy into one.
   PyObject* contig = nullptr;
@@ -82,19 +84,29 @@ bool encode_ndarray(PyObject* obj, std::string* out) {
     uint64_t d = static_cast<uint64_t>(view.shape[i]);
     for (int b = 0; b < 8; ++b) header.push_back(static_cast<char>((d >> (8 * b)) & 0xff));
   }
-  size_t total = header.size() + static_cast<size_t>(view.len);
-  out->push_back('\xc9');
-  put_be(out, total, 4);
-  out->push_back(static_cast<char>(kNdarrayExtType));
-  out->append(header);
-  out->append(static_cast<const char*>(view.buf), static_cast<size_t>(view.len));
+  if (owner && static_cast<size_t>(view.len) >= transport::kShmBlobThreshold) {
+    uint32_t index = transport::current_blob_writer().add(
+        owner, std::string_view(static_cast<const char*>(view.buf), static_cast<size_t>(view.len)));
+    out->push_back('\xc9');
+    put_be(out, header.size() + 4, 4);
+    out->push_back(static_cast<char>(kNdarrayBlobExtType));
+    out->append(header);
+    put_be(out, index, 4);
+  } else {
+    size_t total = header.size() + static_cast<size_t>(view.len);
+    out->push_back('\xc9');
+    put_be(out, total, 4);
+    out->push_back(static_cast<char>(kNdarrayExtType));
+    out->append(header);
+    out->append(static_cast<const char*>(view.buf), static_cast<size_t>(view.len));
+  }
   Py_DECREF(descr);
   PyBuffer_Release(&view);
   Py_XDECREF(contig);
   return true;
 }
 
-bool encode(PyObject* obj, std::string* out, int depth) {
+bool encode(PyObject* obj, std::string* out, engine::DataPack* owner, int depth) {
   if (depth > 200) {
     PyErr_SetString(PyExc_ValueError, "datapack data nested too deeply (cycle?)");
     return false;
@@ -134,15 +146,15 @@ bool encode(PyObject* obj, std::string* out, int depth) {
     Py_ssize_t pos = 0;
     while (PyDict_Next(obj, &pos, &key, &value)) {
       if (PyUnicode_Check(key)) {
-        if (!encode(key, out, depth + 1)) return false;
+        if (!encode(key, out, owner, depth + 1)) return false;
       } else {
         PyObject* s = PyObject_Str(key);  // JSON keys are strings
         if (!s) return false;
-        bool ok = encode(s, out, depth + 1);
+        bool ok = encode(s, out, owner, depth + 1);
         Py_DECREF(s);
         if (!ok) return false;
       }
-      if (!encode(value, out, depth + 1)) return false;
+      if (!encode(value, out, owner, depth + 1)) return false;
     }
   } else if (PyList_Check(obj) || PyTuple_Check(obj)) {
     PyObject* seq = obj;
@@ -150,7 +162,7 @@ bool encode(PyObject* obj, std::string* out, int depth) {
     put_len(out, static_cast<size_t>(n), 0x90, 15, 0, 0xdc, 0xdd);
     PyObject** items = PySequence_Fast_ITEMS(seq);
     for (Py_ssize_t i = 0; i < n; ++i)
-      if (!encode(items[i], out, depth + 1)) return false;
+      if (!encode(items[i], out, owner, depth + 1)) return false;
   } else if (PyBytes_Check(obj) || PyByteArray_Check(obj)) {
     const char* p = PyBytes_Check(obj) ? PyBytes_AS_STRING(obj) : PyByteArray_AS_STRING(obj);
     size_t n = static_cast<size_t>(PyBytes_Check(obj) ? PyBytes_GET_SIZE(obj)
@@ -158,18 +170,18 @@ bool encode(PyObject* obj, std::string* out, int depth) {
     put_len(out, n, 0, 0, 0xc4, 0xc5, 0xc6);
     out->append(p, n);
   } else if (is_ndarray(obj)) {
-    return encode_ndarray(obj, out);
+    return encode_ndarray(obj, out, owner);
   } else if (PyObject_HasAttrString(obj, "item") && PyObject_HasAttrString(obj, "dtype")) {
     PyObject* item = PyObject_CallMethod(obj, "item", nullptr);  // numpy scalar
     if (!item) return false;
-    bool ok = encode(item, out, depth + 1);
+    bool ok = encode(item, out, owner, depth + 1);
     Py_DECREF(item);
     return ok;
   } else if (PyObject_HasAttrString(obj, "keys") && PyObject_HasAttrString(obj, "__getitem__")) {
     PyObject* d = PyObject_CallFunctionObjArgs(reinterpret_cast<PyObject*>(&PyDict_Type), obj,
                                                nullptr);
     if (!d) return false;
-    bool ok = encode(d, out, depth + 1);
+    bool ok = encode(d, out, owner, depth + 1);
     Py_DECREF(d);
     return ok;
   } else {
@@ -181,8 +193,8 @@ bool encode(PyObject* obj, std::string* out, int depth) {
 
 class Decoder {
  public:
-  explicit Decoder(std::string_view b) : p_(reinterpret_cast<const uint8_t*>(b.data())),
-                                         end_(p_ + b.size()) {}
+  Decoder(std::string_view b, const engine::DataPack* owner)
+      : p_(reinterpret_cast<const uint8_t*>(b.data())), end_(p_ + b.size()), owner_(owner) {}
 
   PyObject* value() {
     if (!need(1)) return nullptr;
@@ -310,19 +322,20 @@ class Decoder {
     int8_t type = static_cast<int8_t>(*p_++);
     const uint8_t* body = p_;
     p_ += n;
-    if (type != kNdarrayExtType) {
-      return PyBytes_FromStringAndSize(reinterpret_cast<const char*>(body), n);
+    if (type == kNdarrayExtType || type == kNdarrayBlobExtType) {
+      return ndarray(body, n, type == kNdarrayBlobExtType);
     }
-    return ndarray(body, n);
+    return PyBytes_FromStringAndSize(reinterpret_cast<const char*>(body), n);
   }
-  PyObject* ndarray(const uint8_t* b, size_t n);
+  PyObject* ndarray(const uint8_t* b, size_t n, bool in_blob);
 
   const uint8_t* p_;
   const uint8_t* end_;
+  const engine::DataPack* owner_;
   bool ok_ = true;
 };
 
-PyObject* Decoder::ndarray(const uint8_t* b, size_t n) {
+PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
   const uint8_t* e = b + n;
   if (n < 2) return fail("bad ndarray header");
   size_t dlen = *b++;
@@ -356,22 +369,41 @@ PyObject* Decoder::ndarray(const uint8_t* b, size_t n) {
     Py_DECREF(arr);
     return fail("ndarray buffer");
   }
-  if (static_cast<size_t>(view.len) != static_cast<size_t>(e - b)) {
+  std::string_view data(reinterpret_cast<const char*>(b), static_cast<size_t>(e - b));
+  if (in_blob) {
+    if (data.size() != 4 || !owner_) {
+      PyBuffer_Release(&view);
+      Py_DECREF(arr);
+      return fail("array blob reference without its datapack");
+    }
+    uint32_t index = (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3];
+    try {
+      data = transport::current_blob_reader().get(*owner_, index);
+    } catch (const std::exception& ex) {
+      PyBuffer_Release(&view);
+      Py_DECREF(arr);
+      PyErr_SetString(PyExc_ValueError, ex.what());
+      return fail(ex.what());
+    }
+  }
+  if (static_cast<size_t>(view.len) != data.size()) {
     PyBuffer_Release(&view);
     Py_DECREF(arr);
     return fail("ndarray size does not match its shape");
   }
-  std::memcpy(view.buf, b, static_cast<size_t>(view.len));
+  std::memcpy(view.buf, data.data(), data.size());
   PyBuffer_Release(&view);
   return arr;
 }
 
 }  // namespace
 
-bool msgpack_encode(PyObject* obj, std::string* out) { return encode(obj, out, 0); }
+bool msgpack_encode(PyObject* obj, std::string* out, engine::DataPack* blob_owner) {
+  return encode(obj, out, blob_owner, 0);
+}
 
-PyObject* msgpack_decode(std::string_view bytes) {
-  Decoder d(bytes);
+PyObject* msgpack_decode(std::string_view bytes, const engine::DataPack* blob_owner) {
+  Decoder d(bytes, blob_owner);
   PyObject* v = d.value();
   if (v && !d.at_end()) {
     Py_DECREF(v);

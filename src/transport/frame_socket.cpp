@@ -136,6 +136,13 @@ RecvStatus FrameSocket::recv(std::string* payload, Deadline deadline) {
 void make_socket_pair(int fds[2]) {
   if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
     throw std::runtime_error(std::string("socketpair: ") + std::strerror(errno));
+  // Large inline frames (no shared memory) pass in fewer wake-ups with larger buffers; the
+  // kernel caps these at net.core.wmem_max unless we may force them.
+  int bytes = 8 << 20;
+  for (int i = 0; i < 2; ++i) {
+    if (setsockopt(fds[i], SOL_SOCKET, SO_SNDBUFFORCE, &bytes, sizeof bytes) != 0)
+      setsockopt(fds[i], SOL_SOCKET, SO_SNDBUF, &bytes, sizeof bytes);
+  }
 }
 
 }  // namespace convoy::transport

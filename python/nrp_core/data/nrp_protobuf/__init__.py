@@ -1,0 +1,103 @@
+"""Protobuf datapacks of the world engine, as in NRP-Core's nrp_core.data.nrp_protobuf.
+
+The data objects answer to the report's attribute names and to NRP-Core 1.4's:
+  GazeboCameraDataPack.data: image_height/imageHeight, image_width/imageWidth,
+      image_depth/imageDepth, image_data/imageData (numpy uint8, 1-D)
+  GazeboJointDataPack.data:  position, velocity, effort
+  GazeboLinkDataPack.data:   pos/position, rot/rotation (x y z w), lin_vel/linear_velocity,
+      ang_vel/angular_velocity (numpy float32)
+A camera image received in a transceiver function is a read-only view on the engine's
+frame (no copy): copy it (image_data.copy()) to change it or keep it beyond the call.
+"""
+import numpy as np
+
+from nrp_core._datapacks import DataPack, DataPackIdentifier  # noqa: F401
+
+
+def _alias(name):
+    return property(lambda self: getattr(self, name),
+                    lambda self, value: setattr(self, name, value))
+
+
+class CameraData:
+    __slots__ = ("image_height", "image_width", "image_depth", "image_data")
+
+    def __init__(self, image_height=0, image_width=0, image_depth=0, image_data=None):
+        self.image_height = image_height
+        self.image_width = image_width
+        self.image_depth = image_depth
+        self.image_data = np.zeros(0, np.uint8) if image_data is None else image_data
+
+    imageHeight = _alias("image_height")
+    imageWidth = _alias("image_width")
+    imageDepth = _alias("image_depth")
+    imageData = _alias("image_data")
+
+    def __repr__(self):
+        return "CameraData(%dx%dx%d)" % (self.image_height, self.image_width, self.image_depth)
+
+
+class JointData:
+    __slots__ = ("position", "velocity", "effort")
+
+    def __init__(self, position=0.0, velocity=0.0, effort=0.0):
+        self.position = position
+        self.velocity = velocity
+        self.effort = effort
+
+    def __repr__(self):
+        return "JointData(position=%g, velocity=%g, effort=%g)" % (
+            self.position, self.velocity, self.effort)
+
+
+def _vec(n, value=None):
+    return np.zeros(n, np.float32) if value is None else np.asarray(value, np.float32)
+
+
+class LinkData:
+    __slots__ = ("pos", "rot", "lin_vel", "ang_vel")
+
+    def __init__(self, pos=None, rot=None, lin_vel=None, ang_vel=None):
+        self.pos = _vec(3, pos)
+        self.rot = _vec(4, rot) if rot is not None else np.array([0, 0, 0, 1], np.float32)
+        self.lin_vel = _vec(3, lin_vel)
+        self.ang_vel = _vec(3, ang_vel)
+
+    position = _alias("pos")
+    rotation = _alias("rot")
+    linear_velocity = _alias("lin_vel")
+    angular_velocity = _alias("ang_vel")
+
+    def __repr__(self):
+        return "LinkData(pos=%s, rot=%s)" % (list(self.pos), list(self.rot))
+
+
+class GazeboCameraDataPack(DataPack):
+    __slots__ = ()
+    _type = "convoy.data.Camera"
+
+    def __init__(self, name, engine_name):
+        DataPack.__init__(self, name, engine_name)
+        self._data = CameraData()
+
+
+class GazeboJointDataPack(DataPack):
+    __slots__ = ()
+    _type = "convoy.data.Joint"
+
+    def __init__(self, name, engine_name):
+        DataPack.__init__(self, name, engine_name)
+        self._data = JointData()
+
+
+class GazeboLinkDataPack(DataPack):
+    __slots__ = ()
+    _type = "convoy.data.Link"
+
+    def __init__(self, name, engine_name):
+        DataPack.__init__(self, name, engine_name)
+        self._data = LinkData()
+
+
+__all__ = ["GazeboCameraDataPack", "GazeboJointDataPack", "GazeboLinkDataPack", "CameraData",
+           "JointData", "LinkData", "DataPackIdentifier"]
