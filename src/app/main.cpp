@@ -6,6 +6,7 @@
 #include <string>
 
 #include "app/simulation.h"
+#include "core/memory.h"
 
 namespace {
 
@@ -25,6 +26,7 @@ void usage(const char* prog) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  convoy::tune_allocator_for_frames();
   std::string prog = std::filesystem::path(argv[0]).filename().string();
   int i = 1;
   if (prog != "NRPCoreSim") {

@@ -13,6 +13,7 @@
 
 #include "convoy/engine.grpc.pb.h"
 #include "core/clock.h"
+#include "core/memory.h"
 #include "transport/blobs.h"
 #include "transport/frame_socket.h"
 
@@ -261,6 +262,7 @@ void EngineServer::serve_grpc(const std::string& address) {
 }
 
 int engine_main(int argc, char** argv) {
+  tune_allocator_for_frames();
   std::string type, address;
   int fd = -1;
   int64_t spin_us = 0;
