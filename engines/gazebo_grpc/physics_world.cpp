@@ -1,0 +1,247 @@
+#include "physics_world.h"
+
+#include <dart/collision/bullet/BulletCollisionDetector.hpp>
+
+#include <functional>
+#include <set>
+#include <stdexcept>
+
+namespace convoy::world {
+
+namespace dd = dart::dynamics;
+
+namespace {
+
+dd::ShapePtr make_shape(const Shape& s, Eigen::Isometry3d* offset) {
+  switch (s.kind) {
+    case Shape::kBox:
+      return std::make_shared<dd::BoxShape>(s.size);
+    case Shape::kCylinder:
+      return std::make_shared<dd::CylinderShape>(s.size.x(), s.size.z());
+    case Shape::kSphere:
+      return std::make_shared<dd::SphereShape>(s.size.x());
+    case Shape::kPlane: {
+      // A thick box whose top face is the plane: robust with every collision detector.
+      double sx = s.size.x() > 0 ? s.size.x() : 1000, sy = s.size.y() > 0 ? s.size.y() : 1000;
+      Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), s.normal);
+      Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+      t.linear() = q.toRotationMatrix();
+      t.translation() = -0.5 * s.normal;
+      *offset = *offset * t;
+      return std::make_shared<dd::BoxShape>(Eigen::Vector3d(sx, sy, 1.0));
+    }
+    case Shape::kMesh: {
+      const aiScene* scene = dd::MeshShape::loadMesh(s.mesh.string());
+      if (!scene) throw std::runtime_error(s.mesh.string() + ": cannot load mesh");
+      return std::make_shared<dd::MeshShape>(s.scale, scene);
+    }
+  }
+  return nullptr;
+}
+
+// Properties shared by every joint type: name and the frames on both sides.
+template <typename Props>
+void set_frames(Props& p, const std::string& name, const Eigen::Isometry3d& parent_world,
+                const Eigen::Isometry3d& child_world, const Eigen::Isometry3d& joint_world) {
+  p.mName = name;
+  p.mT_ParentBodyToJoint = parent_world.inverse() * joint_world;
+  p.mT_ChildBodyToJoint = child_world.inverse() * joint_world;
+}
+
+}  // namespace
+
+PhysicsWorld::PhysicsWorld(const WorldDesc& desc) {
+  world_ = dart::simulation::World::create(desc.name);
+  world_->setGravity(desc.gravity);
+  world_->setTimeStep(desc.max_step_size > 0 ? desc.max_step_size : 0.001);
+  world_->getConstraintSolver()->setCollisionDetector(
+      dart::collision::BulletCollisionDetector::create());
+  for (const auto& model : desc.models) build_model(model);
+}
+
+void PhysicsWorld::build_model(const ModelDesc& model) {
+  if (model.links.empty()) return;
+  auto skel = dd::Skeleton::create(model.name);
+  std::unordered_map<std::string, const LinkDesc*> links;
+  for (const auto& l : model.links) links[l.name] = &l;
+  std::unordered_map<std::string, std::vector<const JointDesc*>> children;  // by parent
+  std::set<std::string> has_parent;
+  std::unordered_map<std::string, const JointDesc*> to_world;  // child link -> joint to world
+  for (const auto& j : model.joints) {
+    if (!links.count(j.child)) {
+      throw std::runtime_error("joint '" + j.name + "': unknown child link '" + j.child + "'");
+    }
+    if (j.parent == "world") {
+      to_world[j.child] = &j;
+    } else {
+      if (!links.count(j.parent)) {
+        throw std::runtime_error("joint '" + j.name + "': unknown parent link '" + j.parent + "'");
+      }
+      children[j.parent].push_back(&j);
+    }
+    has_parent.insert(j.child);
+  }
+
+  auto body_props = [](const LinkDesc& l) {
+    dd::BodyNode::Properties bp;
+    bp.mName = l.name;
+    bp.mInertia = dd::Inertia(l.mass, l.com, l.inertia);
+    bp.mGravityMode = l.gravity;
+    return bp;
+  };
+  auto add_shapes = [&](dd::BodyNode* bn, const LinkDesc& l) {
+    for (const auto& c : l.collisions) {
+      Eigen::Isometry3d offset = c.pose;
+      auto shape = make_shape(c.shape, &offset);
+      auto* node =
+          bn->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(shape, l.name + "::" + c.name);
+      node->setRelativeTransform(offset);
+      node->getDynamicsAspect()->setFrictionCoeff(c.mu);
+    }
+    links_.push_back(bn);
+    link_names_.push_back(l.name);
+    link_by_name_[l.name] = static_cast<int>(links_.size() - 1);
+  };
+
+  // Builds the subtree hanging from `parent_bn` through joint `j` (nullptr: a root link).
+  std::function<void(dd::BodyNode*, const LinkDesc&, const JointDesc*)> attach;
+  attach = [&](dd::BodyNode* parent_bn, const LinkDesc& l, const JointDesc* j) {
+    Eigen::Isometry3d parent_world = (j && j->parent != "world") ? links.at(j->parent)->pose
+                                                                   : Eigen::Isometry3d::Identity();
+    std::pair<dd::Joint*, dd::BodyNode*> made;
+    auto bp = body_props(l);
+    if (!j) {
+      if (model.is_static) {
+        dd::WeldJoint::Properties p;
+        set_frames(p, model.name + "::__root__" + l.short_name, Eigen::Isometry3d::Identity(),
+                   l.pose, l.pose);
+        made = skel->createJointAndBodyNodePair<dd::WeldJoint>(nullptr, p, bp);
+      } else {
+        dd::FreeJoint::Properties p;
+        p.mName = model.name + "::__root__" + l.short_name;
+        made = skel->createJointAndBodyNodePair<dd::FreeJoint>(nullptr, p, bp);
+        made.first->setPositions(dd::FreeJoint::convertToPositions(l.pose));
+      }
+    } else {
+      const AxisDesc axis = j->axes.empty() ? AxisDesc{} : j->axes[0];
+      switch (j->type) {
+        case JointDesc::kRevolute:
+        case JointDesc::kContinuous: {
+          dd::RevoluteJoint::Properties p;
+          set_frames(p, j->name, parent_world, l.pose, j->pose);
+          p.mAxis = axis.xyz;
+          made = skel->createJointAndBodyNodePair<dd::RevoluteJoint>(parent_bn, p, bp);
+          break;
+        }
+        case JointDesc::kPrismatic: {
+          dd::PrismaticJoint::Properties p;
+          set_frames(p, j->name, parent_world, l.pose, j->pose);
+          p.mAxis = axis.xyz;
+          made = skel->createJointAndBodyNodePair<dd::PrismaticJoint>(parent_bn, p, bp);
+          break;
+        }
+        case JointDesc::kFixed: {
+          dd::WeldJoint::Properties p;
+          set_frames(p, j->name, parent_world, l.pose, j->pose);
+          made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
+          break;
+        }
+        case JointDesc::kBall: {
+          dd::BallJoint::Properties p;
+          set_frames(p, j->name, parent_world, l.pose, j->pose);
+          made = skel->createJointAndBodyNodePair<dd::BallJoint>(parent_bn, p, bp);
+          break;
+        }
+        case JointDesc::kUniversal: {
+          dd::UniversalJoint::Properties p;
+          set_frames(p, j->name, parent_world, l.pose, j->pose);
+          p.mAxis[0] = axis.xyz;
+          p.mAxis[1] = j->axes.size() > 1 ? j->axes[1].xyz : Eigen::Vector3d::UnitY();
+          made = skel->createJointAndBodyNodePair<dd::UniversalJoint>(parent_bn, p, bp);
+          break;
+        }
+      }
+      dd::Joint* joint = made.first;
+      for (size_t a = 0; a < joint->getNumDofs() && a < j->axes.size(); ++a) {
+        const auto& ax = j->axes[a];
+        bool limited = j->type != JointDesc::kContinuous && ax.lower < ax.upper &&
+                       ax.lower > -1e15 && ax.upper < 1e15;
+        if (limited) {
+          joint->setPositionLowerLimit(a, ax.lower);
+          joint->setPositionUpperLimit(a, ax.upper);
+          joint->setLimitEnforcement(true);
+        }
+        joint->setDampingCoefficient(a, ax.damping);
+        joint->setCoulombFriction(a, ax.friction);
+        if (ax.effort > 0) {
+          joint->setForceLowerLimit(a, -ax.effort);
+          joint->setForceUpperLimit(a, ax.effort);
+        }
+      }
+      if (joint->getNumDofs() > 0) {
+        joints_.push_back({j->name, joint, 0});
+        joint_by_name_[j->name] = static_cast<int>(joints_.size() - 1);
+      }
+    }
+    add_shapes(made.second, l);
+    auto it = children.find(l.name);
+    if (it == children.end()) return;
+    for (const JointDesc* cj : it->second) attach(made.second, *links.at(cj->child), cj);
+  };
+
+  for (const auto& l : model.links) {
+    auto tw = to_world.find(l.name);
+    if (tw != to_world.end()) {
+      attach(nullptr, l, tw->second);  // jointed to the world frame
+    } else if (!has_parent.count(l.name)) {
+      attach(nullptr, l, nullptr);  // a free (or, in a static model, welded) root
+    }
+  }
+  world_->addSkeleton(skel);
+}
+
+void PhysicsWorld::step() {
+  for (auto& j : joints_) {
+    if (j.effort != 0) j.joint->setForce(0, j.effort);
+  }
+  world_->step();
+}
+
+int PhysicsWorld::joint_index(const std::string& name) const {
+  auto it = joint_by_name_.find(name);
+  return it == joint_by_name_.end() ? -1 : it->second;
+}
+
+JointState PhysicsWorld::joint_state(int index) const {
+  const auto& j = joints_[index];
+  return {j.joint->getPosition(0), j.joint->getVelocity(0), j.effort};
+}
+
+void PhysicsWorld::set_joint_effort(int index, double effort) { joints_[index].effort = effort; }
+
+void PhysicsWorld::set_joint_position(int index, double position) {
+  joints_[index].joint->setPosition(0, position);
+  joints_[index].joint->setVelocity(0, 0);
+}
+
+int PhysicsWorld::link_index(const std::string& name) const {
+  auto it = link_by_name_.find(name);
+  return it == link_by_name_.end() ? -1 : it->second;
+}
+
+Eigen::Isometry3d PhysicsWorld::link_pose(int index) const {
+  return links_[index]->getWorldTransform();
+}
+
+LinkState PhysicsWorld::link_state(int index) const {
+  const dd::BodyNode* bn = links_[index];
+  LinkState s;
+  const Eigen::Isometry3d& t = bn->getWorldTransform();
+  s.position = t.translation();
+  s.rotation = Eigen::Quaterniond(t.linear());
+  s.linear_velocity = bn->getLinearVelocity();
+  s.angular_velocity = bn->getAngularVelocity();
+  return s;
+}
+
+}  // namespace convoy::world

@@ -1,0 +1,70 @@
+// The world's physics: DART with the Bullet collision detector, built from a WorldDesc.
+// Each SDF model is a DART skeleton; each link a body node; root links hang from the world
+// on a free joint (a weld for static models).
+#pragma once
+
+#include <dart/dart.hpp>
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "world_description.h"
+
+namespace convoy::world {
+
+struct JointState {
+  double position = 0, velocity = 0, effort = 0;
+};
+
+struct LinkState {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+};
+
+class PhysicsWorld {
+ public:
+  explicit PhysicsWorld(const WorldDesc& desc);
+
+  // One physics step of max_step_size.
+  void step();
+  double time() const { return world_->getTime(); }
+  double step_size() const { return world_->getTimeStep(); }
+
+  // Joints by scoped name (model::joint); -1 if unknown.
+  int joint_index(const std::string& name) const;
+  const std::string& joint_name(int index) const { return joints_[index].name; }
+  JointState joint_state(int index) const;
+  // Effort (torque or force) applied on the joint's first axis during the next steps.
+  void set_joint_effort(int index, double effort);
+  // Moves the joint (first axis) to `position`, at rest; for initial conditions.
+  void set_joint_position(int index, double position);
+
+  // Links by scoped name (model::link); -1 if unknown.
+  int link_index(const std::string& name) const;
+  LinkState link_state(int index) const;
+  Eigen::Isometry3d link_pose(int index) const;
+  const std::vector<std::string>& link_names() const { return link_names_; }
+
+  dart::simulation::WorldPtr dart_world() const { return world_; }
+
+ private:
+  struct JointRef {
+    std::string name;
+    dart::dynamics::Joint* joint = nullptr;
+    double effort = 0;
+  };
+  void build_model(const ModelDesc& model);
+
+  dart::simulation::WorldPtr world_;
+  std::vector<JointRef> joints_;
+  std::unordered_map<std::string, int> joint_by_name_;
+  std::vector<dart::dynamics::BodyNode*> links_;
+  std::vector<std::string> link_names_;
+  std::unordered_map<std::string, int> link_by_name_;
+};
+
+}  // namespace convoy::world

@@ -1,0 +1,447 @@
+#include "world_description.h"
+
+#include <sdf/sdf.hh>
+
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace convoy::world {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+Eigen::Isometry3d to_eigen(const ignition::math::Pose3d& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(p.Pos().X(), p.Pos().Y(), p.Pos().Z());
+  t.linear() = Eigen::Quaterniond(p.Rot().W(), p.Rot().X(), p.Rot().Y(), p.Rot().Z())
+                   .normalized()
+                   .toRotationMatrix();
+  return t;
+}
+
+Eigen::Vector3d to_eigen(const ignition::math::Vector3d& v) { return {v.X(), v.Y(), v.Z()}; }
+
+Rgba to_rgba(const ignition::math::Color& c) { return {c.R(), c.G(), c.B(), c.A()}; }
+
+std::string format_errors(const sdf::Errors& errors, const fs::path& file) {
+  std::ostringstream out;
+  for (const auto& e : errors) {
+    out << e.FilePath().value_or(file.string());
+    if (e.LineNumber()) out << ":" << *e.LineNumber();
+    out << ": " << e.Message() << "\n";
+  }
+  std::string s = out.str();
+  if (!s.empty()) s.pop_back();
+  return s;
+}
+
+std::vector<fs::path> model_paths(const fs::path& world_file) {
+  std::vector<fs::path> dirs;
+  for (const char* var : {"CONVOY_MODEL_PATH", "GAZEBO_MODEL_PATH", "SDF_PATH"}) {
+    const char* v = std::getenv(var);
+    if (!v) continue;
+    std::stringstream ss(v);
+    std::string item;
+    while (std::getline(ss, item, ':'))
+      if (!item.empty()) dirs.emplace_back(item);
+  }
+  dirs.push_back(world_file.parent_path());
+  dirs.push_back(world_file.parent_path() / "models");
+  return dirs;
+}
+
+// Resolves model://name/rest, file://, absolute and relative (to `base_dir`) URIs.
+fs::path resolve_uri(const std::string& uri, const fs::path& base_dir,
+                     const std::vector<fs::path>& paths) {
+  const std::string model = "model://", file = "file://";
+  if (uri.rfind(model, 0) == 0) {
+    std::string rest = uri.substr(model.size());
+    for (const auto& dir : paths) {
+      if (fs::exists(dir / rest)) return fs::absolute(dir / rest);
+    }
+    return {};
+  }
+  std::string p = uri.rfind(file, 0) == 0 ? uri.substr(file.size()) : uri;
+  fs::path path(p);
+  if (path.is_relative()) path = base_dir / path;
+  return fs::exists(path) ? fs::absolute(path) : fs::path{};
+}
+
+// Gazebo's stock script materials, for worlds that use them.
+bool script_colour(const std::string& name, Rgba* out) {
+  static const std::map<std::string, Rgba> colours = {
+      {"Gazebo/White", {1, 1, 1, 1}},        {"Gazebo/Black", {0.05f, 0.05f, 0.05f, 1}},
+      {"Gazebo/Grey", {0.7f, 0.7f, 0.7f, 1}}, {"Gazebo/DarkGrey", {0.35f, 0.35f, 0.35f, 1}},
+      {"Gazebo/Red", {1, 0, 0, 1}},          {"Gazebo/Green", {0, 1, 0, 1}},
+      {"Gazebo/Blue", {0, 0, 1, 1}},         {"Gazebo/Yellow", {1, 1, 0, 1}},
+      {"Gazebo/Orange", {1, 0.5f, 0.05f, 1}}, {"Gazebo/Purple", {1, 0, 1, 1}},
+      {"Gazebo/Turquoise", {0, 1, 1, 1}},    {"Gazebo/Wood", {0.6f, 0.4f, 0.2f, 1}},
+      {"Gazebo/Asphalt", {0.2f, 0.2f, 0.2f, 1}}, {"Gazebo/Road", {0.25f, 0.25f, 0.25f, 1}},
+  };
+  auto it = colours.find(name);
+  if (it == colours.end()) return false;
+  *out = it->second;
+  return true;
+}
+
+class Loader {
+ public:
+  explicit Loader(const fs::path& file) : file_(file), paths_(model_paths(file)) {}
+
+  Shape shape(const sdf::Geometry* g, const std::string& where) {
+    Shape s;
+    switch (g->Type()) {
+      case sdf::GeometryType::BOX:
+        s.kind = Shape::kBox;
+        s.size = to_eigen(g->BoxShape()->Size());
+        break;
+      case sdf::GeometryType::CYLINDER:
+        s.kind = Shape::kCylinder;
+        s.size = {g->CylinderShape()->Radius(), g->CylinderShape()->Radius(),
+                  g->CylinderShape()->Length()};
+        break;
+      case sdf::GeometryType::SPHERE:
+        s.kind = Shape::kSphere;
+        s.size = Eigen::Vector3d::Constant(g->SphereShape()->Radius());
+        break;
+      case sdf::GeometryType::PLANE:
+        s.kind = Shape::kPlane;
+        s.size = {g->PlaneShape()->Size().X(), g->PlaneShape()->Size().Y(), 0};
+        s.normal = to_eigen(g->PlaneShape()->Normal()).normalized();
+        break;
+      case sdf::GeometryType::MESH: {
+        s.kind = Shape::kMesh;
+        const sdf::Mesh* m = g->MeshShape();
+        fs::path base = m->FilePath().empty() ? file_.parent_path() : fs::path(m->FilePath()).parent_path();
+        s.mesh = resolve_uri(m->Uri(), base, paths_);
+        if (s.mesh.empty()) {
+          throw std::runtime_error(file_.string() + ": " + where + ": mesh '" + m->Uri() +
+                                   "' not found (model path: $CONVOY_MODEL_PATH, "
+                                   "$GAZEBO_MODEL_PATH, $SDF_PATH)");
+        }
+        s.scale = to_eigen(m->Scale());
+        break;
+      }
+      default:
+        throw std::runtime_error(file_.string() + ": " + where +
+                                 ": unsupported geometry (box, cylinder, sphere, plane and mesh "
+                                 "are)");
+    }
+    return s;
+  }
+
+  Material material(const sdf::Material* m, const std::string& where) {
+    Material out;
+    if (!m) return out;
+    out.has_material = true;
+    out.ambient = to_rgba(m->Ambient());
+    out.diffuse = to_rgba(m->Diffuse());
+    out.specular = to_rgba(m->Specular());
+    out.emissive = to_rgba(m->Emissive());
+    Rgba c;
+    if (!m->ScriptName().empty() && script_colour(m->ScriptName(), &c)) {
+      out.diffuse = c;
+      out.ambient = c;
+    }
+    if (const sdf::Pbr* pbr = m->PbrMaterial()) {
+      for (auto type : {sdf::PbrWorkflowType::METAL, sdf::PbrWorkflowType::SPECULAR}) {
+        const sdf::PbrWorkflow* wf = pbr->Workflow(type);
+        if (wf && !wf->AlbedoMap().empty()) {
+          out.texture = resolve_uri(wf->AlbedoMap(), fs::path(m->FilePath()).parent_path(), paths_);
+          if (out.texture.empty()) {
+            throw std::runtime_error(file_.string() + ": " + where + ": texture '" +
+                                     wf->AlbedoMap() + "' not found");
+          }
+        }
+      }
+    }
+    return out;
+  }
+
+  static std::string attr(const sdf::ElementPtr& e, const char* name) {
+    auto a = e->GetAttribute(name);
+    return a ? a->GetAsString() : "";
+  }
+
+  void plugins(const sdf::ElementPtr& elem, const std::string& model_name, ModelDesc* model) {
+    if (!elem->HasElement("plugin")) return;
+    for (auto p = elem->GetElement("plugin"); p; p = p->GetNextElement("plugin")) {
+      std::string name = attr(p, "name"), filename = attr(p, "filename");
+      std::string where = "model '" + model_name + "' plugin '" + name + "'";
+      if (filename.find("JointController") != std::string::npos) {
+        std::vector<PidDesc> pids;
+        for (auto j = p->GetFirstElement(); j; j = j->GetNextElement()) {
+          PidDesc pid;
+          pid.joint = model_name + "::" + j->GetName();
+          bool known = false;
+          for (const auto& jd : model->joints) known |= jd.name == pid.joint;
+          if (!known) {
+            throw std::runtime_error(file_.string() + ": " + where + ": unknown joint '" +
+                                     j->GetName() + "'");
+          }
+          auto num = [&](const char* key, double def) {
+            std::string v = attr(j, key);
+            if (v.empty()) return def;
+            try {
+              return std::stod(v);
+            } catch (const std::exception&) {
+              throw std::runtime_error(file_.string() + ": " + where + ": joint '" +
+                                       j->GetName() + "': " + key + "='" + v + "' is not a number");
+            }
+          };
+          pid.p = num("P", 0);
+          pid.i = num("I", 0);
+          pid.d = num("D", 0);
+          pid.target = num("Target", 0);
+          pid.i_max = num("IMax", 0);
+          pid.i_min = num("IMin", 0);
+          std::string type = attr(j, "Type");
+          if (type != "position" && type != "velocity") {
+            throw std::runtime_error(file_.string() + ": " + where + ": joint '" + j->GetName() +
+                                     "': Type must be position or velocity, got '" + type + "'");
+          }
+          pid.velocity = type == "velocity";
+          pids.push_back(pid);
+        }
+        model->joint_plugins.emplace_back(name, std::move(pids));
+      } else if (filename.find("LinkController") != std::string::npos ||
+                 filename.find("LinkPlugin") != std::string::npos) {
+        model->link_plugins.push_back(name);
+      }
+    }
+  }
+
+  void model(const sdf::Model* m, const Eigen::Isometry3d& model_world, const std::string& name,
+             WorldDesc* world) {
+    ModelDesc md;
+    md.name = name;
+    md.is_static = m->Static();
+    for (uint64_t i = 0; i < m->LinkCount(); ++i) {
+      const sdf::Link* l = m->LinkByIndex(i);
+      LinkDesc ld;
+      ld.short_name = l->Name();
+      ld.name = name + "::" + l->Name();
+      std::string where = "link '" + ld.name + "'";
+      ignition::math::Pose3d pose;
+      auto errors = l->SemanticPose().Resolve(pose);
+      if (!errors.empty()) throw std::runtime_error(format_errors(errors, file_));
+      ld.pose = model_world * to_eigen(pose);
+      const auto& inertial = l->Inertial();
+      ld.mass = inertial.MassMatrix().Mass();
+      if (!(ld.mass > 0)) {
+        throw std::runtime_error(file_.string() + ": " + where + ": mass must be > 0");
+      }
+      Eigen::Isometry3d inertial_pose = to_eigen(inertial.Pose());
+      ld.com = inertial_pose.translation();
+      const auto& moi = inertial.MassMatrix().Moi();
+      Eigen::Matrix3d I;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) I(r, c) = moi(r, c);
+      ld.inertia = inertial_pose.linear() * I * inertial_pose.linear().transpose();
+      if (auto e = l->Element(); e && e->HasElement("gravity")) ld.gravity = e->Get<bool>("gravity");
+      for (uint64_t c = 0; c < l->CollisionCount(); ++c) {
+        const sdf::Collision* col = l->CollisionByIndex(c);
+        CollisionDesc cd;
+        cd.name = col->Name();
+        ignition::math::Pose3d cp;
+        col->SemanticPose().Resolve(cp);
+        cd.pose = to_eigen(cp);
+        cd.shape = shape(col->Geom(), where + " collision '" + col->Name() + "'");
+        if (auto e = col->Element()) {
+          auto s = e->FindElement("surface");
+          auto f = s ? s->FindElement("friction") : nullptr;
+          auto o = f ? f->FindElement("ode") : nullptr;
+          if (o && o->HasElement("mu")) cd.mu = o->Get<double>("mu");
+        }
+        ld.collisions.push_back(cd);
+      }
+      for (uint64_t v = 0; v < l->VisualCount(); ++v) {
+        const sdf::Visual* vis = l->VisualByIndex(v);
+        VisualDesc vd;
+        vd.name = vis->Name();
+        ignition::math::Pose3d vp;
+        vis->SemanticPose().Resolve(vp);
+        vd.pose = to_eigen(vp);
+        vd.shape = shape(vis->Geom(), where + " visual '" + vis->Name() + "'");
+        vd.material = material(vis->Material(), where + " visual '" + vis->Name() + "'");
+        ld.visuals.push_back(vd);
+      }
+      for (uint64_t s = 0; s < l->SensorCount(); ++s) {
+        const sdf::Sensor* sensor = l->SensorByIndex(s);
+        if (sensor->Type() != sdf::SensorType::CAMERA) continue;
+        const sdf::Camera* cam = sensor->CameraSensor();
+        CameraDesc cd;
+        cd.name = sensor->Name();
+        cd.scoped_name = ld.name + "::" + sensor->Name();
+        ignition::math::Pose3d sp;
+        sensor->SemanticPose().Resolve(sp);
+        cd.pose = to_eigen(sp);
+        if (cam) {
+          cd.width = static_cast<int>(cam->ImageWidth());
+          cd.height = static_cast<int>(cam->ImageHeight());
+          cd.format = cam->PixelFormatStr();
+          cd.hfov = cam->HorizontalFov().Radian();
+          cd.near_clip = cam->NearClip();
+          cd.far_clip = cam->FarClip();
+          const sdf::Noise& n = cam->ImageNoise();
+          cd.noise = n.Type() == sdf::NoiseType::GAUSSIAN;
+          cd.noise_mean = n.Mean();
+          cd.noise_stddev = n.StdDev();
+        }
+        cd.update_rate = sensor->UpdateRate();
+        if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
+          cd.plugin_name = attr(e->GetElement("plugin"), "name");
+        }
+        ld.cameras.push_back(cd);
+      }
+      md.links.push_back(std::move(ld));
+    }
+    for (uint64_t i = 0; i < m->JointCount(); ++i) {
+      const sdf::Joint* j = m->JointByIndex(i);
+      JointDesc jd;
+      jd.short_name = j->Name();
+      jd.name = name + "::" + j->Name();
+      std::string where = "joint '" + jd.name + "'";
+      switch (j->Type()) {
+        case sdf::JointType::REVOLUTE: jd.type = JointDesc::kRevolute; break;
+        case sdf::JointType::CONTINUOUS: jd.type = JointDesc::kContinuous; break;
+        case sdf::JointType::PRISMATIC: jd.type = JointDesc::kPrismatic; break;
+        case sdf::JointType::FIXED: jd.type = JointDesc::kFixed; break;
+        case sdf::JointType::BALL: jd.type = JointDesc::kBall; break;
+        case sdf::JointType::UNIVERSAL: jd.type = JointDesc::kUniversal; break;
+        default:
+          throw std::runtime_error(file_.string() + ": " + where + ": unsupported joint type");
+      }
+      auto scoped = [&](const std::string& link) {
+        return link == "world" ? link : name + "::" + link;
+      };
+      jd.parent = scoped(j->ParentLinkName());
+      jd.child = scoped(j->ChildLinkName());
+      ignition::math::Pose3d jp;
+      auto errors = j->SemanticPose().Resolve(jp, "__model__");
+      if (!errors.empty()) throw std::runtime_error(format_errors(errors, file_));
+      jd.pose = model_world * to_eigen(jp);
+      for (unsigned a = 0; a < 2; ++a) {
+        const sdf::JointAxis* axis = j->Axis(a);
+        if (!axis) continue;
+        AxisDesc ad;
+        ignition::math::Vector3d xyz;
+        auto axis_errors = axis->ResolveXyz(xyz, "__model__");
+        if (!axis_errors.empty()) throw std::runtime_error(format_errors(axis_errors, file_));
+        // model frame -> joint frame
+        Eigen::Matrix3d r_model_joint = to_eigen(jp).linear();
+        ad.xyz = (r_model_joint.transpose() * to_eigen(xyz)).normalized();
+        ad.lower = axis->Lower();
+        ad.upper = axis->Upper();
+        ad.damping = axis->Damping();
+        ad.friction = axis->Friction();
+        ad.effort = axis->Effort();
+        ad.velocity = axis->MaxVelocity();
+        jd.axes.push_back(ad);
+      }
+      md.joints.push_back(jd);
+    }
+    plugins(m->Element(), name, &md);
+    world->models.push_back(std::move(md));
+    for (uint64_t i = 0; i < m->ModelCount(); ++i) {
+      const sdf::Model* nested = m->ModelByIndex(i);
+      ignition::math::Pose3d np;
+      nested->SemanticPose().Resolve(np);
+      model(nested, model_world * to_eigen(np), name + "::" + nested->Name(), world);
+    }
+  }
+
+  sdf::ParserConfig config() const {
+    sdf::ParserConfig cfg;
+    auto paths = paths_;
+    cfg.SetFindCallback([paths](const std::string& uri) -> std::string {
+      for (const auto& dir : paths) {
+        if (fs::exists(dir / uri)) return (dir / uri).string();
+      }
+      return "";
+    });
+    for (const auto& dir : paths_) cfg.AddURIPath("model://", dir.string());
+    return cfg;
+  }
+
+  const fs::path& file() const { return file_; }
+
+ private:
+  fs::path file_;
+  std::vector<fs::path> paths_;
+};
+
+}  // namespace
+
+WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& extra) {
+  fs::path file = fs::absolute(file_in);
+  if (!fs::exists(file)) throw std::runtime_error(file.string() + ": world file not found");
+  Loader loader(file);
+  sdf::Root root;
+  sdf::Errors errors = root.Load(file.string(), loader.config());
+  if (!errors.empty()) throw std::runtime_error(format_errors(errors, file));
+  if (root.WorldCount() == 0) throw std::runtime_error(file.string() + ": no <world> in the file");
+  const sdf::World* w = root.WorldByIndex(0);
+  WorldDesc world;
+  world.file = file;
+  world.name = w->Name();
+  world.gravity = to_eigen(w->Gravity());
+  if (w->PhysicsCount() > 0) world.max_step_size = w->PhysicsByIndex(0)->MaxStepSize();
+  if (const sdf::Scene* scene = w->Scene()) {
+    world.ambient = to_rgba(scene->Ambient());
+    world.background = to_rgba(scene->Background());
+  }
+  if (auto e = w->Element(); e && e->HasElement("plugin")) {
+    for (auto p = e->GetElement("plugin"); p; p = p->GetNextElement("plugin")) {
+      auto fn = p->GetAttribute("filename");
+      std::string f = fn ? fn->GetAsString() : "";
+      if (f.find("WorldPlugin") != std::string::npos ||
+          f.find("CommunicationPlugin") != std::string::npos)
+        world.world_plugin = true;
+    }
+  }
+  for (uint64_t i = 0; i < w->LightCount(); ++i) {
+    const sdf::Light* l = w->LightByIndex(i);
+    LightDesc ld;
+    ld.name = l->Name();
+    ld.type = l->Type() == sdf::LightType::POINT  ? LightDesc::kPoint
+              : l->Type() == sdf::LightType::SPOT ? LightDesc::kSpot
+                                                  : LightDesc::kDirectional;
+    ignition::math::Pose3d lp;
+    l->SemanticPose().Resolve(lp);
+    Eigen::Isometry3d pose = to_eigen(lp);
+    ld.position = pose.translation();
+    ld.direction = (pose.linear() * to_eigen(l->Direction())).normalized();
+    ld.diffuse = to_rgba(l->Diffuse());
+    ld.specular = to_rgba(l->Specular());
+    ld.range = l->AttenuationRange();
+    ld.constant = l->ConstantAttenuationFactor();
+    ld.linear = l->LinearAttenuationFactor();
+    ld.quadratic = l->QuadraticAttenuationFactor();
+    world.lights.push_back(ld);
+  }
+  for (uint64_t i = 0; i < w->ModelCount(); ++i) {
+    const sdf::Model* m = w->ModelByIndex(i);
+    ignition::math::Pose3d mp;
+    m->SemanticPose().Resolve(mp);
+    loader.model(m, to_eigen(mp), m->Name(), &world);
+  }
+  for (const auto& insert : extra) {
+    fs::path mf = fs::absolute(insert.file);
+    if (!fs::exists(mf)) throw std::runtime_error(mf.string() + ": model file not found");
+    Loader model_loader(mf);
+    sdf::Root mroot;
+    auto merrors = mroot.Load(mf.string(), model_loader.config());
+    if (!merrors.empty()) throw std::runtime_error(format_errors(merrors, mf));
+    if (!mroot.Model()) throw std::runtime_error(mf.string() + ": no <model> in the file");
+    model_loader.model(mroot.Model(), insert.pose,
+                       insert.name.empty() ? mroot.Model()->Name() : insert.name, &world);
+  }
+  return world;
+}
+
+}  // namespace convoy::world

@@ -1,0 +1,134 @@
+// The parsed SDF world: an immutable description of models, links, joints, plugins,
+// sensors and lights, with every pose resolved to the world frame. Built once from
+// libsdformat's DOM; the physics and the renderer are built from it.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace convoy::world {
+
+using Rgba = std::array<float, 4>;
+
+struct Shape {
+  enum Kind { kBox, kCylinder, kSphere, kPlane, kMesh } kind = kBox;
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();  // box: x y z; cylinder: r r length;
+                                                   // sphere: r r r; plane: x y 0
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // plane
+  std::filesystem::path mesh;                         // mesh: absolute file path
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();    // mesh
+};
+
+struct Material {
+  Rgba ambient{0.6f, 0.6f, 0.6f, 1}, diffuse{0.7f, 0.7f, 0.7f, 1}, specular{0.1f, 0.1f, 0.1f, 1},
+      emissive{0, 0, 0, 1};
+  std::filesystem::path texture;  // albedo map, if any
+  bool has_material = false;
+};
+
+struct CollisionDesc {
+  std::string name;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
+  Shape shape;
+  double mu = 1.0;  // surface/friction/ode/mu
+};
+
+struct VisualDesc {
+  std::string name;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
+  Shape shape;
+  Material material;
+};
+
+struct CameraDesc {
+  std::string name;         // sensor name
+  std::string plugin_name;  // NRP camera plugin name ("" if none)
+  std::string scoped_name;  // model::link::sensor
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
+  int width = 320, height = 240;
+  std::string format = "R8G8B8";
+  double hfov = 1.047, near_clip = 0.1, far_clip = 100, update_rate = 0;  // 0: every step
+  bool noise = false;
+  double noise_mean = 0, noise_stddev = 0;
+};
+
+struct LinkDesc {
+  std::string name;         // model::link
+  std::string short_name;   // link
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // world, at load
+  double mass = 1;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();            // in the link frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity();    // about the COM, link axes
+  bool gravity = true;
+  std::vector<CollisionDesc> collisions;
+  std::vector<VisualDesc> visuals;
+  std::vector<CameraDesc> cameras;
+};
+
+struct AxisDesc {
+  Eigen::Vector3d xyz = Eigen::Vector3d::UnitZ();  // in the joint frame
+  double lower = -1e16, upper = 1e16, damping = 0, friction = 0, effort = -1, velocity = -1;
+};
+
+struct JointDesc {
+  enum Type { kRevolute, kContinuous, kPrismatic, kFixed, kBall, kUniversal } type = kFixed;
+  std::string name;        // model::joint
+  std::string short_name;  // joint
+  std::string parent;      // scoped link name, or "world"
+  std::string child;       // scoped link name
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // world, at load
+  std::vector<AxisDesc> axes;
+};
+
+// One <joint_name P I D Type Target IMax IMin/> of an NRP joint controller plugin.
+struct PidDesc {
+  std::string joint;  // scoped joint name
+  double p = 0, i = 0, d = 0, target = 0, i_max = 0, i_min = 0;
+  bool velocity = false;  // Type: velocity, else position
+};
+
+struct ModelDesc {
+  std::string name;
+  bool is_static = false;
+  std::vector<LinkDesc> links;
+  std::vector<JointDesc> joints;
+  std::vector<std::pair<std::string, std::vector<PidDesc>>> joint_plugins;  // plugin name
+  std::vector<std::string> link_plugins;                                     // plugin names
+};
+
+struct LightDesc {
+  enum Type { kDirectional, kPoint, kSpot } type = kDirectional;
+  std::string name;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero(), direction = -Eigen::Vector3d::UnitZ();
+  Rgba diffuse{1, 1, 1, 1}, specular{0.1f, 0.1f, 0.1f, 1};
+  double range = 100, constant = 1, linear = 0, quadratic = 0;
+};
+
+struct WorldDesc {
+  std::filesystem::path file;
+  std::string name;
+  Eigen::Vector3d gravity{0, 0, -9.8};
+  double max_step_size = 0.001;
+  Rgba ambient{0.4f, 0.4f, 0.4f, 1}, background{0.7f, 0.7f, 0.7f, 1};
+  bool world_plugin = false;
+  std::vector<ModelDesc> models;
+  std::vector<LightDesc> lights;
+};
+
+// A model added by the engine config (GazeboSDFModels).
+struct ModelInsert {
+  std::string name;
+  std::filesystem::path file;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+
+// Loads the world file (plus extra models). `model://` URIs are looked up in
+// $CONVOY_MODEL_PATH, $GAZEBO_MODEL_PATH and $SDF_PATH (colon-separated) and next to the
+// file. Throws std::runtime_error("<file>: <element>: <problem>").
+WorldDesc load_world(const std::filesystem::path& file, const std::vector<ModelInsert>& extra = {});
+
+}  // namespace convoy::world

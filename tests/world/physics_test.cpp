@@ -1,0 +1,155 @@
+// Physics against analytic results: free fall, a pendulum's period, PID step responses,
+// a wheeled robot's speed, determinism, and SDF error messages.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "joint_pid.h"
+#include "physics_world.h"
+#include "world_description.h"
+
+namespace convoy::world {
+namespace {
+
+const std::string kData = CONVOY_TEST_DATA_DIR;
+
+TEST(WorldDescription, ReadsModelsLinksJointsAndPlugins) {
+  WorldDesc w = load_world(kData + "/physics_basics.sdf");
+  EXPECT_NEAR(w.gravity.z(), -9.81, 1e-12);
+  EXPECT_DOUBLE_EQ(w.max_step_size, 0.001);
+  EXPECT_TRUE(w.world_plugin);
+  ASSERT_EQ(w.models.size(), 2u);
+  const ModelDesc& pend = w.models[1];
+  ASSERT_EQ(pend.joints.size(), 1u);
+  EXPECT_EQ(pend.joints[0].name, "pendulum::pivot");
+  EXPECT_EQ(pend.joints[0].parent, "world");
+  EXPECT_NEAR(pend.joints[0].pose.translation().z(), 2.0, 1e-12);  // 1 m above the bob
+  EXPECT_NEAR(pend.links[0].pose.translation().z(), 1.0, 1e-12);
+  ASSERT_EQ(pend.joint_plugins.size(), 1u);
+  EXPECT_EQ(pend.joint_plugins[0].first, "pendulum_joint_plugin");
+  EXPECT_EQ(w.models[0].link_plugins, std::vector<std::string>{"ball_link_plugin"});
+}
+
+TEST(Physics, FreeFallMatchesTheAnalyticResult) {
+  PhysicsWorld p(load_world(kData + "/physics_basics.sdf"));
+  int ball = p.link_index("ball::body");
+  ASSERT_GE(ball, 0);
+  for (int i = 0; i < 1000; ++i) p.step();
+  LinkState s = p.link_state(ball);
+  EXPECT_NEAR(s.linear_velocity.z(), -9.81, 1e-9);
+  // z = z0 - g t^2 / 2, up to the semi-implicit Euler error g dt t / 2 (~5 mm)
+  EXPECT_NEAR(s.position.z(), 100 - 0.5 * 9.81, 6e-3);
+}
+
+TEST(Physics, PendulumPeriodMatchesTheAnalyticResult) {
+  PhysicsWorld p(load_world(kData + "/physics_basics.sdf"));
+  int pivot = p.joint_index("pendulum::pivot");
+  ASSERT_GE(pivot, 0);
+  p.set_joint_position(pivot, 0.05);  // small angle
+  std::vector<double> crossings;
+  double last = p.joint_state(pivot).position;
+  for (int i = 0; i < 10000; ++i) {
+    p.step();
+    double now = p.joint_state(pivot).position;
+    if (last > 0 && now <= 0) crossings.push_back(p.time() - p.step_size() * now / (now - last));
+    last = now;
+  }
+  ASSERT_GE(crossings.size(), 3u);
+  double period = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  double expected = 2 * M_PI * std::sqrt(1.0 / 9.81);
+  EXPECT_NEAR(period, expected, 0.005 * expected);
+}
+
+TEST(Physics, PositionPidConvergesToItsTarget) {
+  PhysicsWorld p(load_world(kData + "/physics_basics.sdf"));
+  int pivot = p.joint_index("pendulum::pivot");
+  JointPid pid(300, 300, 30, 100, -100);
+  for (int i = 0; i < 10000; ++i) {
+    double error = p.joint_state(pivot).position - 0.5;
+    p.set_joint_effort(pivot, pid.update(error, p.step_size()));
+    p.step();
+  }
+  EXPECT_NEAR(p.joint_state(pivot).position, 0.5, 2e-3);
+  EXPECT_NEAR(p.joint_state(pivot).velocity, 0.0, 1e-2);
+}
+
+// Drives the four wheels at `omega` with the report's velocity PID (P = 10) for `seconds`.
+LinkState drive(PhysicsWorld& p, double omega, double seconds, double* wheel_velocity) {
+  std::vector<int> wheels;
+  for (const char* j : {"robot::j_fl", "robot::j_fr", "robot::j_rl", "robot::j_rr"})
+    wheels.push_back(p.joint_index(j));
+  std::vector<JointPid> pids(4, JointPid(10, 0, 0, 0, 0));
+  int steps = static_cast<int>(std::lround(seconds / p.step_size()));
+  for (int i = 0; i < steps; ++i) {
+    for (size_t w = 0; w < 4; ++w) {
+      double error = p.joint_state(wheels[w]).velocity - omega;
+      p.set_joint_effort(wheels[w], pids[w].update(error, p.step_size()));
+    }
+    p.step();
+  }
+  *wheel_velocity = p.joint_state(wheels[0]).velocity;
+  return p.link_state(p.link_index("robot::chassis"));
+}
+
+TEST(Physics, VelocityPidAndWheelsMoveTheRobotAtOmegaTimesRadius) {
+  PhysicsWorld p(load_world(kData + "/wheel_robot.sdf"));
+  double wheel_velocity = 0;
+  LinkState s = drive(p, 5.0, 4.0, &wheel_velocity);
+  EXPECT_NEAR(wheel_velocity, 5.0, 0.02 * 5.0);
+  double speed = s.linear_velocity.head<2>().norm();
+  EXPECT_NEAR(speed, 5.0 * 0.1, 0.02 * 0.5);
+  EXPECT_GT(s.position.x(), 1.0);          // forward
+  EXPECT_NEAR(s.position.y(), 0.0, 0.05);  // straight
+}
+
+TEST(Physics, SameWorldGivesTheSameTrajectoryBitForBit) {
+  auto run = [] {
+    PhysicsWorld p(load_world(kData + "/wheel_robot.sdf"));
+    double w = 0;
+    LinkState s = drive(p, 3.0, 2.0, &w);
+    return std::vector<double>{s.position.x(), s.position.y(), s.position.z(), s.rotation.w(),
+                               s.rotation.z(), w};
+  };
+  EXPECT_EQ(run(), run());
+}
+
+std::string error_of(const std::string& sdf_text) {
+  std::string file = ::testing::TempDir() + "/bad_world.sdf";
+  std::ofstream(file) << sdf_text;
+  try {
+    load_world(file);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(WorldErrors, MissingFileBadXmlUnknownJointAndMeshAreNamed) {
+  try {
+    load_world("/nonexistent/world.sdf");
+    FAIL();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/world.sdf"), std::string::npos);
+  }
+  std::string bad_xml = error_of("<sdf version='1.7'><world name='w'><model name='m'>");
+  EXPECT_NE(bad_xml.find("bad_world.sdf"), std::string::npos) << bad_xml;
+
+  std::string unknown_joint = error_of(R"(<sdf version='1.7'><world name='w'>
+    <model name='m'><link name='l'><inertial><mass>1</mass></inertial></link>
+      <plugin name='jp' filename='NRPGazeboGrpcJointControllerPlugin.so'>
+        <nope P='1' I='0' D='0' Type='position' Target='0' IMax='0' IMin='0'/>
+      </plugin></model></world></sdf>)");
+  EXPECT_NE(unknown_joint.find("bad_world.sdf"), std::string::npos) << unknown_joint;
+  EXPECT_NE(unknown_joint.find("plugin 'jp'"), std::string::npos) << unknown_joint;
+  EXPECT_NE(unknown_joint.find("unknown joint 'nope'"), std::string::npos) << unknown_joint;
+
+  std::string missing_mesh = error_of(R"(<sdf version='1.7'><world name='w'>
+    <model name='m'><link name='l'><visual name='v'><geometry><mesh><uri>model://nothing/car.dae</uri>
+    </mesh></geometry></visual></link></model></world></sdf>)");
+  EXPECT_NE(missing_mesh.find("model://nothing/car.dae"), std::string::npos) << missing_mesh;
+  EXPECT_NE(missing_mesh.find("link 'm::l'"), std::string::npos) << missing_mesh;
+}
+
+}  // namespace
+}  // namespace convoy::world
