@@ -10,6 +10,8 @@ PACKAGES=(
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   pybind11-dev nlohmann-json3-dev python3-dev python3-numpy
   libgtest-dev
+  libdart-dev libdart-external-ikfast-dev libdart-collision-bullet-dev libsdformat-dev
+  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev libglm-dev
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
