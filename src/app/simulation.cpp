@@ -141,6 +141,7 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
     spec.pass_fds.push_back(handle.in_arena_fd());
   }
   spec.env = ec.env_params;
+  spec.env.push_back("CONVOY_RUN_DIR=" + handle.log_file().parent_path().parent_path().string());
   spec.log_file = handle.log_file();
   spec.working_dir = cfg.dir;
   spec.search_dirs = {bin_dir()};
