@@ -1,0 +1,123 @@
+"""End-to-end tests of the world engine (gazebo_grpc) under the coordinator: the wheeled
+robot example, joint and link datapacks in TFs, the gazebo_json alias, bad SDF input.
+
+Run with Debian's /usr/bin/python3 -m unittest test_world."""
+
+import csv
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import textwrap
+import unittest
+
+from test_core import CONVOY, Experiment
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+ROBOT = os.path.join(REPO, "experiments", "wheeled_robot")
+
+
+class WorldEngine(unittest.TestCase):
+    def run_robot(self, seconds, *extra):
+        d = tempfile.mkdtemp(prefix="convoy-world-")
+        self.addCleanup(shutil.rmtree, d, True)
+        r = subprocess.run([CONVOY, "run", "-q", "-c", os.path.join(ROBOT, "simulation_config.json"),
+                            "--run-dir", os.path.join(d, "run"), "-o", "SimulationTimeout=%g" % seconds]
+                           + list(extra), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(d, "run", "trajectory.csv")) as f:
+            return list(csv.DictReader(f))
+
+    def test_wheeled_robot_example_drives_to_its_first_waypoint(self):
+        rows = self.run_robot(4)
+        self.assertEqual(len(rows), 200)
+        first, last = rows[0], rows[-1]
+        self.assertLess(abs(float(first["x"])), 0.05)
+        # heading for (2, 1): it moved that way and is driving
+        self.assertGreater(float(last["x"]), 1.0)
+        self.assertGreater(float(last["y"]), 0.3)
+        self.assertGreater(float(last["speed"]), 0.3)
+
+    def test_alias_gazebo_json_and_determinism(self):
+        a = self.run_robot(2)
+        b = self.run_robot(2, "-o", "EngineConfigs/0/EngineType=gazebo_json")
+        self.assertEqual(a, b)
+
+    def test_joint_and_link_datapacks_in_a_tf(self):
+        ex = Experiment(self)
+        shutil.copy(os.path.join(ROBOT, "world.sdf"), os.path.join(ex.dir, "world.sdf"))
+        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                           "GazeboWorldFile": "world.sdf", "EngineTimestep": 0.01})
+        ex.engine("probe", textwrap.dedent("""\
+            import json, os
+            from nrp_core.engines.python_json import EngineScript
+            class Script(EngineScript):
+                def initialize(self):
+                    self._registerDataPack("seen")
+                    self.log = []
+                def runLoop(self, timestep_ns):
+                    self.log.append(self._getDataPack("seen"))
+                def shutdown(self):
+                    with open(os.path.join(os.path.dirname(__file__), "seen.json"), "w") as f:
+                        json.dump(self.log, f)
+            """))
+        ex.function("tf", textwrap.dedent("""\
+            from nrp_core import *
+            from nrp_core.data.nrp_json import *
+            from nrp_core.data.nrp_protobuf import GazeboJointDataPack
+
+            @EngineDataPack(keyword='wheel', id=DataPackIdentifier('robot_joint_plugin::j_fl', 'gazebo'))
+            @EngineDataPack(keyword='wheel_scoped', id=DataPackIdentifier('robot::j_fl', 'gazebo'))
+            @EngineDataPack(keyword='chassis', id=DataPackIdentifier('robot_link_plugin::chassis', 'gazebo'))
+            @TransceiverFunction("gazebo")
+            def spin(wheel, wheel_scoped, chassis):
+                out = []
+                for j in ("j_fl", "j_fr", "j_rl", "j_rr"):
+                    dp = GazeboJointDataPack("robot_joint_plugin::" + j, "gazebo")
+                    dp.data.velocity = 4.0
+                    out.append(dp)
+                return out
+
+            @EngineDataPack(keyword='wheel', id=DataPackIdentifier('robot_joint_plugin::j_fl', 'gazebo'))
+            @EngineDataPack(keyword='chassis', id=DataPackIdentifier('robot::chassis', 'gazebo'))
+            @TransceiverFunction("probe")
+            def report(wheel, chassis):
+                return [JsonDataPack("seen", "probe", {
+                    "velocity": wheel.data.velocity, "position": wheel.data.position,
+                    "effort": wheel.data.effort, "x": float(chassis.data.pos[0]),
+                    "qw": float(chassis.data.rotation[3])})]
+            """))
+        ex.run(3.0)
+        with open(os.path.join(ex.dir, "seen.json")) as f:
+            seen = [s for s in json.load(f) if s]
+        last = seen[-1]
+        self.assertAlmostEqual(last["velocity"], 4.0, delta=0.1)
+        self.assertGreater(last["position"], 5.0)   # turned several radians
+        self.assertGreater(last["x"], 0.8)          # ~0.4 m/s for ~3 s
+        self.assertAlmostEqual(last["qw"], 1.0, delta=0.01)
+
+    def test_bad_sdf_names_the_file_and_engine(self):
+        ex = Experiment(self)
+        ex.file("world.sdf", "<sdf version='1.7'><world name='w'><model name='m'>")
+        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                           "GazeboWorldFile": "world.sdf"})
+        r = ex.run(0.1, expect=3)
+        self.assertIn("engine 'gazebo'", r.stderr)
+        self.assertIn("world.sdf", r.stderr)
+
+    def test_unknown_joint_in_plugin_is_named(self):
+        ex = Experiment(self)
+        with open(os.path.join(ROBOT, "world.sdf")) as f:
+            text = f.read().replace("<j_rr P=", "<j_zz P=")
+        ex.file("world.sdf", text)
+        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                           "GazeboWorldFile": "world.sdf"})
+        r = ex.run(0.1, expect=3)
+        self.assertIn("plugin 'robot_joint_plugin': unknown joint 'j_zz'", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
