@@ -6,6 +6,10 @@
 // Datapacks (each under the NRP plugin name and under NRP-Core 1.4's scoped name):
 //   <joint plugin>::<joint>, <model>::<joint>          GazeboJointDataPack, read and write
 //   <link plugin>::<link>,   <model>::<link>           GazeboLinkDataPack, read
+//   <camera plugin>::<sensor>, <model>::<link>::<sensor>  GazeboCameraDataPack, read
+//   ...::depth   JSON {"width", "height", "depth": float32 ndarray (metres)}
+//   ...::boxes   JSON {"width", "height", "boxes": [{"model", "class", "instance", "x_min",
+//                "y_min", "x_max", "y_max", "pixels"}]}: ground truth of visible models
 // A joint datapack sent to the engine sets the joint's PID target: its position for a
 // position controller, its velocity for a velocity controller; a non-zero effort is added
 // as a feed-forward effort.
@@ -17,6 +21,7 @@
 #include "convoy/datapacks.pb.h"
 #include "engine/engine.h"
 #include "joint_pid.h"
+#include "camera_sensors.h"
 #include "physics_world.h"
 #include "world_description.h"
 
@@ -64,6 +69,8 @@ class GazeboEngine final : public Engine {
     rng_.seed(config.value("GazeboRNGSeed", 0u));
     desc_ = world::load_world(file, extra);
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
+    cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_,
+                                                      config.value("GazeboRNGSeed", 0u));
     substeps_ = std::max<int64_t>(
         1, std::llround(static_cast<double>(timestep_ns) * 1e-9 / physics_->step_size()));
 
@@ -99,6 +106,20 @@ class GazeboEngine final : public Engine {
         }
       }
     }
+    for (size_t c = 0; c < cameras_->count(); ++c) {
+      const auto& cam = cameras_->camera(c);
+      std::vector<std::string> bases{cam.scoped_name};
+      if (!cam.plugin_name.empty()) bases.insert(bases.begin(), cam.plugin_name + "::" + cam.name);
+      for (const auto& base : bases) {
+        camera_dps_[base] = {c, kImage};
+        camera_dps_[base + "::depth"] = {c, kDepth};
+        camera_dps_[base + "::boxes"] = {c, kBoxes};
+        add(base, "convoy.data.Camera");
+        add(base + "::depth", "json");
+        add(base + "::boxes", "json");
+      }
+    }
+    cameras_->update(0.0);
     return ids;
   }
 
@@ -115,6 +136,7 @@ class GazeboEngine final : public Engine {
       physics_->step();
     }
     time_ns_ += duration_ns;
+    cameras_->update(static_cast<double>(time_ns_) * 1e-9);
     return time_ns_;
   }
 
@@ -137,6 +159,13 @@ class GazeboEngine final : public Engine {
   }
 
   void get_datapack(const engine::DataPackId& id, engine::DataPack* out) override {
+    if (auto it = camera_dps_.find(id.name()); it != camera_dps_.end()) {
+      auto [index, kind] = it->second;
+      if (kind == kImage) cameras_->image_datapack(index, out);
+      else if (kind == kDepth) cameras_->depth_datapack(index, out);
+      else cameras_->boxes_datapack(index, out);
+      return;
+    }
     if (auto it = joint_dps_.find(id.name()); it != joint_dps_.end()) {
       const auto& c = controllers_[it->second];
       auto s = physics_->joint_state(c.joint);
@@ -174,6 +203,9 @@ class GazeboEngine final : public Engine {
   std::string name_;
   world::WorldDesc desc_;
   std::unique_ptr<world::PhysicsWorld> physics_;
+  std::unique_ptr<world::CameraSensors> cameras_;
+  enum CameraOutput { kImage, kDepth, kBoxes };
+  std::unordered_map<std::string, std::pair<size_t, CameraOutput>> camera_dps_;
   std::vector<Controller> controllers_;
   std::unordered_map<std::string, size_t> joint_dps_;
   std::unordered_map<std::string, int> link_dps_;

@@ -1,0 +1,70 @@
+// The world's camera sensors: a render::Scene kept in step with the physics, and for each
+// SDF <sensor type="camera"> its latest image (with Gazebo's gaussian noise), depth image
+// and ground-truth boxes, refreshed at the sensor's update_rate in simulated time.
+#pragma once
+
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "convoy/engine.pb.h"
+#include "physics_world.h"
+#include "render/renderer.h"
+#include "world_description.h"
+
+namespace convoy::world {
+
+class CameraSensors {
+ public:
+  // Builds the scene. The renderer (EGL) starts only if the world has a camera.
+  CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed);
+  ~CameraSensors();
+
+  size_t count() const { return cameras_.size(); }
+  const CameraDesc& camera(size_t i) const { return *cameras_[i].desc; }
+
+  // Renders the cameras that are due at simulated time `t` (seconds).
+  void update(double t);
+
+  // The latest frame as a convoy.data.Camera datapack (empty until the first render).
+  void image_datapack(size_t i, engine::DataPack* out) const;
+  // The latest depth image (metres, float32, H x W) as a JSON datapack
+  // {"width", "height", "depth": ndarray}.
+  void depth_datapack(size_t i, engine::DataPack* out) const;
+  // The latest ground truth as a JSON datapack: {"boxes": [{"model", "class", "instance",
+  // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}.
+  void boxes_datapack(size_t i, engine::DataPack* out) const;
+
+  // The object class of a model: its <convoy:class> element if any, else its name without
+  // a trailing number ("pedestrian_3" -> "pedestrian").
+  static std::string class_of(const std::string& model_name);
+
+ private:
+  struct Camera {
+    const CameraDesc* desc;
+    int link;  // physics link index
+    double next_update = 0;
+    bool rendered = false;
+    render::Frame frame;
+    int depth_channels = 3;
+  };
+  struct Tracked {
+    int link;                    // physics link index
+    std::vector<int> instances;  // scene instances of this link's visuals
+    std::vector<render::Pose> offsets;
+  };
+  void build_scene(const WorldDesc& desc);
+  void apply_noise(Camera& cam);
+
+  const PhysicsWorld& physics_;
+  std::unique_ptr<render::Renderer> renderer_;
+  render::Scene scene_;
+  std::vector<Camera> cameras_;
+  std::vector<Tracked> tracked_;
+  std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
+  std::vector<float> noise_table_;
+  std::mt19937_64 rng_;
+};
+
+}  // namespace convoy::world

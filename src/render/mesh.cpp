@@ -1,0 +1,204 @@
+#include "render/mesh.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace convoy::render {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void push3(std::vector<float>* v, double x, double y, double z) {
+  v->push_back(static_cast<float>(x));
+  v->push_back(static_cast<float>(y));
+  v->push_back(static_cast<float>(z));
+}
+
+void push2(std::vector<float>* v, double x, double y) {
+  v->push_back(static_cast<float>(x));
+  v->push_back(static_cast<float>(y));
+}
+
+void check_positive(const char* what, double value) {
+  if (!(value > 0) || !std::isfinite(value)) {
+    throw std::invalid_argument(std::string(what) + " must be > 0, got " + std::to_string(value));
+  }
+}
+
+}  // namespace
+
+MeshData make_box(float sx, float sy, float sz) {
+  check_positive("make_box: size x", sx);
+  check_positive("make_box: size y", sy);
+  check_positive("make_box: size z", sz);
+  const double half[3] = {sx / 2.0, sy / 2.0, sz / 2.0};
+  MeshData m;
+  // One quad per face; (e_b, e_c) spans the face with e_b x e_c = e_a, so the corners below
+  // run counter-clockwise seen from outside.
+  for (int a = 0; a < 3; ++a) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    for (int s : {1, -1}) {
+      const uint32_t base = static_cast<uint32_t>(m.vertex_count());
+      const int corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+      for (const auto& corner : corners) {
+        double p[3], n[3] = {0, 0, 0};
+        p[a] = s * half[a];
+        p[b] = corner[0] * s * half[b];
+        p[c] = corner[1] * half[c];
+        n[a] = s;
+        push3(&m.positions, p[0], p[1], p[2]);
+        push3(&m.normals, n[0], n[1], n[2]);
+        push2(&m.uvs, (corner[0] + 1) / 2.0, (corner[1] + 1) / 2.0);
+      }
+      for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
+    }
+  }
+  return m;
+}
+
+MeshData make_cylinder(float radius, float length, int segments) {
+  check_positive("make_cylinder: radius", radius);
+  check_positive("make_cylinder: length", length);
+  if (segments < 3) {
+    throw std::invalid_argument("make_cylinder: segments must be >= 3, got " +
+                                std::to_string(segments));
+  }
+  MeshData m;
+  const double h = length / 2.0;
+  // Side: a bottom and a top vertex per segment boundary, smooth normals.
+  for (int k = 0; k <= segments; ++k) {
+    const double t = 2 * kPi * k / segments, c = std::cos(t), s = std::sin(t);
+    for (int top = 0; top < 2; ++top) {
+      push3(&m.positions, radius * c, radius * s, top ? h : -h);
+      push3(&m.normals, c, s, 0);
+      push2(&m.uvs, static_cast<double>(k) / segments, top);
+    }
+  }
+  for (int k = 0; k < segments; ++k) {
+    const uint32_t b0 = 2 * k, t0 = b0 + 1, b1 = b0 + 2, t1 = b0 + 3;
+    for (uint32_t i : {b0, b1, t1, b0, t1, t0}) m.indices.push_back(i);
+  }
+  // Caps: a centre and a ring each, flat normals.
+  for (int top = 0; top < 2; ++top) {
+    const double z = top ? h : -h, nz = top ? 1 : -1;
+    const uint32_t centre = static_cast<uint32_t>(m.vertex_count());
+    push3(&m.positions, 0, 0, z);
+    push3(&m.normals, 0, 0, nz);
+    push2(&m.uvs, 0.5, 0.5);
+    for (int k = 0; k <= segments; ++k) {
+      const double t = 2 * kPi * k / segments, c = std::cos(t), s = std::sin(t);
+      push3(&m.positions, radius * c, radius * s, z);
+      push3(&m.normals, 0, 0, nz);
+      push2(&m.uvs, 0.5 + 0.5 * c, 0.5 + 0.5 * s);
+    }
+    for (int k = 0; k < segments; ++k) {
+      const uint32_t r0 = centre + 1 + k, r1 = r0 + 1;
+      m.indices.insert(m.indices.end(), {centre, top ? r0 : r1, top ? r1 : r0});
+    }
+  }
+  return m;
+}
+
+MeshData make_sphere(float radius, int stacks, int slices) {
+  check_positive("make_sphere: radius", radius);
+  if (stacks < 2 || slices < 3) {
+    throw std::invalid_argument("make_sphere: need stacks >= 2 and slices >= 3, got " +
+                                std::to_string(stacks) + " and " + std::to_string(slices));
+  }
+  MeshData m;
+  for (int i = 0; i <= stacks; ++i) {
+    const double phi = kPi * i / stacks, sp = std::sin(phi), cp = std::cos(phi);
+    for (int j = 0; j <= slices; ++j) {
+      const double theta = 2 * kPi * j / slices;
+      const double n[3] = {sp * std::cos(theta), sp * std::sin(theta), cp};
+      push3(&m.positions, radius * n[0], radius * n[1], radius * n[2]);
+      push3(&m.normals, n[0], n[1], n[2]);
+      push2(&m.uvs, static_cast<double>(j) / slices, 1.0 - static_cast<double>(i) / stacks);
+    }
+  }
+  const uint32_t row = slices + 1;
+  for (int i = 0; i < stacks; ++i) {
+    for (int j = 0; j < slices; ++j) {
+      const uint32_t a = i * row + j, b = a + row;
+      // The triangle touching a pole would be degenerate; leave it out.
+      if (i != 0) {
+        for (uint32_t k : {b, a + 1, a}) m.indices.push_back(k);
+      }
+      if (i != stacks - 1) {
+        for (uint32_t k : {b, b + 1, a + 1}) m.indices.push_back(k);
+      }
+    }
+  }
+  return m;
+}
+
+MeshData make_plane(float sx, float sy) {
+  check_positive("make_plane: size x", sx);
+  check_positive("make_plane: size y", sy);
+  MeshData m;
+  const double x = sx / 2.0, y = sy / 2.0;
+  const double corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (const auto& c : corners) {
+    push3(&m.positions, c[0] * x, c[1] * y, 0);
+    push3(&m.normals, 0, 0, 1);
+    push2(&m.uvs, (c[0] + 1) / 2, (c[1] + 1) / 2);
+  }
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+void compute_normals(MeshData* mesh) {
+  const auto& p = mesh->positions;
+  std::vector<double> n(p.size(), 0.0);
+  for (size_t t = 0; t + 2 < mesh->indices.size(); t += 3) {
+    const uint32_t i0 = mesh->indices[t], i1 = mesh->indices[t + 1], i2 = mesh->indices[t + 2];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; ++k) {
+      e1[k] = static_cast<double>(p[3 * i1 + k]) - p[3 * i0 + k];
+      e2[k] = static_cast<double>(p[3 * i2 + k]) - p[3 * i0 + k];
+    }
+    // The cross product's length is twice the area: larger faces weigh more.
+    const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+    for (uint32_t i : {i0, i1, i2}) {
+      for (int k = 0; k < 3; ++k) n[3 * i + k] += c[k];
+    }
+  }
+  mesh->normals.assign(p.size(), 0.0f);
+  for (size_t v = 0; v < n.size(); v += 3) {
+    const double len = std::sqrt(n[v] * n[v] + n[v + 1] * n[v + 1] + n[v + 2] * n[v + 2]);
+    if (len > 0) {
+      for (int k = 0; k < 3; ++k) mesh->normals[v + k] = static_cast<float>(n[v + k] / len);
+    } else {
+      mesh->normals[v + 2] = 1.0f;
+    }
+  }
+}
+
+void validate_mesh(const MeshData& mesh, const char* what) {
+  auto fail = [&](const std::string& why) {
+    throw std::invalid_argument(std::string(what) + ": " + why);
+  };
+  if (mesh.positions.size() % 3 != 0) fail("positions.size() is not a multiple of 3");
+  const size_t n = mesh.vertex_count();
+  if (!mesh.normals.empty() && mesh.normals.size() != 3 * n) {
+    fail("normals.size() = " + std::to_string(mesh.normals.size()) + ", expected " +
+         std::to_string(3 * n));
+  }
+  if (!mesh.uvs.empty() && mesh.uvs.size() != 2 * n) {
+    fail("uvs.size() = " + std::to_string(mesh.uvs.size()) + ", expected " +
+         std::to_string(2 * n));
+  }
+  if (mesh.indices.size() % 3 != 0) fail("indices.size() is not a multiple of 3");
+  for (uint32_t i : mesh.indices) {
+    if (i >= n) {
+      fail("index " + std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
+    }
+  }
+  for (float x : mesh.positions) {
+    if (!std::isfinite(x)) fail("non-finite vertex position");
+  }
+}
+
+}  // namespace convoy::render

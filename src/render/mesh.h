@@ -1,0 +1,40 @@
+// Triangle meshes for the renderer and the primitive shapes of SDF geometry.
+//
+// A MeshData is what the renderer uploads once per Scene: flat arrays, indexed triangles,
+// counter-clockwise front faces, metres. Texture coordinates follow OpenGL's convention
+// (v = 0 is the bottom row of the image), as Assimp and OBJ files do.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace convoy::render {
+
+struct MeshData {
+  std::vector<float> positions;   // x y z per vertex
+  std::vector<float> normals;     // x y z per vertex, or empty (computed by compute_normals)
+  std::vector<float> uvs;         // u v per vertex, or empty (no texture mapping)
+  std::vector<uint32_t> indices;  // three per triangle, counter-clockwise seen from outside
+
+  size_t vertex_count() const { return positions.size() / 3; }
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// SDF <box>: an axis-aligned box of the given full sizes, centred on the origin.
+MeshData make_box(float sx, float sy, float sz);
+// SDF <cylinder>: axis z, centred on the origin, `segments` facets around the axis.
+MeshData make_cylinder(float radius, float length, int segments = 32);
+// SDF <sphere>: centred on the origin, poles on the z axis.
+MeshData make_sphere(float radius, int stacks = 16, int slices = 32);
+// SDF <plane>: a rectangle of sx by sy in the xy plane, centred, facing +z.
+MeshData make_plane(float sx, float sy);
+
+// Fills `mesh->normals` with area-weighted smooth vertex normals.
+void compute_normals(MeshData* mesh);
+
+// Throws std::invalid_argument naming `what` if the arrays are inconsistent (sizes, indices
+// out of range, non-finite positions).
+void validate_mesh(const MeshData& mesh, const char* what);
+
+}  // namespace convoy::render

@@ -1,0 +1,38 @@
+// Mesh files (SDF <mesh><uri>) through Assimp: COLLADA (.dae), Wavefront (.obj), STL.
+//
+// A file becomes one LoadedMesh per material: node transforms are baked into the vertices,
+// then `scale` (SDF <mesh><scale>) is applied along the file's axes. COLLADA files are turned
+// Z-up as Gazebo does (a Y_UP file's +Y becomes +Z; a Z_UP file keeps its axes), honouring
+// the file's <unit>. OBJ and STL vertices are taken as they are.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "render/mesh.h"
+#include "render/scene.h"
+
+namespace convoy::render {
+
+struct LoadedMesh {
+  MeshData mesh;
+  // The file's material for this part (Material's defaults where the file says nothing).
+  Rgba diffuse{0.7f, 0.7f, 0.7f, 1.0f};
+  Rgba ambient{0.7f, 0.7f, 0.7f, 1.0f};
+  Rgba specular{0.1f, 0.1f, 0.1f, 1.0f};
+  Rgba emissive{0.0f, 0.0f, 0.0f, 0.0f};
+  float shininess = 32.0f;
+  // The diffuse texture's file, resolved against the mesh file's folder; empty if none.
+  // Textures embedded in the file are not supported (left empty).
+  std::string texture_path;
+
+  // The part's material, drawn with the given Scene texture (-1: none).
+  Material material(int texture = -1) const;
+};
+
+// Throws std::runtime_error naming the file if it cannot be read or holds no triangles.
+std::vector<LoadedMesh> load_mesh(const std::string& path,
+                                  const std::array<float, 3>& scale = {1, 1, 1});
+
+}  // namespace convoy::render

@@ -1,0 +1,360 @@
+#include "render/renderer.h"
+
+#include <GLES3/gl3.h>
+
+#include <algorithm>
+#include <bit>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+
+#include "render/egl_context.h"
+#include "render/gl_program.h"
+#include "render/gpu_resources.h"
+
+namespace convoy::render {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "instance ids are read as RGBA bytes");
+
+// The GL camera (x right, y up, looking down -z) in the SDF camera's frame (x forward, y left,
+// z up): its columns are GL's axes.
+const glm::dmat4 kSdfFromGlCamera(glm::dvec4(0, -1, 0, 0), glm::dvec4(0, 0, 1, 0),
+                                  glm::dvec4(-1, 0, 0, 0), glm::dvec4(0, 0, 0, 1));
+
+// Perspective projection for the pinhole of CameraSpec, flipped vertically so that the first
+// row glReadPixels returns is the top of the image (the winding flips too: see glFrontFace).
+glm::dmat4 projection(const CameraSpec& spec) {
+  const double t = std::tan(spec.hfov / 2), aspect = double(spec.width) / spec.height;
+  const double n = spec.near_clip, f = spec.far_clip;
+  glm::dmat4 p(0.0);
+  p[0][0] = 1 / t;
+  p[1][1] = -aspect / t;
+  p[2][2] = (f + n) / (n - f);
+  p[2][3] = -1;
+  p[3][2] = 2 * f * n / (n - f);
+  return p;
+}
+
+void check_spec(const CameraSpec& s) {
+  auto fail = [](const std::string& why) {
+    throw std::invalid_argument("Renderer::render: CameraSpec " + why);
+  };
+  if (s.width <= 0 || s.height <= 0) {
+    fail("size must be positive, got " + std::to_string(s.width) + "x" +
+         std::to_string(s.height));
+  }
+  if (!(s.hfov > 0 && s.hfov < std::numbers::pi)) fail("hfov must be in (0, pi), got " + std::to_string(s.hfov));
+  if (!(s.near_clip > 0 && s.far_clip > s.near_clip && std::isfinite(s.far_clip))) {
+    fail("clip must satisfy 0 < near < far, got near " + std::to_string(s.near_clip) + ", far " +
+         std::to_string(s.far_clip));
+  }
+}
+
+struct Draw {
+  double distance;  // of the bounding sphere's centre, for front-to-back order
+  int instance;
+  glm::mat4 model_view;
+  glm::mat3 normal_matrix;
+};
+
+void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels) {
+  for (size_t i = 0; i < pixels; ++i) {
+    dst[3 * i] = src[4 * i];
+    dst[3 * i + 1] = src[4 * i + 1];
+    dst[3 * i + 2] = src[4 * i + 2];
+  }
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  EglContext context;  // first: made first, destroyed last
+  GpuSceneCache scenes;
+  RenderTargetCache targets;
+  SurfaceProgram programs[2][2];  // [depth][ids], built when first needed
+  GLint max_size = 0;
+  RenderStats stats;
+  // Reused from frame to frame.
+  std::vector<Draw> draws;
+  std::vector<uint8_t> rgba;
+  std::vector<uint32_t> ids;  // bytes r, g, b, a of the id attachment: the id, little-endian
+  std::vector<float> distance_rgba;
+
+  ~Impl() {
+    try {
+      context.make_current();
+    } catch (...) {
+      return;  // another thread holds the context: leak the GL objects rather than crash
+    }
+    for (auto& row : programs) {
+      for (auto& p : row) destroy_program(&p);
+    }
+  }
+
+  const SurfaceProgram& program(bool depth, bool ids) {
+    SurfaceProgram& p = programs[depth][ids];
+    if (!p.id) p = build_surface_program(depth, ids, Scene::kMaxLights);
+    return p;
+  }
+
+  void upload_frame_uniforms(const SurfaceProgram& p, const Scene& scene, const glm::dmat4& view,
+                             const CameraSpec& spec);
+  void collect_draws(const Scene& scene, const glm::dmat4& view, const CameraSpec& spec);
+  void draw(const SurfaceProgram& p, const Scene& scene, const GpuScene& gpu);
+  void compute_boxes(const Scene& scene, int width, int height, std::vector<BoundingBox>* boxes);
+};
+
+void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene& scene,
+                                           const glm::dmat4& view, const CameraSpec& spec) {
+  glUniformMatrix4fv(p.projection, 1, GL_FALSE, glm::value_ptr(glm::mat4(projection(spec))));
+  glUniform3fv(p.scene_ambient, 1, scene.ambient().data());
+  const auto& lights = scene.lights();
+  const int n = static_cast<int>(lights.size());
+  std::vector<glm::vec4> position(n), direction(n);
+  std::vector<glm::vec3> diffuse(n), specular(n), attenuation(n), spot(n);
+  for (int i = 0; i < n; ++i) {
+    const Light& l = lights[i];
+    const glm::dvec3 pos = view * glm::dvec4(l.position[0], l.position[1], l.position[2], 1);
+    glm::dvec3 dir = glm::dmat3(view) * glm::dvec3(l.direction[0], l.direction[1], l.direction[2]);
+    dir = glm::length(dir) > 0 ? glm::normalize(dir) : glm::dvec3(0, 0, -1);
+    position[i] = glm::vec4(glm::vec3(pos), static_cast<float>(l.type));
+    direction[i] = glm::vec4(glm::vec3(dir), l.range);
+    diffuse[i] = glm::vec3(l.diffuse[0], l.diffuse[1], l.diffuse[2]);
+    specular[i] = glm::vec3(l.specular[0], l.specular[1], l.specular[2]);
+    attenuation[i] =
+        glm::vec3(l.attenuation_constant, l.attenuation_linear, l.attenuation_quadratic);
+    const double cos_outer = std::cos(l.spot_outer_angle / 2.0);
+    const double cos_inner = std::cos(std::min(l.spot_inner_angle, l.spot_outer_angle) / 2.0);
+    spot[i] = glm::vec3(cos_outer, 1.0 / std::max(cos_inner - cos_outer, 1e-6),
+                        std::max(l.spot_falloff, 0.0f));
+  }
+  glUniform1i(p.light_count, n);
+  if (n > 0) {
+    glUniform4fv(p.light_position, n, glm::value_ptr(position[0]));
+    glUniform4fv(p.light_direction, n, glm::value_ptr(direction[0]));
+    glUniform3fv(p.light_diffuse, n, glm::value_ptr(diffuse[0]));
+    glUniform3fv(p.light_specular, n, glm::value_ptr(specular[0]));
+    glUniform3fv(p.light_attenuation, n, glm::value_ptr(attenuation[0]));
+    glUniform3fv(p.light_spot, n, glm::value_ptr(spot[0]));
+  }
+}
+
+// Keeps the visible instances whose bounding sphere meets the view frustum, nearest first.
+void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
+                                   const CameraSpec& spec) {
+  const double tx = std::tan(spec.hfov / 2), ty = tx * spec.height / spec.width;
+  const double nx = std::sqrt(1 + tx * tx), ny = std::sqrt(1 + ty * ty);
+  draws.clear();
+  const auto& instances = scene.instances();
+  for (int i = 0; i < static_cast<int>(instances.size()); ++i) {
+    const Scene::Instance& inst = instances[i];
+    if (!inst.visible) continue;
+    const Scene::Bounds& b = scene.mesh_bounds()[inst.mesh];
+    const glm::dmat4 mv = view * glm::make_mat4(inst.world_from_object.data());
+    const glm::dvec3 c = mv * glm::dvec4(b.centre[0], b.centre[1], b.centre[2], 1);
+    const double scale = std::max({glm::length(glm::dvec3(mv[0])), glm::length(glm::dvec3(mv[1])),
+                                   glm::length(glm::dvec3(mv[2]))});
+    const double r = b.radius * scale;
+    // Eye space looks down -z; each side plane passes through the eye.
+    if (c.z - r > -spec.near_clip || -c.z - r > spec.far_clip) continue;
+    if ((std::abs(c.x) + c.z * tx) / nx > r || (std::abs(c.y) + c.z * ty) / ny > r) continue;
+    const glm::dmat3 normal = glm::transpose(glm::inverse(glm::dmat3(mv)));
+    draws.push_back(Draw{-c.z, i, glm::mat4(mv), glm::mat3(normal)});
+  }
+  std::sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) {
+    return a.distance != b.distance ? a.distance < b.distance : a.instance < b.instance;
+  });
+}
+
+void Renderer::Impl::draw(const SurfaceProgram& p, const Scene& scene, const GpuScene& gpu) {
+  stats = RenderStats{static_cast<int>(draws.size()), 0};
+  int bound_mesh = -1;
+  GLuint bound_texture = 0;
+  bool culling = true;
+  const Material* last = nullptr;
+  for (const Draw& d : draws) {
+    const Scene::Instance& inst = scene.instances()[d.instance];
+    const GpuMesh& mesh = gpu.meshes[inst.mesh];
+    if (inst.mesh != bound_mesh) {
+      glBindVertexArray(mesh.vao);
+      bound_mesh = inst.mesh;
+    }
+    glUniformMatrix4fv(p.model_view, 1, GL_FALSE, glm::value_ptr(d.model_view));
+    glUniformMatrix3fv(p.normal_matrix, 1, GL_FALSE, glm::value_ptr(d.normal_matrix));
+    const Material& m = inst.material;
+    if (!last || !(*last == m)) {
+      glUniform4fv(p.diffuse, 1, m.diffuse.data());
+      glUniform4fv(p.ambient, 1, m.ambient.data());
+      glUniform4fv(p.specular, 1, m.specular.data());
+      glUniform4fv(p.emissive, 1, m.emissive.data());
+      glUniform1f(p.shininess, std::max(m.shininess, 1e-3f));
+      glUniform1i(p.textured, m.texture >= 0);
+      glUniform1i(p.double_sided, m.double_sided);
+      last = &m;
+    }
+    if (m.texture >= 0 && gpu.textures[m.texture] != bound_texture) {
+      bound_texture = gpu.textures[m.texture];
+      glBindTexture(GL_TEXTURE_2D, bound_texture);
+    }
+    if (m.double_sided == culling) {
+      culling = !m.double_sided;
+      culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+    }
+    if (p.instance_id >= 0) {
+      const uint32_t id = static_cast<uint32_t>(d.instance) + 1;
+      glUniform4f(p.instance_id, (id & 0xff) / 255.0f, ((id >> 8) & 0xff) / 255.0f,
+                  ((id >> 16) & 0xff) / 255.0f, ((id >> 24) & 0xff) / 255.0f);
+    }
+    glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+    stats.triangles_drawn += mesh.index_count / 3;
+  }
+  glBindVertexArray(0);
+  if (!culling) glEnable(GL_CULL_FACE);
+}
+
+void Renderer::Impl::compute_boxes(const Scene& scene, int width, int height,
+                                   std::vector<BoundingBox>* boxes) {
+  struct Extent {
+    int x_min = INT_MAX, y_min = INT_MAX, x_max = -1, y_max = -1;
+    uint32_t count = 0;
+  };
+  const auto& instances = scene.instances();
+  std::vector<Extent> extents(instances.size() + 1);  // by instance id (index + 1)
+  const uint32_t* id = ids.data();
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width;) {
+      const uint32_t v = id[static_cast<size_t>(y) * width + x];
+      int end = x + 1;
+      while (end < width && id[static_cast<size_t>(y) * width + end] == v) ++end;
+      if (v != 0 && v < extents.size()) {
+        Extent& e = extents[v];
+        e.x_min = std::min(e.x_min, x);
+        e.x_max = std::max(e.x_max, end - 1);
+        e.y_min = std::min(e.y_min, y);
+        e.y_max = y;
+        e.count += end - x;
+      }
+      x = end;
+    }
+  }
+  std::map<uint32_t, BoundingBox> by_model;
+  for (size_t i = 0; i < instances.size(); ++i) {
+    const Extent& e = extents[i + 1];
+    const uint32_t model = instances[i].model_id;
+    if (model == 0 || e.count == 0) continue;
+    auto [it, inserted] = by_model.try_emplace(
+        model, BoundingBox{model, instances[i].class_id, e.x_min, e.y_min, e.x_max, e.y_max, 0});
+    BoundingBox& b = it->second;
+    b.x_min = std::min(b.x_min, e.x_min);
+    b.y_min = std::min(b.y_min, e.y_min);
+    b.x_max = std::max(b.x_max, e.x_max);
+    b.y_max = std::max(b.y_max, e.y_max);
+    b.pixel_count += e.count;
+  }
+  boxes->clear();
+  for (const auto& [model, box] : by_model) boxes->push_back(box);
+}
+
+Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &impl_->max_size);
+}
+
+Renderer::~Renderer() = default;
+
+const RenderStats& Renderer::last_stats() const { return impl_->stats; }
+
+const std::string& Renderer::description() const { return impl_->context.description(); }
+
+void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const CameraSpec& spec,
+                      Frame* out, bool want_depth, bool want_boxes) {
+  check_spec(spec);
+  Impl& s = *impl_;
+  s.context.make_current();
+  if (spec.width > s.max_size || spec.height > s.max_size) {
+    throw std::invalid_argument("Renderer::render: CameraSpec size " + std::to_string(spec.width) +
+                                "x" + std::to_string(spec.height) + " exceeds the GPU's limit " +
+                                std::to_string(s.max_size));
+  }
+  const int w = spec.width, h = spec.height;
+  const RenderTarget& target = s.targets.get(w, h);
+  const GpuScene& gpu = s.scenes.sync(scene);
+  const SurfaceProgram& program = s.program(want_depth, want_boxes);
+
+  glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
+  glViewport(0, 0, w, h);
+  const GLenum none = GL_NONE;
+  const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, want_depth ? GL_COLOR_ATTACHMENT1 : none,
+                             want_boxes ? GL_COLOR_ATTACHMENT2 : none};
+  glDrawBuffers(3, buffers);
+  glDisable(GL_BLEND);
+  glDisable(GL_DITHER);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  glFrontFace(GL_CW);  // counter-clockwise faces turn clockwise under the flipped projection
+  const Rgba& bg = scene.background();
+  const float background[4] = {bg[0], bg[1], bg[2], 1.0f};
+  const float infinity[4] = {std::numeric_limits<float>::infinity(), 0, 0, 0};
+  const float zero[4] = {0, 0, 0, 0};
+  const float far_depth = 1.0f;
+  glClearBufferfv(GL_COLOR, 0, background);
+  if (want_depth) glClearBufferfv(GL_COLOR, 1, infinity);
+  if (want_boxes) glClearBufferfv(GL_COLOR, 2, zero);
+  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+
+  const glm::dmat4 view =
+      glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
+  glUseProgram(program.id);
+  glActiveTexture(GL_TEXTURE0);
+  s.upload_frame_uniforms(program, scene, view, spec);
+  s.collect_draws(scene, view, spec);
+  s.draw(program, scene, gpu);
+
+  // Read back. Rows come top first thanks to the flipped projection.
+  const size_t pixels = static_cast<size_t>(w) * h;
+  out->width = w;
+  out->height = h;
+  s.rgba.resize(pixels * 4);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, s.rgba.data());
+  out->rgb.resize(pixels * 3);
+  rgba_to_rgb(s.rgba.data(), out->rgb.data(), pixels);
+  if (want_depth) {
+    out->depth.resize(pixels);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    if (target.distance_read_format == GL_RED) {
+      glReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, out->depth.data());
+    } else {
+      s.distance_rgba.resize(pixels * 4);
+      glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, s.distance_rgba.data());
+      for (size_t i = 0; i < pixels; ++i) out->depth[i] = s.distance_rgba[4 * i];
+    }
+  } else {
+    out->depth.clear();
+  }
+  if (want_boxes) {
+    s.ids.resize(pixels);
+    glReadBuffer(GL_COLOR_ATTACHMENT2);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, s.ids.data());
+    s.compute_boxes(scene, w, h, &out->boxes);
+  } else {
+    out->boxes.clear();
+  }
+  if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
+    char code[16];
+    std::snprintf(code, sizeof code, "0x%04x", error);
+    throw std::runtime_error(std::string("Renderer::render: OpenGL ES error ") + code);
+  }
+}
+
+}  // namespace convoy::render

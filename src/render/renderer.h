@@ -1,0 +1,93 @@
+// Headless rendering of camera sensors: colour, depth and ground-truth bounding boxes.
+//
+// The world engine keeps a Scene in step with its bodies and asks a Renderer for each camera's
+// frame. Rendering is OpenGL ES 3 through EGL without a display (Mesa's llvmpipe on a plain
+// CPU machine), per-pixel Blinn-Phong lighting, no shadows, no anti-aliasing. The output is
+// deterministic: the same scene, pose and spec give the same bytes on the same machine.
+//
+// Camera convention (Gazebo / SDF): the camera looks along its +X axis, +Z is up in the
+// image, +Y is to the image's left. The image is an ideal pinhole with square pixels:
+// fx = fy = (width / 2) / tan(hfov / 2), principal point (width / 2, height / 2), pixel (u, v)
+// covering [u, u+1) x [v, v+1) with v = 0 the top row.
+//
+//   Renderer renderer;                     // throws if no OpenGL ES 3 context can be had
+//   CameraSpec spec{736, 480, 1.047, 0.1, 100};
+//   Frame frame;                           // reuse it: its buffers are kept
+//   renderer.render(scene, camera_pose, spec, &frame, /*want_depth=*/true, /*want_boxes=*/true);
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/pose.h"
+#include "render/scene.h"
+
+namespace convoy::render {
+
+// SDF <camera>: image size, horizontal field of view and clip distances (defaults are SDF's).
+struct CameraSpec {
+  int width = 320;
+  int height = 240;
+  double hfov = 1.047;  // radians, in (0, pi)
+  double near_clip = 0.1;
+  double far_clip = 100.0;
+};
+
+// A labelled model's extent in the image: the pixels where it is visible (not occluded, not
+// outside the image). Instances sharing a model_id make one box.
+struct BoundingBox {
+  uint32_t model_id;
+  uint32_t class_id;  // that of the model's first instance (lowest index)
+  int x_min, y_min, x_max, y_max;  // inclusive pixel coordinates, y = 0 the top row
+  uint32_t pixel_count;            // visible pixels
+};
+
+struct Frame {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;  // height x width x 3, row 0 = top of the image
+  // height x width distances in metres along the optical axis (camera +X), row 0 = top;
+  // +infinity where nothing lies within the clip range. Empty unless asked for.
+  std::vector<float> depth;
+  // One per labelled model (model_id != 0) with a visible pixel, by increasing model_id.
+  // Empty unless asked for.
+  std::vector<BoundingBox> boxes;
+};
+
+// What the last render drew, after culling instances outside the view.
+struct RenderStats {
+  int instances_drawn = 0;
+  size_t triangles_drawn = 0;
+};
+
+class Renderer {
+ public:
+  using Frame = render::Frame;
+  using BoundingBox = render::BoundingBox;
+
+  // Starts the OpenGL ES context. Throws std::runtime_error saying why if EGL or OpenGL ES 3
+  // cannot start. One Renderer per process is the intended use; it is not thread-safe, and
+  // must be used (and destroyed) by one thread at a time.
+  Renderer();
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders `scene` seen from `camera_world_pose` (world-from-camera, rigid) into `out`,
+  // reusing its buffers. The first render of a Scene uploads its meshes and textures; later
+  // renders upload only what was added since. Throws std::invalid_argument for a bad spec and
+  // std::runtime_error on a GPU error.
+  void render(const Scene& scene, const Pose& camera_world_pose, const CameraSpec& spec,
+              Frame* out, bool want_depth = false, bool want_boxes = false);
+
+  const RenderStats& last_stats() const;
+  // OpenGL ES version, renderer and EGL platform, for logs.
+  const std::string& description() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace convoy::render

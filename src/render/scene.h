@@ -1,0 +1,138 @@
+// What a camera sees: meshes, textures, materials, lights and posed instances.
+//
+// A Scene is the renderer's input. Meshes and textures are added once and never change (the
+// Renderer uploads each to the GPU the first time it renders the Scene); instance poses and
+// visibility change every step. Defaults follow SDF 1.6 (<scene>, <material>, <light>).
+// Colours are linear RGBA in [0, 1].
+//
+//   Scene scene;
+//   int box = scene.add_mesh(make_box(1, 1, 1));
+//   Material red;  red.diffuse = {1, 0, 0, 1};
+//   int car = scene.add_instance(box, red, make_pose(5, 0, 0.5), /*model_id=*/7, /*class=*/1);
+//   scene.add_light(Light{});           // the default: a white directional light
+//   ...  scene.set_pose(car, make_pose(6, 0, 0.5));
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/mesh.h"
+#include "render/pose.h"
+
+namespace convoy::render {
+
+using Rgba = std::array<float, 4>;
+
+// Fixed-function (Blinn-Phong) surface, as SDF <material> / OGRE describe it.
+struct Material {
+  Rgba diffuse{0.7f, 0.7f, 0.7f, 1.0f};
+  Rgba ambient{0.7f, 0.7f, 0.7f, 1.0f};   // multiplied by the scene's ambient light
+  Rgba specular{0.1f, 0.1f, 0.1f, 1.0f};
+  Rgba emissive{0.0f, 0.0f, 0.0f, 0.0f};  // added as is
+  float shininess = 32.0f;                 // Blinn-Phong exponent
+  int texture = -1;          // Scene::add_texture index; it multiplies diffuse and ambient
+  bool double_sided = false;  // draw back faces too (lit with the flipped normal)
+
+  bool operator==(const Material&) const = default;
+};
+
+// SDF <light>. Directions point where the light shines; positions and directions are in the
+// world frame. Attenuation 1 / (constant + linear d + quadratic d^2), zero beyond `range`;
+// directional lights are not attenuated.
+struct Light {
+  enum Type { kDirectional, kPoint, kSpot };
+  Type type = kDirectional;
+  std::array<float, 3> position{0, 0, 10};
+  std::array<float, 3> direction{0.5f, 0.2f, -0.9f};
+  Rgba diffuse{1, 1, 1, 1};
+  Rgba specular{0.1f, 0.1f, 0.1f, 1};
+  float range = 10.0f;
+  float attenuation_constant = 1.0f;
+  float attenuation_linear = 0.0f;
+  float attenuation_quadratic = 0.0f;
+  // Spot cone, full angles in radians: full intensity inside inner_angle, fading
+  // ((cos a - cos outer/2) / (cos inner/2 - cos outer/2))^falloff to zero at outer_angle.
+  float spot_inner_angle = 0.0f;
+  float spot_outer_angle = 1.0f;
+  float spot_falloff = 1.0f;
+  bool cast_shadows = false;  // accepted and ignored: the renderer draws no shadows
+};
+
+class Scene {
+ public:
+  // The renderer draws at most this many lights; add_light throws beyond it.
+  static constexpr int kMaxLights = 16;
+
+  struct Instance {
+    int mesh;
+    Material material;
+    Pose world_from_object;
+    uint32_t model_id;  // ground-truth label; 0 = unlabelled (never gets a bounding box)
+    uint32_t class_id;
+    bool visible = true;
+  };
+  struct Texture {
+    int width, height;
+    std::vector<uint8_t> rgba;  // row 0 = top of the image
+  };
+  // A mesh's bounding sphere in its own frame (used to skip what the camera cannot see).
+  struct Bounds {
+    std::array<float, 3> centre;
+    float radius;
+  };
+
+  Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  // A moved-from Scene is empty and gets a new uid.
+  Scene(Scene&& other) noexcept;
+  Scene& operator=(Scene&& other) noexcept;
+
+  // Returns the mesh's index. Computes normals if it has none; throws std::invalid_argument if
+  // the arrays are inconsistent.
+  int add_mesh(const MeshData& mesh);
+  // Copies a w x h RGBA8 image (row 0 = top) and returns its index.
+  int add_texture(const uint8_t* rgba, int width, int height);
+  // Loads a PNG or JPEG file (see image_io.h); throws std::runtime_error naming the file.
+  int add_texture_file(const std::string& path);
+
+  // Returns the instance's index. Throws std::out_of_range for an unknown mesh or texture.
+  int add_instance(int mesh, const Material& material, const Pose& world_from_object,
+                   uint32_t model_id = 0, uint32_t class_id = 0);
+  void set_pose(int instance, const Pose& world_from_object);
+  void set_visible(int instance, bool visible);
+  void set_material(int instance, const Material& material);
+
+  void add_light(const Light& light);
+  void clear_lights() { lights_.clear(); }
+  void set_ambient(const Rgba& rgba) { ambient_ = rgba; }
+  void set_background(const Rgba& rgba) { background_ = rgba; }
+
+  // Read access for the renderer.
+  uint64_t uid() const { return uid_; }  // unique per Scene object in this process
+  const std::vector<MeshData>& meshes() const { return meshes_; }
+  const std::vector<Bounds>& mesh_bounds() const { return bounds_; }
+  const std::vector<Texture>& textures() const { return textures_; }
+  const std::vector<Instance>& instances() const { return instances_; }
+  const std::vector<Light>& lights() const { return lights_; }
+  const Rgba& ambient() const { return ambient_; }
+  const Rgba& background() const { return background_; }
+
+ private:
+  Instance& instance_at(int index, const char* what);
+  void check_material(const Material& material) const;
+
+  uint64_t uid_;
+  std::vector<MeshData> meshes_;
+  std::vector<Bounds> bounds_;
+  std::vector<Texture> textures_;
+  std::vector<Instance> instances_;
+  std::vector<Light> lights_;
+  Rgba ambient_{0.4f, 0.4f, 0.4f, 1.0f};     // SDF <scene><ambient> default
+  Rgba background_{0.7f, 0.7f, 0.7f, 1.0f};  // SDF <scene><background> default
+};
+
+}  // namespace convoy::render
