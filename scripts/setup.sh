@@ -11,7 +11,7 @@ PACKAGES=(
   pybind11-dev nlohmann-json3-dev python3-dev python3-numpy
   libgtest-dev
   libdart-dev libdart-external-ikfast-dev libdart-collision-bullet-dev libsdformat-dev
-  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev libglm-dev
+  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev libglm-dev libpng-dev libjpeg-dev
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then

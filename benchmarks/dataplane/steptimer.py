@@ -1,12 +1,14 @@
-"""Times an engine's runLoop calls and writes timing_<engine>.json next to this file."""
+"""Times an engine's runLoop calls and writes timing_<engine>.json (next to this file, or
+in `outdir`)."""
 import json
 import os
 import time
 
 
 class StepTimer:
-    def __init__(self, name):
+    def __init__(self, name, outdir=None):
         self.name = name
+        self.outdir = outdir or os.path.dirname(os.path.abspath(__file__))
         self.stamps = []
 
     def tick(self):
@@ -18,6 +20,5 @@ class StepTimer:
         if len(st) >= 3:
             res["steps_per_s"] = (len(st) - 2) / (st[-1] - st[1])  # first interval is warm-up
         res.update(extra)
-        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                               "timing_%s.json" % self.name), "w") as f:
+        with open(os.path.join(self.outdir, "timing_%s.json" % self.name), "w") as f:
             json.dump(res, f, indent=1)

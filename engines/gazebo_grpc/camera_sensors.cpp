@@ -69,11 +69,17 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
   build_scene(desc);
   // Gaussian noise comes from a fixed table read at a random offset per frame: as random as
   // a camera needs, deterministic for a seed, and far cheaper than a draw per pixel.
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  noise_table_.resize(1 << 20);
-  for (auto& v : noise_table_) v = normal(rng_);
+  std::normal_distribution<double> normal(0.0, 1.0);
   for (auto& cam : cameras_) {
     if (cam.desc->format == "L8" || cam.desc->format == "L_INT8") cam.depth_channels = 1;
+    if (!cam.desc->noise || cam.desc->noise_stddev <= 0) continue;
+    // 2^20 starting points, each followed by a whole frame's worth of samples
+    cam.noise.resize((size_t{1} << 20) +
+                     static_cast<size_t>(cam.desc->width) * cam.desc->height * 3);
+    for (auto& v : cam.noise) {
+      v = static_cast<int16_t>(std::lround(
+          255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
+    }
   }
 }
 
@@ -179,29 +185,38 @@ void CameraSensors::update(double t) {
       }
       poses_fresh = true;
     }
+    render(cam);
     const CameraDesc& d = *cam.desc;
-    render::CameraSpec spec{d.width, d.height, d.hfov, d.near_clip, d.far_clip};
-    render::Pose pose = to_pose(physics_.link_pose(cam.link) * d.pose);
-    renderer_->render(scene_, pose, spec, &cam.frame, /*want_depth=*/true, /*want_boxes=*/true);
-    if (d.noise && d.noise_stddev > 0) apply_noise(cam);
-    cam.rendered = true;
     double period = d.update_rate > 0 ? 1.0 / d.update_rate : 0;
     cam.next_update = period > 0 ? std::max(cam.next_update + period, t) : t;
     if (period > 0 && cam.next_update <= t) cam.next_update = t + period;
   }
 }
 
+void CameraSensors::render(Camera& cam) {
+  const CameraDesc& d = *cam.desc;
+  render::CameraSpec spec{d.width, d.height, d.hfov, d.near_clip, d.far_clip};
+  render::Pose pose = to_pose(physics_.link_pose(cam.link) * d.pose);
+  renderer_->render(scene_, pose, spec, &cam.frame, cam.want_depth, cam.want_boxes);
+  cam.has_depth = cam.want_depth;
+  cam.has_boxes = cam.want_boxes;
+  apply_noise(cam);
+  cam.rendered = true;
+}
+
 void CameraSensors::apply_noise(Camera& cam) {
-  // Gazebo: each channel value (0..1) gets mean + stddev * N(0, 1), clamped to [0, 1].
-  const double mean = cam.desc->noise_mean * 255.0, stddev = cam.desc->noise_stddev * 255.0;
-  const size_t n = cam.frame.rgb.size(), table = noise_table_.size();
-  size_t k = static_cast<size_t>(rng_() % table);
-  size_t stride = 1 + static_cast<size_t>(rng_() % 7) * 2;  // odd: visits the whole table
+  // Gazebo: each channel value (0..1) gets mean + stddev * N(0, 1), clamped to [0, 1]. The
+  // normal samples come from the camera's fixed table, read from a random place each
+  // frame: deterministic for a seed, and a loop the compiler vectorises.
+  if (cam.noise.empty()) return;
+  const size_t n = cam.frame.rgb.size();
+  if (cam.noise.size() < n + 1) return;
+  const size_t starts = cam.noise.size() - n;
+  uint8_t* px = cam.frame.rgb.data();
+  const int16_t* noise = cam.noise.data() + static_cast<size_t>(rng_() % starts);
   for (size_t i = 0; i < n; ++i) {
-    double v = cam.frame.rgb[i] + mean + stddev * noise_table_[k];
-    k += stride;
-    if (k >= table) k -= table;
-    cam.frame.rgb[i] = static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));
+    int v = px[i] + noise[i];
+    px[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
   }
 }
 
@@ -232,9 +247,11 @@ void CameraSensors::image_datapack(size_t i, engine::DataPack* out) const {
   c.SerializeToString(out->mutable_proto()->mutable_data());
 }
 
-void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) const {
-  const Camera& cam = cameras_[i];
+void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) {
+  Camera& cam = cameras_[i];
   if (!cam.rendered) return;
+  cam.want_depth = true;
+  if (!cam.has_depth) render(cam);  // (noise redrawn: a new sample of the same view)
   nlohmann::json j;
   j["width"] = cam.frame.width;
   j["height"] = cam.frame.height;
@@ -244,9 +261,11 @@ void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) const {
   out->set_json_msgpack(std::string(bytes.begin(), bytes.end()));
 }
 
-void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) const {
-  const Camera& cam = cameras_[i];
+void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
+  Camera& cam = cameras_[i];
   if (!cam.rendered) return;
+  cam.want_boxes = true;
+  if (!cam.has_boxes) render(cam);
   nlohmann::json boxes = nlohmann::json::array();
   for (const auto& b : cam.frame.boxes) {
     boxes.push_back({{"model", model_names_[b.model_id - 1]},

@@ -26,15 +26,17 @@ class CameraSensors {
 
   // Renders the cameras that are due at simulated time `t` (seconds).
   void update(double t);
+  // Depth images and boxes cost extra render passes: a camera makes them only once they
+  // have been asked for (the first request renders them for the current frame).
 
   // The latest frame as a convoy.data.Camera datapack (empty until the first render).
   void image_datapack(size_t i, engine::DataPack* out) const;
   // The latest depth image (metres, float32, H x W) as a JSON datapack
   // {"width", "height", "depth": ndarray}.
-  void depth_datapack(size_t i, engine::DataPack* out) const;
+  void depth_datapack(size_t i, engine::DataPack* out);
   // The latest ground truth as a JSON datapack: {"boxes": [{"model", "class", "instance",
   // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}.
-  void boxes_datapack(size_t i, engine::DataPack* out) const;
+  void boxes_datapack(size_t i, engine::DataPack* out);
 
   // The object class of a model: its <convoy:class> element if any, else its name without
   // a trailing number ("pedestrian_3" -> "pedestrian").
@@ -48,6 +50,9 @@ class CameraSensors {
     bool rendered = false;
     render::Frame frame;
     int depth_channels = 3;
+    std::vector<int16_t> noise;  // mean + stddev * N(0,1) in 0..255 units, a fixed table
+    bool want_depth = false, want_boxes = false;  // asked for once: rendered from then on
+    bool has_depth = false, has_boxes = false;    // the current frame has them
   };
   struct Tracked {
     int link;                    // physics link index
@@ -55,6 +60,7 @@ class CameraSensors {
     std::vector<render::Pose> offsets;
   };
   void build_scene(const WorldDesc& desc);
+  void render(Camera& cam);
   void apply_noise(Camera& cam);
 
   const PhysicsWorld& physics_;
@@ -63,7 +69,6 @@ class CameraSensors {
   std::vector<Camera> cameras_;
   std::vector<Tracked> tracked_;
   std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
-  std::vector<float> noise_table_;
   std::mt19937_64 rng_;
 };
 
