@@ -2,6 +2,7 @@
 
 #include <dart/collision/bullet/BulletCollisionDetector.hpp>
 
+#include <algorithm>
 #include <functional>
 #include <set>
 #include <stdexcept>
@@ -20,20 +21,20 @@ dd::ShapePtr make_shape(const Shape& s, Eigen::Isometry3d* offset) {
       return std::make_shared<dd::CylinderShape>(s.size.x(), s.size.z());
     case Shape::kSphere:
       return std::make_shared<dd::SphereShape>(s.size.x());
-    case Shape::kPlane: {
-      // A thick box whose top face is the plane: robust with every collision detector.
-      double sx = s.size.x() > 0 ? s.size.x() : 1000, sy = s.size.y() > 0 ? s.size.y() : 1000;
-      Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), s.normal);
-      Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-      t.linear() = q.toRotationMatrix();
-      t.translation() = -0.5 * s.normal;
-      *offset = *offset * t;
-      return std::make_shared<dd::BoxShape>(Eigen::Vector3d(sx, sy, 1.0));
-    }
+    case Shape::kPlane:
+      // Collision planes are infinite, as in Gazebo (Bullet's static plane).
+      return std::make_shared<dd::PlaneShape>(s.normal, 0.0);
     case Shape::kMesh: {
+      // Bullet, as DART drives it, does not collide moving triangle meshes with primitives;
+      // a mesh collides as its bounding box (documented limitation).
       const aiScene* scene = dd::MeshShape::loadMesh(s.mesh.string());
       if (!scene) throw std::runtime_error(s.mesh.string() + ": cannot load mesh");
-      return std::make_shared<dd::MeshShape>(s.scale, scene);
+      auto mesh = std::make_shared<dd::MeshShape>(s.scale, scene);
+      const auto& box = mesh->getBoundingBox();
+      Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+      t.translation() = box.computeCenter();
+      *offset = *offset * t;
+      return std::make_shared<dd::BoxShape>(box.computeFullExtents().cwiseMax(1e-3));
     }
   }
   return nullptr;

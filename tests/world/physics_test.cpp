@@ -114,6 +114,31 @@ TEST(Physics, SameWorldGivesTheSameTrajectoryBitForBit) {
   EXPECT_EQ(run(), run());
 }
 
+TEST(WorldDescription, IncludeWithModelUriMeshesAndJointTypes) {
+  setenv("CONVOY_MODEL_PATH", (kData + "/models").c_str(), 1);
+  WorldDesc w = load_world(kData + "/include_world.sdf");
+  ASSERT_EQ(w.models.size(), 2u);
+  const ModelDesc& tower = w.models[1];
+  EXPECT_EQ(tower.name, "tower_a");
+  EXPECT_NEAR(tower.links[0].pose.translation().x(), 2.0, 1e-12);
+  EXPECT_NEAR(tower.links[0].pose.translation().z(), 0.5, 1e-12);
+  EXPECT_EQ(tower.links[0].collisions[0].shape.kind, Shape::kMesh);
+  EXPECT_EQ(tower.links[0].collisions[0].shape.mesh.filename(), "block.obj");
+  EXPECT_DOUBLE_EQ(tower.links[1].visuals[0].shape.scale.x(), 0.5);
+  EXPECT_EQ(tower.joints[1].type, JointDesc::kBall);
+  EXPECT_EQ(tower.joints[2].type, JointDesc::kUniversal);
+  ASSERT_EQ(tower.joints[2].axes.size(), 2u);
+
+  PhysicsWorld p(w);
+  int lift = p.joint_index("tower_a::lift");
+  ASSERT_GE(lift, 0);
+  p.set_joint_effort(lift, 100.0);  // pushes up, against the 0.3 m limit
+  for (int i = 0; i < 2000; ++i) p.step();
+  EXPECT_NEAR(p.joint_state(lift).position, 0.3, 0.01);
+  // the mesh block rests on the ground
+  EXPECT_NEAR(p.link_state(p.link_index("tower_a::base")).position.z(), 0.5, 0.02);
+}
+
 std::string error_of(const std::string& sdf_text) {
   std::string file = ::testing::TempDir() + "/bad_world.sdf";
   std::ofstream(file) << sdf_text;
