@@ -99,6 +99,49 @@ class WorldEngine(unittest.TestCase):
         self.assertGreater(last["x"], 0.8)          # ~0.4 m/s for ~3 s
         self.assertAlmostEqual(last["qw"], 1.0, delta=0.01)
 
+    def test_sdf_models_are_inserted_at_their_init_pose(self):
+        ex = Experiment(self)
+        data = os.path.join(HERE, "..", "world", "data")
+        shutil.copy(os.path.join(data, "include_world.sdf"), os.path.join(ex.dir, "world.sdf"))
+        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "world.sdf",
+                           "EngineEnvParams": ["CONVOY_MODEL_PATH=" + os.path.join(data, "models")],
+                           "GazeboSDFModels": [{"Name": "tower_b", "File": "tower.sdf",
+                                                "InitPose": [-4, 1, 0, 0, 0, 1.5708]}]})
+        # the included model, with a link plugin added
+        with open(os.path.join(data, "models", "tower", "model.sdf")) as f:
+            text = f.read().replace("<model name=\"tower\">",
+                                    "<model name=\"tower\">\n    <plugin name=\"tower_links\" "
+                                    "filename=\"NRPGazeboGrpcLinkControllerPlugin.so\"/>")
+        ex.file("tower.sdf", text)
+        os.makedirs(os.path.join(ex.dir, "meshes"), exist_ok=True)
+        shutil.copy(os.path.join(data, "models", "tower", "meshes", "block.obj"), os.path.join(ex.dir, "meshes"))
+        ex.engine("probe", textwrap.dedent("""\
+            import json, os
+            from nrp_core.engines.python_json import EngineScript
+            class Script(EngineScript):
+                def initialize(self):
+                    self._registerDataPack("pos")
+                def runLoop(self, timestep_ns):
+                    with open(os.path.join(os.path.dirname(__file__), "pos.json"), "w") as f:
+                        json.dump(self._getDataPack("pos"), f)
+            """))
+        ex.function("tf", textwrap.dedent("""\
+            from nrp_core import *
+            from nrp_core.data.nrp_json import *
+            @EngineDataPack(keyword='base', id=DataPackIdentifier('tower_links::base', 'gazebo'))
+            @TransceiverFunction("probe")
+            def tf(base):
+                return [JsonDataPack("pos", "probe", [float(v) for v in base.data.pos] +
+                                                     [float(v) for v in base.data.rot])]
+            """))
+        ex.run(0.2)
+        with open(os.path.join(ex.dir, "pos.json")) as f:
+            pos = json.load(f)
+        self.assertAlmostEqual(pos[0], -4, delta=0.01)
+        self.assertAlmostEqual(pos[1], 1, delta=0.01)
+        self.assertAlmostEqual(pos[2], 0.5, delta=0.02)
+        self.assertAlmostEqual(abs(pos[5]), 0.7071, delta=0.01)  # yaw 90 degrees
+
     def test_bad_sdf_names_the_file_and_engine(self):
         ex = Experiment(self)
         ex.file("world.sdf", "<sdf version='1.7'><world name='w'><model name='m'>")
