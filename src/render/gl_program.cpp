@@ -10,92 +10,116 @@ namespace {
 const char* kVertexShader = R"(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
-layout(location = 2) in vec2 a_uv;
 uniform mat4 u_model_view;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_projection;
 out vec3 v_position;  // eye space
 out vec3 v_normal;
+#ifdef TEXTURED
+layout(location = 2) in vec2 a_uv;
 out vec2 v_uv;
+#endif
 void main() {
   vec4 p = u_model_view * vec4(a_position, 1.0);
   v_position = p.xyz;
   v_normal = u_normal_matrix * a_normal;
+#ifdef TEXTURED
   v_uv = a_uv;
+#endif
   gl_Position = u_projection * p;
 }
 )";
 
-// Light i: position.w is the type (0 directional, 1 point, 2 spot), direction.w the range,
+// Light i (arrays of LIGHTS): position and direction in eye space, direction.w = range,
 // attenuation = (constant, linear, quadratic), spot = (cos(outer/2),
 // 1 / (cos(inner/2) - cos(outer/2)), falloff).
-const char* kFragmentShader = R"(
+const char* kFragmentHead = R"(
 precision highp float;
 in vec3 v_position;
 in vec3 v_normal;
-in vec2 v_uv;
 uniform vec4 u_diffuse;
 uniform vec4 u_ambient;
 uniform vec4 u_specular;
 uniform vec4 u_emissive;
 uniform float u_shininess;
-uniform bool u_textured;
 uniform bool u_double_sided;
-uniform sampler2D u_texture;
 uniform vec3 u_scene_ambient;
-uniform int u_light_count;
-uniform vec4 u_light_position[MAX_LIGHTS];
-uniform vec4 u_light_direction[MAX_LIGHTS];
-uniform vec3 u_light_diffuse[MAX_LIGHTS];
-uniform vec3 u_light_specular[MAX_LIGHTS];
-uniform vec3 u_light_attenuation[MAX_LIGHTS];
-uniform vec3 u_light_spot[MAX_LIGHTS];
+#if LIGHTS > 0
+uniform vec3 u_light_position[LIGHTS];
+uniform vec4 u_light_direction[LIGHTS];
+uniform vec3 u_light_diffuse[LIGHTS];
+uniform vec3 u_light_specular[LIGHTS];
+uniform vec3 u_light_attenuation[LIGHTS];
+uniform vec3 u_light_spot[LIGHTS];
+#endif
+#ifdef TEXTURED
+in vec2 v_uv;
+uniform sampler2D u_texture;
+#endif
 layout(location = 0) out vec4 out_color;
-#ifdef WITH_DEPTH
+#ifdef DEPTH
 layout(location = 1) out vec4 out_depth;
 #endif
-#ifdef WITH_IDS
+#ifdef IDS
 uniform vec4 u_instance_id;
 layout(location = 2) out vec4 out_id;
 #endif
 
+vec3 n;
+vec3 to_eye;
+vec3 kd;
+
+// Diffuse plus Blinn-Phong specular of light i arriving along unit vector l with `gain`.
+vec3 shade(int i, vec3 l, float gain) {
+  float ndl = dot(n, l);
+  float ndh = max(dot(n, normalize(l + to_eye)), 1e-6);
+  float spec = ndl > 0.0 ? pow(ndh, u_shininess) : 0.0;
+  return gain * (u_light_diffuse[i] * kd * max(ndl, 0.0) + u_light_specular[i] * u_specular.rgb * spec);
+}
+
+// Attenuated gain of a point or spot light i at distance `dist`.
+float attenuation(int i, float dist) {
+  vec3 a = u_light_attenuation[i];
+  return dist > u_light_direction[i].w ? 0.0 : 1.0 / max(a.x + (a.y + a.z * dist) * dist, 1e-6);
+}
+
+vec3 directional(int i) { return shade(i, -u_light_direction[i].xyz, 1.0); }
+
+vec3 point(int i) {
+  vec3 d = u_light_position[i] - v_position;
+  float dist = length(d);
+  return shade(i, d / dist, attenuation(i, dist));
+}
+
+vec3 spot(int i) {
+  vec3 d = u_light_position[i] - v_position;
+  float dist = length(d);
+  vec3 l = d / dist;
+  vec3 s = u_light_spot[i];
+  float rho = dot(-l, u_light_direction[i].xyz);
+  float cone = rho < s.x ? 0.0 : pow(clamp((rho - s.x) * s.y, 1e-6, 1.0), s.z);
+  return shade(i, l, attenuation(i, dist) * cone);
+}
+
 void main() {
-  vec3 n = normalize(v_normal);
+  n = normalize(v_normal);
   if (u_double_sided && !gl_FrontFacing) n = -n;
-  vec3 to_eye = normalize(-v_position);
-  vec3 tex = u_textured ? texture(u_texture, v_uv).rgb : vec3(1.0);
-  vec3 kd = u_diffuse.rgb * tex;
+  to_eye = normalize(-v_position);
+#ifdef TEXTURED
+  vec3 tex = texture(u_texture, v_uv).rgb;
+#else
+  vec3 tex = vec3(1.0);
+#endif
+  kd = u_diffuse.rgb * tex;
   vec3 color = u_emissive.rgb + u_scene_ambient * u_ambient.rgb * tex;
-  for (int i = 0; i < u_light_count; ++i) {
-    vec4 lp = u_light_position[i];
-    vec4 ld = u_light_direction[i];
-    vec3 l;
-    float gain = 1.0;
-    if (lp.w == 0.0) {
-      l = -ld.xyz;
-    } else {
-      vec3 d = lp.xyz - v_position;
-      float dist = length(d);
-      l = d / max(dist, 1e-6);
-      vec3 a = u_light_attenuation[i];
-      gain = dist > ld.w ? 0.0 : 1.0 / max(a.x + (a.y + a.z * dist) * dist, 1e-6);
-      if (lp.w == 2.0) {
-        vec3 s = u_light_spot[i];
-        float rho = dot(-l, ld.xyz);
-        gain *= rho < s.x ? 0.0 : pow(clamp((rho - s.x) * s.y, 1e-6, 1.0), s.z);
-      }
-    }
-    float ndl = dot(n, l);
-    if (ndl <= 0.0 || gain <= 0.0) continue;
-    float ndh = max(dot(n, normalize(l + to_eye)), 1e-6);
-    color += gain * (u_light_diffuse[i] * kd * ndl +
-                     u_light_specular[i] * u_specular.rgb * pow(ndh, u_shininess));
-  }
+)";
+
+const char* kFragmentTail = R"(
   out_color = vec4(color, 1.0);
-#ifdef WITH_DEPTH
+#ifdef DEPTH
   out_depth = vec4(-v_position.z, 0.0, 0.0, 1.0);
 #endif
-#ifdef WITH_IDS
+#ifdef IDS
   out_id = u_instance_id;
 #endif
 }
@@ -123,14 +147,26 @@ GLuint compile(GLenum stage, const std::string& source) {
 
 }  // namespace
 
-SurfaceProgram build_surface_program(bool with_depth, bool with_ids, int max_lights) {
-  std::string header = "#version 300 es\n#define MAX_LIGHTS " + std::to_string(max_lights) + "\n";
-  if (with_depth) header += "#define WITH_DEPTH\n";
-  if (with_ids) header += "#define WITH_IDS\n";
+SurfaceProgram build_surface_program(const ProgramKey& key) {
+  std::string header = "#version 300 es\n#define LIGHTS " + std::to_string(key.lights.size()) + "\n";
+  if (key.textured) header += "#define TEXTURED\n";
+  if (key.depth) header += "#define DEPTH\n";
+  if (key.ids) header += "#define IDS\n";
+  std::string body;
+  for (size_t i = 0; i < key.lights.size(); ++i) {
+    const char* f = key.lights[i] == 'D' ? "directional" : key.lights[i] == 'P' ? "point" : "spot";
+    body += "  color += " + std::string(f) + "(" + std::to_string(i) + ");\n";
+  }
+  // Without lights the helper functions would index empty arrays: leave them out.
+  std::string head = kFragmentHead;
+  if (key.lights.empty()) {
+    const size_t from = head.find("// Diffuse plus"), to = head.find("void main()");
+    head.erase(from, to - from);
+  }
   const GLuint vs = compile(GL_VERTEX_SHADER, header + kVertexShader);
   GLuint fs = 0;
   try {
-    fs = compile(GL_FRAGMENT_SHADER, header + kFragmentShader);
+    fs = compile(GL_FRAGMENT_SHADER, header + head + body + kFragmentTail);
   } catch (...) {
     glDeleteShader(vs);
     throw;
@@ -162,10 +198,8 @@ SurfaceProgram build_surface_program(bool with_depth, bool with_ids, int max_lig
   p.specular = at("u_specular");
   p.emissive = at("u_emissive");
   p.shininess = at("u_shininess");
-  p.textured = at("u_textured");
   p.double_sided = at("u_double_sided");
   p.scene_ambient = at("u_scene_ambient");
-  p.light_count = at("u_light_count");
   p.light_position = at("u_light_position");
   p.light_direction = at("u_light_direction");
   p.light_diffuse = at("u_light_diffuse");
@@ -173,7 +207,7 @@ SurfaceProgram build_surface_program(bool with_depth, bool with_ids, int max_lig
   p.light_attenuation = at("u_light_attenuation");
   p.light_spot = at("u_light_spot");
   glUseProgram(p.id);
-  glUniform1i(at("u_texture"), 0);
+  if (key.textured) glUniform1i(at("u_texture"), 0);
   return p;
 }
 

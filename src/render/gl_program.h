@@ -1,29 +1,43 @@
-// The renderer's shader program (internal): Blinn-Phong surfaces with optional extra outputs.
+// The renderer's shader programs (internal): Blinn-Phong surfaces, one program per variant.
+//
+// llvmpipe runs every branch of a shader for every pixel, so instead of one general shader
+// each combination of lights, texturing and outputs gets its own program with only the code
+// it needs: lights unrolled by type, no texture lookup without a texture.
 //
 // Outputs: location 0 the lit colour (RGBA8), location 1 the distance along the optical axis
-// in metres (R32F, when built with depth), location 2 the instance id packed into RGBA8
-// bytes (when built with ids). Lighting is computed in eye space, per pixel.
+// in metres (R32F, with depth), location 2 the instance id as RGBA8 bytes (with ids).
+// Lighting is computed per pixel in eye space.
 #pragma once
 
 #include <GLES3/gl3.h>
 
+#include <string>
+
 namespace convoy::render {
+
+struct ProgramKey {
+  std::string lights;  // one letter per light, in order: D directional, P point, S spot
+  bool textured = false;
+  bool depth = false;
+  bool ids = false;
+
+  auto operator<=>(const ProgramKey&) const = default;
+};
 
 struct SurfaceProgram {
   GLuint id = 0;
   // Per draw.
   GLint model_view = -1, normal_matrix = -1, instance_id = -1;
   GLint diffuse = -1, ambient = -1, specular = -1, emissive = -1, shininess = -1;
-  GLint textured = -1, double_sided = -1;
+  GLint double_sided = -1;
   // Per frame.
-  GLint projection = -1, scene_ambient = -1, light_count = -1;
+  GLint projection = -1, scene_ambient = -1;
   GLint light_position = -1, light_direction = -1, light_diffuse = -1, light_specular = -1;
   GLint light_attenuation = -1, light_spot = -1;
 };
 
 // Compiles and links the program; throws std::runtime_error with the driver's log on failure.
-// `max_lights` sizes the light arrays.
-SurfaceProgram build_surface_program(bool with_depth, bool with_ids, int max_lights);
+SurfaceProgram build_surface_program(const ProgramKey& key);
 void destroy_program(SurfaceProgram* program);
 
 }  // namespace convoy::render

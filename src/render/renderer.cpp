@@ -15,6 +15,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/memory.h"
 #include "render/egl_context.h"
 #include "render/gl_program.h"
 #include "render/gpu_resources.h"
@@ -59,7 +60,8 @@ void check_spec(const CameraSpec& s) {
 }
 
 struct Draw {
-  double distance;  // of the bounding sphere's centre, for front-to-back order
+  bool textured;    // draws are grouped by program,
+  double distance;  // then go front to back (by their bounding sphere's centre)
   int instance;
   glm::mat4 model_view;
   glm::mat3 normal_matrix;
@@ -79,7 +81,9 @@ struct Renderer::Impl {
   EglContext context;  // first: made first, destroyed last
   GpuSceneCache scenes;
   RenderTargetCache targets;
-  SurfaceProgram programs[2][2];  // [depth][ids], built when first needed
+  std::map<ProgramKey, SurfaceProgram> programs;  // built when first needed
+  uint64_t frame_number = 0;
+  std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
   RenderStats stats;
   // Reused from frame to frame.
@@ -94,21 +98,20 @@ struct Renderer::Impl {
     } catch (...) {
       return;  // another thread holds the context: leak the GL objects rather than crash
     }
-    for (auto& row : programs) {
-      for (auto& p : row) destroy_program(&p);
-    }
+    for (auto& [key, p] : programs) destroy_program(&p);
   }
 
-  const SurfaceProgram& program(bool depth, bool ids) {
-    SurfaceProgram& p = programs[depth][ids];
-    if (!p.id) p = build_surface_program(depth, ids, Scene::kMaxLights);
-    return p;
+  const SurfaceProgram& program(const ProgramKey& key) {
+    auto it = programs.find(key);
+    if (it == programs.end()) it = programs.emplace(key, build_surface_program(key)).first;
+    return it->second;
   }
 
   void upload_frame_uniforms(const SurfaceProgram& p, const Scene& scene, const glm::dmat4& view,
                              const CameraSpec& spec);
   void collect_draws(const Scene& scene, const glm::dmat4& view, const CameraSpec& spec);
-  void draw(const SurfaceProgram& p, const Scene& scene, const GpuScene& gpu);
+  void draw(ProgramKey key, const Scene& scene, const glm::dmat4& view, const CameraSpec& spec,
+            const GpuScene& gpu);
   void compute_boxes(const Scene& scene, int width, int height, std::vector<BoundingBox>* boxes);
 };
 
@@ -118,14 +121,14 @@ void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene&
   glUniform3fv(p.scene_ambient, 1, scene.ambient().data());
   const auto& lights = scene.lights();
   const int n = static_cast<int>(lights.size());
-  std::vector<glm::vec4> position(n), direction(n);
-  std::vector<glm::vec3> diffuse(n), specular(n), attenuation(n), spot(n);
+  std::vector<glm::vec4> direction(n);
+  std::vector<glm::vec3> position(n), diffuse(n), specular(n), attenuation(n), spot(n);
   for (int i = 0; i < n; ++i) {
     const Light& l = lights[i];
     const glm::dvec3 pos = view * glm::dvec4(l.position[0], l.position[1], l.position[2], 1);
     glm::dvec3 dir = glm::dmat3(view) * glm::dvec3(l.direction[0], l.direction[1], l.direction[2]);
     dir = glm::length(dir) > 0 ? glm::normalize(dir) : glm::dvec3(0, 0, -1);
-    position[i] = glm::vec4(glm::vec3(pos), static_cast<float>(l.type));
+    position[i] = glm::vec3(pos);
     direction[i] = glm::vec4(glm::vec3(dir), l.range);
     diffuse[i] = glm::vec3(l.diffuse[0], l.diffuse[1], l.diffuse[2]);
     specular[i] = glm::vec3(l.specular[0], l.specular[1], l.specular[2]);
@@ -136,9 +139,8 @@ void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene&
     spot[i] = glm::vec3(cos_outer, 1.0 / std::max(cos_inner - cos_outer, 1e-6),
                         std::max(l.spot_falloff, 0.0f));
   }
-  glUniform1i(p.light_count, n);
   if (n > 0) {
-    glUniform4fv(p.light_position, n, glm::value_ptr(position[0]));
+    glUniform3fv(p.light_position, n, glm::value_ptr(position[0]));
     glUniform4fv(p.light_direction, n, glm::value_ptr(direction[0]));
     glUniform3fv(p.light_diffuse, n, glm::value_ptr(diffuse[0]));
     glUniform3fv(p.light_specular, n, glm::value_ptr(specular[0]));
@@ -167,21 +169,36 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
     if (c.z - r > -spec.near_clip || -c.z - r > spec.far_clip) continue;
     if ((std::abs(c.x) + c.z * tx) / nx > r || (std::abs(c.y) + c.z * ty) / ny > r) continue;
     const glm::dmat3 normal = glm::transpose(glm::inverse(glm::dmat3(mv)));
-    draws.push_back(Draw{-c.z, i, glm::mat4(mv), glm::mat3(normal)});
+    draws.push_back(Draw{inst.material.texture >= 0, -c.z, i, glm::mat4(mv), glm::mat3(normal)});
   }
   std::sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) {
+    if (a.textured != b.textured) return b.textured;
     return a.distance != b.distance ? a.distance < b.distance : a.instance < b.instance;
   });
 }
 
-void Renderer::Impl::draw(const SurfaceProgram& p, const Scene& scene, const GpuScene& gpu) {
+void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& view,
+                          const CameraSpec& spec, const GpuScene& gpu) {
   stats = RenderStats{static_cast<int>(draws.size()), 0};
+  ++frame_number;
+  const SurfaceProgram* program = nullptr;
   int bound_mesh = -1;
   GLuint bound_texture = 0;
   bool culling = true;
   const Material* last = nullptr;
   for (const Draw& d : draws) {
     const Scene::Instance& inst = scene.instances()[d.instance];
+    if (!program || d.textured != key.textured) {
+      key.textured = d.textured;
+      program = &this->program(key);
+      glUseProgram(program->id);
+      if (program_frame[program->id] != frame_number) {
+        upload_frame_uniforms(*program, scene, view, spec);
+        program_frame[program->id] = frame_number;
+      }
+      last = nullptr;
+    }
+    const SurfaceProgram& p = *program;
     const GpuMesh& mesh = gpu.meshes[inst.mesh];
     if (inst.mesh != bound_mesh) {
       glBindVertexArray(mesh.vao);
@@ -196,7 +213,6 @@ void Renderer::Impl::draw(const SurfaceProgram& p, const Scene& scene, const Gpu
       glUniform4fv(p.specular, 1, m.specular.data());
       glUniform4fv(p.emissive, 1, m.emissive.data());
       glUniform1f(p.shininess, std::max(m.shininess, 1e-3f));
-      glUniform1i(p.textured, m.texture >= 0);
       glUniform1i(p.double_sided, m.double_sided);
       last = &m;
     }
@@ -264,6 +280,9 @@ void Renderer::Impl::compute_boxes(const Scene& scene, int width, int height,
 }
 
 Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
+  // llvmpipe allocates its per-frame bins afresh each frame; returned to the system they
+  // would fault in again every frame (4x slower at 100k triangles).
+  tune_allocator_for_frames();
   glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &impl_->max_size);
 }
 
@@ -286,7 +305,12 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   const int w = spec.width, h = spec.height;
   const RenderTarget& target = s.targets.get(w, h);
   const GpuScene& gpu = s.scenes.sync(scene);
-  const SurfaceProgram& program = s.program(want_depth, want_boxes);
+  ProgramKey key;
+  for (const Light& l : scene.lights()) {
+    key.lights += l.type == Light::kDirectional ? 'D' : l.type == Light::kPoint ? 'P' : 'S';
+  }
+  key.depth = want_depth;
+  key.ids = want_boxes;
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
   glViewport(0, 0, w, h);
@@ -314,11 +338,9 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
 
   const glm::dmat4 view =
       glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
-  glUseProgram(program.id);
   glActiveTexture(GL_TEXTURE0);
-  s.upload_frame_uniforms(program, scene, view, spec);
   s.collect_draws(scene, view, spec);
-  s.draw(program, scene, gpu);
+  s.draw(key, scene, view, spec, gpu);
 
   // Read back. Rows come top first thanks to the flipped projection.
   const size_t pixels = static_cast<size_t>(w) * h;
