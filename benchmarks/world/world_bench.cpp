@@ -20,12 +20,16 @@ int main(int argc, char** argv) {
   double final_x = 0;
   for (int run = 0; run < 5; ++run) {
     PhysicsWorld p(desc);
-    struct C { int joint; bool velocity; JointPid pid; };
+    struct C {
+      int joint;
+      bool velocity;
+      JointPid pid;
+    };
     std::vector<C> cs;
     for (const auto& [plugin, pids] : desc.models[1].joint_plugins)
       for (const auto& pd : pids)
-        cs.push_back({p.joint_index(pd.joint), pd.velocity,
-                      JointPid(pd.p, pd.i, pd.d, pd.i_max, pd.i_min)});
+        cs.push_back(
+            {p.joint_index(pd.joint), pd.velocity, JointPid(pd.p, pd.i, pd.d, pd.i_max, pd.i_min)});
     const double sim_seconds = 20, dt = p.step_size();
     auto t0 = std::chrono::steady_clock::now();
     for (long i = 0; i < std::lround(sim_seconds / dt); ++i) {
@@ -34,7 +38,8 @@ int main(int argc, char** argv) {
       for (auto& c : cs) {
         auto s = p.joint_state(c.joint);
         double target = c.velocity ? omega : steer;
-        p.set_joint_effort(c.joint, c.pid.update((c.velocity ? s.velocity : s.position) - target, dt));
+        p.set_joint_effort(c.joint,
+                           c.pid.update((c.velocity ? s.velocity : s.position) - target, dt));
       }
       p.step();
     }
@@ -43,7 +48,8 @@ int main(int argc, char** argv) {
     final_x = p.link_state(p.link_index("car::base_link")).position.x();
   }
   std::sort(rtfs.begin(), rtfs.end());
-  std::printf("car (4 wheels, 2 steering joints), 1 ms step: real-time factor median %.1fx "
-              "(runs: %.1f %.1f %.1f %.1f %.1f)  target >= 20x   [car travelled %.1f m]\n",
-              rtfs[2], rtfs[0], rtfs[1], rtfs[2], rtfs[3], rtfs[4], final_x);
+  std::printf(
+      "car (4 wheels, 2 steering joints), 1 ms step: real-time factor median %.1fx "
+      "(runs: %.1f %.1f %.1f %.1f %.1f)  target >= 20x   [car travelled %.1f m]\n",
+      rtfs[2], rtfs[0], rtfs[1], rtfs[2], rtfs[3], rtfs[4], final_x);
 }

@@ -1,10 +1,9 @@
 #include "camera_sensors.h"
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "convoy/datapacks.pb.h"
 #include "render/mesh_loader.h"
@@ -77,8 +76,8 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
     cam.noise.resize((size_t{1} << 20) +
                      static_cast<size_t>(cam.desc->width) * cam.desc->height * 3);
     for (auto& v : cam.noise) {
-      v = static_cast<int16_t>(std::lround(
-          255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
+      v = static_cast<int16_t>(
+          std::lround(255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
     }
   }
 }
@@ -103,7 +102,8 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
     light.attenuation_constant = static_cast<float>(l.constant);
     light.attenuation_linear = static_cast<float>(l.linear);
     light.attenuation_quadratic = static_cast<float>(l.quadratic);
-    if (static_cast<int>(scene_.lights().size()) < render::Scene::kMaxLights) scene_.add_light(light);
+    if (static_cast<int>(scene_.lights().size()) < render::Scene::kMaxLights)
+      scene_.add_light(light);
   }
   if (desc.lights.empty()) scene_.add_light(render::Light{});
   uint32_t model_id = 0;
@@ -123,8 +123,8 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
         render::Material material = to_material(v.material);
         switch (v.shape.kind) {
           case Shape::kBox:
-            parts.emplace_back(render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z()),
-                               material);
+            parts.emplace_back(
+                render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z()), material);
             break;
           case Shape::kCylinder:
             parts.emplace_back(render::make_cylinder(v.shape.size.x(), v.shape.size.z()), material);
@@ -136,18 +136,20 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
             double sx = v.shape.size.x() > 0 ? v.shape.size.x() : 1000;
             double sy = v.shape.size.y() > 0 ? v.shape.size.y() : 1000;
             Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-            t.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), v.shape.normal)
-                             .toRotationMatrix();
+            t.linear() =
+                Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), v.shape.normal)
+                    .toRotationMatrix();
             offset = offset * t;
             parts.emplace_back(render::make_plane(sx, sy), material);
             break;
           }
           case Shape::kMesh:
             for (auto& part : render::load_mesh(
-                     v.shape.mesh.string(), {static_cast<float>(v.shape.scale.x()),
-                                             static_cast<float>(v.shape.scale.y()),
-                                             static_cast<float>(v.shape.scale.z())})) {
-              int texture = part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
+                     v.shape.mesh.string(),
+                     {static_cast<float>(v.shape.scale.x()), static_cast<float>(v.shape.scale.y()),
+                      static_cast<float>(v.shape.scale.z())})) {
+              int texture =
+                  part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
               render::Material m = v.material.has_material ? material : part.material(texture);
               if (v.material.has_material && texture >= 0) m.texture = texture;
               parts.emplace_back(std::move(part.mesh), m);
@@ -271,8 +273,10 @@ void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
     boxes.push_back({{"model", model_names_[b.model_id - 1]},
                      {"class", model_classes_[b.model_id - 1]},
                      {"instance", b.model_id},
-                     {"x_min", b.x_min}, {"y_min", b.y_min},
-                     {"x_max", b.x_max}, {"y_max", b.y_max},
+                     {"x_min", b.x_min},
+                     {"y_min", b.y_min},
+                     {"x_max", b.x_max},
+                     {"y_max", b.y_max},
                      {"pixels", b.pixel_count}});
   }
   nlohmann::json j = {{"width", cam.frame.width}, {"height", cam.frame.height}, {"boxes", boxes}};

@@ -18,10 +18,10 @@
 #include <random>
 #include <unordered_map>
 
+#include "camera_sensors.h"
 #include "convoy/datapacks.pb.h"
 #include "engine/engine.h"
 #include "joint_pid.h"
-#include "camera_sensors.h"
 #include "physics_world.h"
 #include "world_description.h"
 
@@ -69,8 +69,8 @@ class GazeboEngine final : public Engine {
     rng_.seed(config.value("GazeboRNGSeed", 0u));
     desc_ = world::load_world(file, extra);
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
-    cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_,
-                                                      config.value("GazeboRNGSeed", 0u));
+    cameras_ =
+        std::make_unique<world::CameraSensors>(desc_, *physics_, config.value("GazeboRNGSeed", 0u));
     substeps_ = std::max<int64_t>(
         1, std::llround(static_cast<double>(timestep_ns) * 1e-9 / physics_->step_size()));
 
@@ -86,7 +86,8 @@ class GazeboEngine final : public Engine {
       for (const auto& [plugin, pids] : model.joint_plugins) {
         for (const auto& pid : pids) {
           int index = physics_->joint_index(pid.joint);
-          if (index < 0) throw std::runtime_error("joint '" + pid.joint + "' has no degree of freedom");
+          if (index < 0)
+            throw std::runtime_error("joint '" + pid.joint + "' has no degree of freedom");
           controllers_.push_back({index, pid.velocity, pid.target,
                                   world::JointPid(pid.p, pid.i, pid.d, pid.i_max, pid.i_min), 0});
           std::string short_name = pid.joint.substr(model.name.size() + 2);
@@ -125,8 +126,7 @@ class GazeboEngine final : public Engine {
 
   int64_t step(int64_t duration_ns) override {
     const double dt = physics_->step_size();
-    int64_t n = std::max<int64_t>(
-        1, std::llround(static_cast<double>(duration_ns) * 1e-9 / dt));
+    int64_t n = std::max<int64_t>(1, std::llround(static_cast<double>(duration_ns) * 1e-9 / dt));
     for (int64_t k = 0; k < n; ++k) {
       for (auto& c : controllers_) {
         auto s = physics_->joint_state(c.joint);
@@ -148,8 +148,7 @@ class GazeboEngine final : public Engine {
     }
     if (dp.payload_case() != engine::DataPack::kProto ||
         dp.proto().type_name() != "convoy.data.Joint") {
-      throw std::runtime_error("datapack '" + dp.id().name() +
-                               "' must be a GazeboJointDataPack");
+      throw std::runtime_error("datapack '" + dp.id().name() + "' must be a GazeboJointDataPack");
     }
     data::Joint j;
     j.ParseFromString(dp.proto().data());
@@ -161,9 +160,12 @@ class GazeboEngine final : public Engine {
   void get_datapack(const engine::DataPackId& id, engine::DataPack* out) override {
     if (auto it = camera_dps_.find(id.name()); it != camera_dps_.end()) {
       auto [index, kind] = it->second;
-      if (kind == kImage) cameras_->image_datapack(index, out);
-      else if (kind == kDepth) cameras_->depth_datapack(index, out);
-      else cameras_->boxes_datapack(index, out);
+      if (kind == kImage)
+        cameras_->image_datapack(index, out);
+      else if (kind == kDepth)
+        cameras_->depth_datapack(index, out);
+      else
+        cameras_->boxes_datapack(index, out);
       return;
     }
     if (auto it = joint_dps_.find(id.name()); it != joint_dps_.end()) {

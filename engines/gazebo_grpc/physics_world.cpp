@@ -1,8 +1,7 @@
 #include "physics_world.h"
 
-#include <dart/collision/bullet/BulletCollisionDetector.hpp>
-
 #include <algorithm>
+#include <dart/collision/bullet/BulletCollisionDetector.hpp>
 #include <functional>
 #include <set>
 #include <stdexcept>
@@ -94,8 +93,8 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
     for (const auto& c : l.collisions) {
       Eigen::Isometry3d offset = c.pose;
       auto shape = make_shape(c.shape, &offset);
-      auto* node =
-          bn->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(shape, l.name + "::" + c.name);
+      auto* node = bn->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(
+          shape, l.name + "::" + c.name);
       node->setRelativeTransform(offset);
       node->getDynamicsAspect()->setFrictionCoeff(c.mu);
     }
@@ -107,8 +106,8 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
   // Builds the subtree hanging from `parent_bn` through joint `j` (nullptr: a root link).
   std::function<void(dd::BodyNode*, const LinkDesc&, const JointDesc*)> attach;
   attach = [&](dd::BodyNode* parent_bn, const LinkDesc& l, const JointDesc* j) {
-    Eigen::Isometry3d parent_world = (j && j->parent != "world") ? links.at(j->parent)->pose
-                                                                   : Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d parent_world =
+        (j && j->parent != "world") ? links.at(j->parent)->pose : Eigen::Isometry3d::Identity();
     std::pair<dd::Joint*, dd::BodyNode*> made;
     auto bp = body_props(l);
     if (!j) {

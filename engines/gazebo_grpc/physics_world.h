@@ -4,7 +4,6 @@
 #pragma once
 
 #include <dart/dart.hpp>
-
 #include <memory>
 #include <string>
 #include <unordered_map>

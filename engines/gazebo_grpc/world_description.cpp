@@ -1,10 +1,9 @@
 #include "world_description.h"
 
-#include <sdf/sdf.hh>
-
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <sdf/sdf.hh>
 #include <sstream>
 #include <stdexcept>
 
@@ -74,13 +73,20 @@ fs::path resolve_uri(const std::string& uri, const fs::path& base_dir,
 // Gazebo's stock script materials, for worlds that use them.
 bool script_colour(const std::string& name, Rgba* out) {
   static const std::map<std::string, Rgba> colours = {
-      {"Gazebo/White", {1, 1, 1, 1}},        {"Gazebo/Black", {0.05f, 0.05f, 0.05f, 1}},
-      {"Gazebo/Grey", {0.7f, 0.7f, 0.7f, 1}}, {"Gazebo/DarkGrey", {0.35f, 0.35f, 0.35f, 1}},
-      {"Gazebo/Red", {1, 0, 0, 1}},          {"Gazebo/Green", {0, 1, 0, 1}},
-      {"Gazebo/Blue", {0, 0, 1, 1}},         {"Gazebo/Yellow", {1, 1, 0, 1}},
-      {"Gazebo/Orange", {1, 0.5f, 0.05f, 1}}, {"Gazebo/Purple", {1, 0, 1, 1}},
-      {"Gazebo/Turquoise", {0, 1, 1, 1}},    {"Gazebo/Wood", {0.6f, 0.4f, 0.2f, 1}},
-      {"Gazebo/Asphalt", {0.2f, 0.2f, 0.2f, 1}}, {"Gazebo/Road", {0.25f, 0.25f, 0.25f, 1}},
+      {"Gazebo/White", {1, 1, 1, 1}},
+      {"Gazebo/Black", {0.05f, 0.05f, 0.05f, 1}},
+      {"Gazebo/Grey", {0.7f, 0.7f, 0.7f, 1}},
+      {"Gazebo/DarkGrey", {0.35f, 0.35f, 0.35f, 1}},
+      {"Gazebo/Red", {1, 0, 0, 1}},
+      {"Gazebo/Green", {0, 1, 0, 1}},
+      {"Gazebo/Blue", {0, 0, 1, 1}},
+      {"Gazebo/Yellow", {1, 1, 0, 1}},
+      {"Gazebo/Orange", {1, 0.5f, 0.05f, 1}},
+      {"Gazebo/Purple", {1, 0, 1, 1}},
+      {"Gazebo/Turquoise", {0, 1, 1, 1}},
+      {"Gazebo/Wood", {0.6f, 0.4f, 0.2f, 1}},
+      {"Gazebo/Asphalt", {0.2f, 0.2f, 0.2f, 1}},
+      {"Gazebo/Road", {0.25f, 0.25f, 0.25f, 1}},
   };
   auto it = colours.find(name);
   if (it == colours.end()) return false;
@@ -116,7 +122,8 @@ class Loader {
       case sdf::GeometryType::MESH: {
         s.kind = Shape::kMesh;
         const sdf::Mesh* m = g->MeshShape();
-        fs::path base = m->FilePath().empty() ? file_.parent_path() : fs::path(m->FilePath()).parent_path();
+        fs::path base =
+            m->FilePath().empty() ? file_.parent_path() : fs::path(m->FilePath()).parent_path();
         s.mesh = resolve_uri(m->Uri(), base, paths_);
         if (s.mesh.empty()) {
           throw std::runtime_error(file_.string() + ": " + where + ": mesh '" + m->Uri() +
@@ -189,8 +196,8 @@ class Loader {
             try {
               return std::stod(v);
             } catch (const std::exception&) {
-              throw std::runtime_error(file_.string() + ": " + where + ": joint '" +
-                                       j->GetName() + "': " + key + "='" + v + "' is not a number");
+              throw std::runtime_error(file_.string() + ": " + where + ": joint '" + j->GetName() +
+                                       "': " + key + "='" + v + "' is not a number");
             }
           };
           pid.p = num("P", 0);
@@ -242,7 +249,8 @@ class Loader {
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) I(r, c) = moi(r, c);
       ld.inertia = inertial_pose.linear() * I * inertial_pose.linear().transpose();
-      if (auto e = l->Element(); e && e->HasElement("gravity")) ld.gravity = e->Get<bool>("gravity");
+      if (auto e = l->Element(); e && e->HasElement("gravity"))
+        ld.gravity = e->Get<bool>("gravity");
       for (uint64_t c = 0; c < l->CollisionCount(); ++c) {
         const sdf::Collision* col = l->CollisionByIndex(c);
         CollisionDesc cd;
@@ -307,12 +315,24 @@ class Loader {
       jd.name = name + "::" + j->Name();
       std::string where = "joint '" + jd.name + "'";
       switch (j->Type()) {
-        case sdf::JointType::REVOLUTE: jd.type = JointDesc::kRevolute; break;
-        case sdf::JointType::CONTINUOUS: jd.type = JointDesc::kContinuous; break;
-        case sdf::JointType::PRISMATIC: jd.type = JointDesc::kPrismatic; break;
-        case sdf::JointType::FIXED: jd.type = JointDesc::kFixed; break;
-        case sdf::JointType::BALL: jd.type = JointDesc::kBall; break;
-        case sdf::JointType::UNIVERSAL: jd.type = JointDesc::kUniversal; break;
+        case sdf::JointType::REVOLUTE:
+          jd.type = JointDesc::kRevolute;
+          break;
+        case sdf::JointType::CONTINUOUS:
+          jd.type = JointDesc::kContinuous;
+          break;
+        case sdf::JointType::PRISMATIC:
+          jd.type = JointDesc::kPrismatic;
+          break;
+        case sdf::JointType::FIXED:
+          jd.type = JointDesc::kFixed;
+          break;
+        case sdf::JointType::BALL:
+          jd.type = JointDesc::kBall;
+          break;
+        case sdf::JointType::UNIVERSAL:
+          jd.type = JointDesc::kUniversal;
+          break;
         default:
           throw std::runtime_error(file_.string() + ": " + where + ": unsupported joint type");
       }

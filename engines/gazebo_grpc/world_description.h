@@ -4,7 +4,6 @@
 #pragma once
 
 #include <Eigen/Geometry>
-
 #include <array>
 #include <filesystem>
 #include <string>
@@ -16,8 +15,8 @@ using Rgba = std::array<float, 4>;
 
 struct Shape {
   enum Kind { kBox, kCylinder, kSphere, kPlane, kMesh } kind = kBox;
-  Eigen::Vector3d size = Eigen::Vector3d::Ones();  // box: x y z; cylinder: r r length;
-                                                   // sphere: r r r; plane: x y 0
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();     // box: x y z; cylinder: r r length;
+                                                      // sphere: r r r; plane: x y 0
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // plane
   std::filesystem::path mesh;                         // mesh: absolute file path
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();    // mesh
@@ -45,9 +44,9 @@ struct VisualDesc {
 };
 
 struct CameraDesc {
-  std::string name;         // sensor name
-  std::string plugin_name;  // NRP camera plugin name ("" if none)
-  std::string scoped_name;  // model::link::sensor
+  std::string name;                                        // sensor name
+  std::string plugin_name;                                 // NRP camera plugin name ("" if none)
+  std::string scoped_name;                                 // model::link::sensor
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
   int width = 320, height = 240;
   std::string format = "R8G8B8";
@@ -57,12 +56,12 @@ struct CameraDesc {
 };
 
 struct LinkDesc {
-  std::string name;         // model::link
-  std::string short_name;   // link
+  std::string name;                                        // model::link
+  std::string short_name;                                  // link
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // world, at load
   double mass = 1;
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();            // in the link frame
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity();    // about the COM, link axes
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();          // in the link frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity();  // about the COM, link axes
   bool gravity = true;
   std::vector<CollisionDesc> collisions;
   std::vector<VisualDesc> visuals;
@@ -76,10 +75,10 @@ struct AxisDesc {
 
 struct JointDesc {
   enum Type { kRevolute, kContinuous, kPrismatic, kFixed, kBall, kUniversal } type = kFixed;
-  std::string name;        // model::joint
-  std::string short_name;  // joint
-  std::string parent;      // scoped link name, or "world"
-  std::string child;       // scoped link name
+  std::string name;                                        // model::joint
+  std::string short_name;                                  // joint
+  std::string parent;                                      // scoped link name, or "world"
+  std::string child;                                       // scoped link name
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // world, at load
   std::vector<AxisDesc> axes;
 };
@@ -97,7 +96,7 @@ struct ModelDesc {
   std::vector<LinkDesc> links;
   std::vector<JointDesc> joints;
   std::vector<std::pair<std::string, std::vector<PidDesc>>> joint_plugins;  // plugin name
-  std::vector<std::string> link_plugins;                                     // plugin names
+  std::vector<std::string> link_plugins;                                    // plugin names
 };
 
 struct LightDesc {

@@ -108,7 +108,9 @@ class PythonJsonEngine final : public Engine {
     for (auto item : py::dict(module.attr("__dict__"))) {
       py::handle v = item.second;
       if (isclass(v).cast<bool>() && !v.is(base) && issubclass(v, base).cast<bool>()) {
-        if (found) throw std::runtime_error(file.string() + ": several EngineScript classes; name one Script");
+        if (found)
+          throw std::runtime_error(file.string() +
+                                   ": several EngineScript classes; name one Script");
         found = py::reinterpret_borrow<py::object>(v);
       }
     }

@@ -16,9 +16,11 @@ void usage(const char* prog) {
       "       NRPCoreSim -c simulation_config.json [-o Key=Value]...\n"
       "\n"
       "  -c, --config FILE   the simulation config (NRP-Core format)\n"
-      "  -o, --param K=V     override a config key; K may be a path like EngineConfigs/0/EngineTimestep\n"
+      "  -o, --param K=V     override a config key; K may be a path like "
+      "EngineConfigs/0/EngineTimestep\n"
       "  --run-dir DIR       where to write logs, steps.csv and summary.json\n"
-      "                      (default: ./runs/<SimulationName>-<time>-<pid>, or under $CONVOY_RUNS_DIR)\n"
+      "                      (default: ./runs/<SimulationName>-<time>-<pid>, or under "
+      "$CONVOY_RUNS_DIR)\n"
       "  -q, --quiet         only errors on the terminal\n",
       prog);
 }
@@ -51,10 +53,14 @@ int main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "-c" || a == "--config") options.config_file = value();
-    else if (a == "-o" || a == "--param") options.overrides.push_back(value());
-    else if (a == "--run-dir") options.run_dir = value();
-    else if (a == "-q" || a == "--quiet") options.quiet = true;
+    if (a == "-c" || a == "--config")
+      options.config_file = value();
+    else if (a == "-o" || a == "--param")
+      options.overrides.push_back(value());
+    else if (a == "--run-dir")
+      options.run_dir = value();
+    else if (a == "-q" || a == "--quiet")
+      options.quiet = true;
     else if (a == "-h" || a == "--help") {
       usage(prog.c_str());
       return 0;

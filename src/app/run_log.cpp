@@ -9,9 +9,7 @@ RunLog::~RunLog() {
   if (file_) std::fclose(file_);
 }
 
-void RunLog::open(const std::filesystem::path& file) {
-  file_ = std::fopen(file.c_str(), "a");
-}
+void RunLog::open(const std::filesystem::path& file) { file_ = std::fopen(file.c_str(), "a"); }
 
 void RunLog::write(const char* level, const std::string& text) {
   if (!file_) return;

@@ -83,9 +83,9 @@ void check_functions(const std::vector<python::LoadedFunction>& functions,
     }
     for (const auto& in : fn.inputs) {
       if (!engines.count(in.engine)) {
-        throw UserError(fn.file.string() + ": input '" + in.keyword + "' of function '" +
-                        fn.name + "' reads datapack '" + in.datapack + "' from unknown engine '" +
-                        in.engine + "' (engines: " + list + ")");
+        throw UserError(fn.file.string() + ": input '" + in.keyword + "' of function '" + fn.name +
+                        "' reads datapack '" + in.datapack + "' from unknown engine '" + in.engine +
+                        "' (engines: " + list + ")");
       }
       if (fn.preprocessing && !in.preprocessed && in.engine != fn.engine) {
         throw UserError(fn.file.string() + ": preprocessing function '" + fn.name +
@@ -131,8 +131,8 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   launch::LaunchSpec spec;
   spec.program = ec.proc_cmd.empty() ? "convoy-engine-" + ec.type : ec.proc_cmd;
   spec.args = ec.proc_start_params;
-  spec.args.insert(spec.args.end(), {"--convoy-fd", "3", "--convoy-spin-us",
-                                     std::to_string(engine_spin_us(cfg))});
+  spec.args.insert(spec.args.end(),
+                   {"--convoy-fd", "3", "--convoy-spin-us", std::to_string(engine_spin_us(cfg))});
   spec.pass_fds = {fds[1]};
   if (size_t bytes = shm_arena_bytes(); bytes > 0) {  // CONVOY_SHM_MB=0: blobs inline
     handle.create_arenas(bytes);
@@ -152,8 +152,8 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   } catch (const std::exception& e) {
     close(fds[0]);
     close(fds[1]);
-    throw UserError(cfg.file.string() + ": " + ec.pointer + ": engine '" + ec.name + "': " +
-                    e.what());
+    throw UserError(cfg.file.string() + ": " + ec.pointer + ": engine '" + ec.name +
+                    "': " + e.what());
   }
   close(fds[1]);
   handle.attach(transport::make_socket_channel(fds[0]), child);
@@ -199,8 +199,11 @@ int run_simulation(const RunOptions& options) {
   log.info("run folder: " + run_dir.string());
   for (const auto& w : cfg.warnings) log.info("warning: " + w);
   std::ofstream(run_dir / "config.json") << cfg.json.dump(2) << "\n";
-  if (cfg.loop != "FTILoop") log.info("warning: SimulationLoop " + cfg.loop + " is not available yet; running FTILoop");
-  if (cfg.datapack_processor != "tf") log.info("warning: DataPackProcessor " + cfg.datapack_processor + " is not available yet; running tf");
+  if (cfg.loop != "FTILoop")
+    log.info("warning: SimulationLoop " + cfg.loop + " is not available yet; running FTILoop");
+  if (cfg.datapack_processor != "tf")
+    log.info("warning: DataPackProcessor " + cfg.datapack_processor +
+             " is not available yet; running tf");
 
   std::vector<std::unique_ptr<loop::EngineHandle>> engines;
   std::unique_ptr<loop::FtiLoop> fti;
@@ -234,8 +237,8 @@ int run_simulation(const RunOptions& options) {
         init->set_engine_name(e->name());
         init->set_config_json(e->config().json.dump());
         init->set_timestep_ns(e->config().timestep_ns);
-        double timeout = e->config().command_timeout_s > 0
-                             ? std::max(e->config().command_timeout_s, 60.0) : 0;
+        double timeout =
+            e->config().command_timeout_s > 0 ? std::max(e->config().command_timeout_s, 60.0) : 0;
         e->start(request, "Initialize", timeout);
       }
       for (auto& e : engines) {

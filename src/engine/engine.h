@@ -6,11 +6,10 @@
 // bin/convoy-engine-<type>.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -46,8 +45,7 @@ std::vector<std::string> registered_engine_types();
 
 }  // namespace convoy::engines
 
-#define CONVOY_REGISTER_ENGINE(type_name, Class)                                \
-  static const bool convoy_engine_registered_##Class =                          \
-      ::convoy::engines::register_engine(type_name, [] {                        \
-        return std::unique_ptr<::convoy::engines::Engine>(std::make_unique<Class>()); \
-      })
+#define CONVOY_REGISTER_ENGINE(type_name, Class)                                           \
+  static const bool convoy_engine_registered_##Class = ::convoy::engines::register_engine( \
+      type_name,                                                                           \
+      [] { return std::unique_ptr<::convoy::engines::Engine>(std::make_unique<Class>()); })

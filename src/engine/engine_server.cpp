@@ -2,13 +2,13 @@
 
 #include <grpcpp/grpcpp.h>
 
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
-#include <map>
-#include <mutex>
-#include <condition_variable>
 #include <deque>
 #include <future>
+#include <map>
+#include <mutex>
 #include <thread>
 
 #include "convoy/engine.grpc.pb.h"
@@ -276,12 +276,18 @@ int engine_main(int argc, char** argv) {
       }
       return argv[++i];
     };
-    if (a == "--type") type = value("--type");
-    else if (a == "--convoy-fd") fd = std::stoi(value("--convoy-fd"));
-    else if (a == "--convoy-shm-out") shm_out = std::stoi(value("--convoy-shm-out"));
-    else if (a == "--convoy-shm-in") shm_in = std::stoi(value("--convoy-shm-in"));
-    else if (a == "--convoy-spin-us") spin_us = std::stoll(value("--convoy-spin-us"));
-    else if (a == "--address" || a == "--serverurl") address = value("--address");
+    if (a == "--type")
+      type = value("--type");
+    else if (a == "--convoy-fd")
+      fd = std::stoi(value("--convoy-fd"));
+    else if (a == "--convoy-shm-out")
+      shm_out = std::stoi(value("--convoy-shm-out"));
+    else if (a == "--convoy-shm-in")
+      shm_in = std::stoi(value("--convoy-shm-in"));
+    else if (a == "--convoy-spin-us")
+      spin_us = std::stoll(value("--convoy-spin-us"));
+    else if (a == "--address" || a == "--serverurl")
+      address = value("--address");
     else if (a == "-h" || a == "--help") {
       std::printf("usage: %s [--type T] (--convoy-fd N | --address host:port)\n", argv[0]);
       return 0;
@@ -303,8 +309,10 @@ int engine_main(int argc, char** argv) {
   EngineServer server(*engine);
   server.set_spin_us(spin_us);
   try {
-    if (fd >= 0) server.serve_socket(fd, shm_out, shm_in);
-    else server.serve_grpc(address);
+    if (fd >= 0)
+      server.serve_socket(fd, shm_out, shm_in);
+    else
+      server.serve_grpc(address);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "engine server error: %s\n", e.what());
     return 1;

@@ -35,7 +35,8 @@ std::string resolve_program(const LaunchSpec& spec) {
     if (access(p.c_str(), X_OK) == 0) return p;
     start = end + 1;
   }
-  throw std::runtime_error("program '" + spec.program + "' not found (searched the Convoy bin "
+  throw std::runtime_error("program '" + spec.program +
+                           "' not found (searched the Convoy bin "
                            "directory and PATH)");
 }
 

@@ -50,10 +50,10 @@ class EngineHandle {
   std::string log_tail(size_t lines = 20) const;
 
   // Loop bookkeeping.
-  size_t index = 0;                                // position in the config
+  size_t index = 0;  // position in the config
   int64_t time_ns = 0;
-  std::vector<engine::DataPackId> wanted;          // datapacks the functions read from it
-  std::vector<engine::DataPack> pending_inputs;    // TF outputs for its next step
+  std::vector<engine::DataPackId> wanted;        // datapacks the functions read from it
+  std::vector<engine::DataPack> pending_inputs;  // TF outputs for its next step
   int64_t call_started_ns = 0;
   int64_t last_roundtrip_ns = -1, last_compute_ns = -1;
 

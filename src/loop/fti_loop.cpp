@@ -34,8 +34,9 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
     for (const auto& in : fn.inputs) {
       if (in.preprocessed) continue;
       auto* e = by_name_.at(in.engine);
-      bool known = std::any_of(e->wanted.begin(), e->wanted.end(),
-                               [&](const engine::DataPackId& id) { return id.name() == in.datapack; });
+      bool known =
+          std::any_of(e->wanted.begin(), e->wanted.end(),
+                      [&](const engine::DataPackId& id) { return id.name() == in.datapack; });
       if (!known) {
         engine::DataPackId id;
         id.set_name(in.datapack);
@@ -44,8 +45,8 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
       }
     }
   }
-  source_.engine_datapack = [this](const std::string& engine, const std::string& name)
-      -> const engine::DataPack* {
+  source_.engine_datapack = [this](const std::string& engine,
+                                   const std::string& name) -> const engine::DataPack* {
     auto it = pool_.find(key(engine, name));
     return it == pool_.end() ? nullptr : &it->second;
   };
@@ -177,9 +178,8 @@ void FtiLoop::run(int64_t until_ns) {
       due.push_back(engines_[queue_.begin()->second]);
       queue_.erase(queue_.begin());
     }
-    std::sort(due.begin(), due.end(), [&](EngineHandle* a, EngineHandle* b) {
-      return a->index < b->index;
-    });
+    std::sort(due.begin(), due.end(),
+              [&](EngineHandle* a, EngineHandle* b) { return a->index < b->index; });
     std::fill(due_mask_.begin(), due_mask_.end(), 0);
     for (auto* e : due) due_mask_[e->index] = 1;
     for (auto* e : due) {

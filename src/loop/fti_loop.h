@@ -42,14 +42,14 @@ class FtiLoop {
 
   std::vector<EngineHandle*> engines_;
   std::unordered_map<std::string, EngineHandle*> by_name_;
-  std::vector<char> due_mask_;            // by engine index: due this cycle
-  std::vector<size_t> function_engine_;   // by function: index of its engine
+  std::vector<char> due_mask_;           // by engine index: due this cycle
+  std::vector<size_t> function_engine_;  // by function: index of its engine
   std::string row_;
   python::FunctionRuntime& runtime_;
   const std::vector<python::LoadedFunction>& functions_;
   python::InputSource source_;
   std::unordered_map<std::string, engine::DataPack> pool_;  // "engine\0name" -> latest
-  std::multimap<int64_t, size_t> queue_;                     // completion time -> engine
+  std::multimap<int64_t, size_t> queue_;                    // completion time -> engine
   std::vector<engine::DataPack> outputs_;
   std::FILE* csv_ = nullptr;
   int64_t sim_time_ns_ = 0;

@@ -52,8 +52,8 @@ std::vector<float> float_vector(py::handle value, size_t n, const char* what) {
   std::vector<float> out;
   for (auto v : value) out.push_back(v.cast<float>());
   if (out.size() != n) {
-    throw std::runtime_error(std::string(what) + " needs " + std::to_string(n) +
-                             " numbers, got " + std::to_string(out.size()));
+    throw std::runtime_error(std::string(what) + " needs " + std::to_string(n) + " numbers, got " +
+                             std::to_string(out.size()));
   }
   return out;
 }
@@ -92,7 +92,8 @@ py::object proto_data(const engine::DataPack& dp, ImageAccess access) {
     if (!l.ParseFromString(p.data())) throw std::runtime_error("corrupt link datapack");
     py::object rot = float_array(l.rotation(), 4);
     if (l.rotation_size() == 0) rot[py::int_(3)] = 1.0f;
-    return m.attr("LinkData")(float_array(l.position(), 3), rot, float_array(l.linear_velocity(), 3),
+    return m.attr("LinkData")(float_array(l.position(), 3), rot,
+                              float_array(l.linear_velocity(), 3),
                               float_array(l.angular_velocity(), 3));
   }
   throw std::runtime_error("datapack '" + dp.id().name() + "' of engine '" + dp.id().engine_name() +
@@ -136,8 +137,10 @@ bool encode_proto(py::handle data, engine::DataPack* out) {
     data::Link l;
     for (float v : float_vector(data.attr("pos"), 3, "link position")) l.add_position(v);
     for (float v : float_vector(data.attr("rot"), 4, "link rotation")) l.add_rotation(v);
-    for (float v : float_vector(data.attr("lin_vel"), 3, "link linear velocity")) l.add_linear_velocity(v);
-    for (float v : float_vector(data.attr("ang_vel"), 3, "link angular velocity")) l.add_angular_velocity(v);
+    for (float v : float_vector(data.attr("lin_vel"), 3, "link linear velocity"))
+      l.add_linear_velocity(v);
+    for (float v : float_vector(data.attr("ang_vel"), 3, "link angular velocity"))
+      l.add_angular_velocity(v);
     payload->set_type_name(kLink);
     l.SerializeToString(payload->mutable_data());
   } else {

@@ -42,8 +42,10 @@ std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
                     format_exception(e));
   }
   if (out.empty()) {
-    throw UserError(file.string() + ": declares no @TransceiverFunction or "
-                    "@PreprocessingFunction (function '" + name + "')");
+    throw UserError(file.string() +
+                    ": declares no @TransceiverFunction or "
+                    "@PreprocessingFunction (function '" +
+                    name + "')");
   }
   return out;
 }
@@ -61,14 +63,14 @@ py::object FunctionRuntime::input_object(const FunctionInput& in, const InputSou
       if (by_reference_) return obj;
       return py::module_::import("copy").attr("deepcopy")(obj);
     }
-    return py::module_::import("nrp_core._datapacks")
-        .attr("EmptyDataPack")(in.datapack, in.engine);
+    return py::module_::import("nrp_core._datapacks").attr("EmptyDataPack")(in.datapack, in.engine);
   }
   if (by_reference_ && shared_.contains(key)) return shared_[key];
   const engine::DataPack* dp = src.engine_datapack(in.engine, in.datapack);
   py::object obj;
   if (dp) {
-    transport::ScopedBlobContext blobs(nullptr, src.reader_for ? src.reader_for(in.engine) : nullptr);
+    transport::ScopedBlobContext blobs(nullptr,
+                                       src.reader_for ? src.reader_for(in.engine) : nullptr);
     obj = to_python(*dp);
   } else {
     obj = py::module_::import("nrp_core._datapacks").attr("EmptyDataPack")(in.datapack, in.engine);
@@ -83,8 +85,7 @@ py::object FunctionRuntime::call(const LoadedFunction& fn, const InputSource& sr
     for (const auto& in : fn.inputs) kwargs[py::str(in.keyword)] = input_object(in, src, fn);
     py::object result = fn.callable(**kwargs);
     if (!py::isinstance<py::list>(result) && !py::isinstance<py::tuple>(result)) {
-      throw FunctionError(fn.label() + " returned " +
-                          std::string(Py_TYPE(result.ptr())->tp_name) +
+      throw FunctionError(fn.label() + " returned " + std::string(Py_TYPE(result.ptr())->tp_name) +
                           "; it must return a list of datapacks");
     }
     return result;
@@ -125,8 +126,8 @@ void FunctionRuntime::run_preprocessing(const LoadedFunction& fn, const InputSou
                         id.attr("dataPackName").cast<std::string>();
       preprocessed_[py::str(key)] = item;
     } catch (py::error_already_set& e) {
-      throw FunctionError(fn.label() + " returned something that is not a datapack: " +
-                          format_exception(e));
+      throw FunctionError(fn.label() +
+                          " returned something that is not a datapack: " + format_exception(e));
     }
   }
 }

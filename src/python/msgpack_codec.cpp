@@ -12,8 +12,8 @@ void put_be(std::string* out, uint64_t v, int bytes) {
   for (int i = bytes - 1; i >= 0; --i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xff));
 }
 
-void put_len(std::string* out, size_t n, uint8_t fix_base, size_t fix_max, uint8_t c8,
-             uint8_t c16, uint8_t c32) {
+void put_len(std::string* out, size_t n, uint8_t fix_base, size_t fix_max, uint8_t c8, uint8_t c16,
+             uint8_t c32) {
   if (fix_max && n <= fix_max) {
     out->push_back(static_cast<char>(fix_base | n));
   } else if (c8 && n <= 0xff) {
@@ -35,23 +35,41 @@ void put_str(std::string* out, const char* s, size_t n) {
 
 void put_int(std::string* out, long long v) {
   if (v >= 0) {
-    if (v <= 0x7f) out->push_back(static_cast<char>(v));
-    else if (v <= 0xff) { out->push_back('\xcc'); put_be(out, v, 1); }
-    else if (v <= 0xffff) { out->push_back('\xcd'); put_be(out, v, 2); }
-    else if (v <= 0xffffffffLL) { out->push_back('\xce'); put_be(out, v, 4); }
-    else { out->push_back('\xcf'); put_be(out, static_cast<uint64_t>(v), 8); }
+    if (v <= 0x7f)
+      out->push_back(static_cast<char>(v));
+    else if (v <= 0xff) {
+      out->push_back('\xcc');
+      put_be(out, v, 1);
+    } else if (v <= 0xffff) {
+      out->push_back('\xcd');
+      put_be(out, v, 2);
+    } else if (v <= 0xffffffffLL) {
+      out->push_back('\xce');
+      put_be(out, v, 4);
+    } else {
+      out->push_back('\xcf');
+      put_be(out, static_cast<uint64_t>(v), 8);
+    }
   } else {
-    if (v >= -32) out->push_back(static_cast<char>(v));
-    else if (v >= -128) { out->push_back('\xd0'); put_be(out, static_cast<uint64_t>(v), 1); }
-    else if (v >= -32768) { out->push_back('\xd1'); put_be(out, static_cast<uint64_t>(v), 2); }
-    else if (v >= -2147483648LL) { out->push_back('\xd2'); put_be(out, static_cast<uint64_t>(v), 4); }
-    else { out->push_back('\xd3'); put_be(out, static_cast<uint64_t>(v), 8); }
+    if (v >= -32)
+      out->push_back(static_cast<char>(v));
+    else if (v >= -128) {
+      out->push_back('\xd0');
+      put_be(out, static_cast<uint64_t>(v), 1);
+    } else if (v >= -32768) {
+      out->push_back('\xd1');
+      put_be(out, static_cast<uint64_t>(v), 2);
+    } else if (v >= -2147483648LL) {
+      out->push_back('\xd2');
+      put_be(out, static_cast<uint64_t>(v), 4);
+    } else {
+      out->push_back('\xd3');
+      put_be(out, static_cast<uint64_t>(v), 8);
+    }
   }
 }
 
-bool is_ndarray(PyObject* obj) {
-  return std::strcmp(Py_TYPE(obj)->tp_name, "numpy.ndarray") == 0;
-}
+bool is_ndarray(PyObject* obj) { return std::strcmp(Py_TYPE(obj)->tp_name, "numpy.ndarray") == 0; }
 
 bool encode_ndarray(PyObject* obj, std::string* out, engine::DataPack* owner) {
   Py_buffer view;
@@ -165,8 +183,8 @@ bool encode(PyObject* obj, std::string* out, engine::DataPack* owner, int depth)
       if (!encode(items[i], out, owner, depth + 1)) return false;
   } else if (PyBytes_Check(obj) || PyByteArray_Check(obj)) {
     const char* p = PyBytes_Check(obj) ? PyBytes_AS_STRING(obj) : PyByteArray_AS_STRING(obj);
-    size_t n = static_cast<size_t>(PyBytes_Check(obj) ? PyBytes_GET_SIZE(obj)
-                                                      : PyByteArray_GET_SIZE(obj));
+    size_t n =
+        static_cast<size_t>(PyBytes_Check(obj) ? PyBytes_GET_SIZE(obj) : PyByteArray_GET_SIZE(obj));
     put_len(out, n, 0, 0, 0xc4, 0xc5, 0xc6);
     out->append(p, n);
   } else if (is_ndarray(obj)) {
@@ -178,8 +196,8 @@ bool encode(PyObject* obj, std::string* out, engine::DataPack* owner, int depth)
     Py_DECREF(item);
     return ok;
   } else if (PyObject_HasAttrString(obj, "keys") && PyObject_HasAttrString(obj, "__getitem__")) {
-    PyObject* d = PyObject_CallFunctionObjArgs(reinterpret_cast<PyObject*>(&PyDict_Type), obj,
-                                               nullptr);
+    PyObject* d =
+        PyObject_CallFunctionObjArgs(reinterpret_cast<PyObject*>(&PyDict_Type), obj, nullptr);
     if (!d) return false;
     bool ok = encode(d, out, owner, depth + 1);
     Py_DECREF(d);
@@ -205,15 +223,30 @@ class Decoder {
     if ((c & 0xf0) == 0x90) return array(c & 0x0f);
     if ((c & 0xe0) == 0xa0) return str(c & 0x1f);
     switch (c) {
-      case 0xc0: Py_RETURN_NONE;
-      case 0xc2: Py_RETURN_FALSE;
-      case 0xc3: Py_RETURN_TRUE;
-      case 0xc4: return bin(be(1));
-      case 0xc5: return bin(be(2));
-      case 0xc6: return bin(be(4));
-      case 0xc7: { size_t n = be(1); return ext(n); }
-      case 0xc8: { size_t n = be(2); return ext(n); }
-      case 0xc9: { size_t n = be(4); return ext(n); }
+      case 0xc0:
+        Py_RETURN_NONE;
+      case 0xc2:
+        Py_RETURN_FALSE;
+      case 0xc3:
+        Py_RETURN_TRUE;
+      case 0xc4:
+        return bin(be(1));
+      case 0xc5:
+        return bin(be(2));
+      case 0xc6:
+        return bin(be(4));
+      case 0xc7: {
+        size_t n = be(1);
+        return ext(n);
+      }
+      case 0xc8: {
+        size_t n = be(2);
+        return ext(n);
+      }
+      case 0xc9: {
+        size_t n = be(4);
+        return ext(n);
+      }
       case 0xca: {
         uint32_t bits = static_cast<uint32_t>(be(4));
         float f;
@@ -226,26 +259,46 @@ class Decoder {
         std::memcpy(&d, &bits, 8);
         return ok_ ? PyFloat_FromDouble(d) : nullptr;
       }
-      case 0xcc: return uint(be(1));
-      case 0xcd: return uint(be(2));
-      case 0xce: return uint(be(4));
-      case 0xcf: return uint(be(8));
-      case 0xd0: return sint(static_cast<int8_t>(be(1)));
-      case 0xd1: return sint(static_cast<int16_t>(be(2)));
-      case 0xd2: return sint(static_cast<int32_t>(be(4)));
-      case 0xd3: return sint(static_cast<int64_t>(be(8)));
-      case 0xd4: return ext(1);
-      case 0xd5: return ext(2);
-      case 0xd6: return ext(4);
-      case 0xd7: return ext(8);
-      case 0xd8: return ext(16);
-      case 0xd9: return str(be(1));
-      case 0xda: return str(be(2));
-      case 0xdb: return str(be(4));
-      case 0xdc: return array(be(2));
-      case 0xdd: return array(be(4));
-      case 0xde: return map(be(2));
-      case 0xdf: return map(be(4));
+      case 0xcc:
+        return uint(be(1));
+      case 0xcd:
+        return uint(be(2));
+      case 0xce:
+        return uint(be(4));
+      case 0xcf:
+        return uint(be(8));
+      case 0xd0:
+        return sint(static_cast<int8_t>(be(1)));
+      case 0xd1:
+        return sint(static_cast<int16_t>(be(2)));
+      case 0xd2:
+        return sint(static_cast<int32_t>(be(4)));
+      case 0xd3:
+        return sint(static_cast<int64_t>(be(8)));
+      case 0xd4:
+        return ext(1);
+      case 0xd5:
+        return ext(2);
+      case 0xd6:
+        return ext(4);
+      case 0xd7:
+        return ext(8);
+      case 0xd8:
+        return ext(16);
+      case 0xd9:
+        return str(be(1));
+      case 0xda:
+        return str(be(2));
+      case 0xdb:
+        return str(be(4));
+      case 0xdc:
+        return array(be(2));
+      case 0xdd:
+        return array(be(4));
+      case 0xde:
+        return map(be(2));
+      case 0xdf:
+        return map(be(4));
       default:
         return fail("unknown MessagePack type byte");
     }

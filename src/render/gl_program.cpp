@@ -1,5 +1,6 @@
 #include "render/gl_program.h"
 
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -73,7 +74,13 @@ vec3 kd;
 vec3 shade(int i, vec3 l, float gain) {
   float ndl = dot(n, l);
   float ndh = max(dot(n, normalize(l + to_eye)), 1e-6);
+#ifdef NOSPEC
+  float spec = 0.0;
+#elif defined(SCHLICK)
+  float spec = ndl > 0.0 ? ndh / (u_shininess - u_shininess * ndh + ndh) : 0.0;
+#else
   float spec = ndl > 0.0 ? pow(ndh, u_shininess) : 0.0;
+#endif
   return gain * (u_light_diffuse[i] * kd * max(ndl, 0.0) + u_light_specular[i] * u_specular.rgb * spec);
 }
 
@@ -86,6 +93,9 @@ float attenuation(int i, float dist) {
 vec3 directional(int i) { return shade(i, -u_light_direction[i].xyz, 1.0); }
 
 vec3 point(int i) {
+#ifdef NOPOINT
+  return vec3(0.0);
+#endif
   vec3 d = u_light_position[i] - v_position;
   float dist = length(d);
   return shade(i, d / dist, attenuation(i, dist));
@@ -102,6 +112,14 @@ vec3 spot(int i) {
 }
 
 void main() {
+#ifdef FLAT
+  out_color = u_diffuse;
+  return;
+#endif
+#ifdef NORMAL
+  out_color = vec4(normalize(v_normal) * u_diffuse.rgb, 1.0);
+  return;
+#endif
   n = normalize(v_normal);
   if (u_double_sided && !gl_FrontFacing) n = -n;
   to_eye = normalize(-v_position);
@@ -150,6 +168,7 @@ GLuint compile(GLenum stage, const std::string& source) {
 SurfaceProgram build_surface_program(const ProgramKey& key) {
   std::string header = "#version 300 es\n#define LIGHTS " + std::to_string(key.lights.size()) + "\n";
   if (key.textured) header += "#define TEXTURED\n";
+  if (getenv("DBG")) header += std::string("#define ") + getenv("DBG") + "\n";
   if (key.depth) header += "#define DEPTH\n";
   if (key.ids) header += "#define IDS\n";
   std::string body;

@@ -1,7 +1,5 @@
 #include "transport/frame_socket.h"
 
-#include "core/interrupt.h"
-
 #include <poll.h>
 #include <sched.h>
 #include <sys/socket.h>
@@ -11,6 +9,8 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+
+#include "core/interrupt.h"
 
 namespace convoy::transport {
 
@@ -60,8 +60,10 @@ size_t FrameSocket::read_some(char* dst, size_t n, Deadline deadline, RecvStatus
     ssize_t r = ::recv(fd_, dst, n, MSG_DONTWAIT);
     if (r > 0) return static_cast<size_t>(r);
     if (r < 0 && errno == EAGAIN && spin_until && now_ns() < spin_until) {
-      if (spin_yield_) sched_yield();
-      else __builtin_ia32_pause();
+      if (spin_yield_)
+        sched_yield();
+      else
+        __builtin_ia32_pause();
       continue;
     }
     if (r == 0) {
@@ -126,8 +128,8 @@ RecvStatus FrameSocket::recv(std::string* payload, Deadline deadline) {
       buffer_len_ = avail;
     }
     if (buffer_.size() < buffer_len_ + kChunk) buffer_.resize(buffer_len_ + kChunk);
-    size_t r = read_some(buffer_.data() + buffer_len_, buffer_.size() - buffer_len_, deadline,
-                         &status);
+    size_t r =
+        read_some(buffer_.data() + buffer_len_, buffer_.size() - buffer_len_, deadline, &status);
     if (r == 0) return status;
     buffer_len_ += r;
   }

@@ -97,8 +97,8 @@ std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Dea
   args.SetMaxReceiveMessageSize(-1);
   args.SetMaxSendMessageSize(-1);
   auto channel = grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args);
-  auto wait_until = deadline == Deadline::max() ? SteadyClock::now() + std::chrono::seconds(60)
-                                                : deadline;
+  auto wait_until =
+      deadline == Deadline::max() ? SteadyClock::now() + std::chrono::seconds(60) : deadline;
   if (!channel->WaitForConnected(std::chrono::system_clock::now() +
                                  (wait_until - SteadyClock::now()))) {
     return nullptr;

@@ -1,7 +1,7 @@
+#include <cstdlib>
+
 #include "transport/engine_channel.h"
 #include "transport/frame_socket.h"
-
-#include <cstdlib>
 
 namespace convoy::transport {
 namespace {

@@ -2,9 +2,8 @@
 // noise, update_rate in simulated time, ground-truth boxes.
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
-
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "camera_sensors.h"
 #include "convoy/datapacks.pb.h"
@@ -25,8 +24,9 @@ Image image_of(CameraSensors& cams, size_t i) {
   cams.image_datapack(i, &dp);
   data::Camera c;
   EXPECT_TRUE(c.ParseFromString(dp.proto().data()));
-  std::string bytes = c.image_blob() ? std::string(transport::current_blob_reader().get(dp, c.image_blob() - 1))
-                                     : c.image_data();
+  std::string bytes =
+      c.image_blob() ? std::string(transport::current_blob_reader().get(dp, c.image_blob() - 1))
+                     : c.image_data();
   return {static_cast<int>(c.image_width()), static_cast<int>(c.image_height()),
           static_cast<int>(c.image_depth()), bytes};
 }
@@ -76,7 +76,7 @@ TEST_F(CameraTest, MeasuredNoiseMatchesTheConfiguredStddev) {
   }
   double n = static_cast<double>(img.bytes.size());
   double mean = sum / n, stddev = std::sqrt(sum2 / n - mean * mean);
-  EXPECT_NEAR(mean / 255.0, 0.5, 0.01);         // the grey wall
+  EXPECT_NEAR(mean / 255.0, 0.5, 0.01);            // the grey wall
   EXPECT_NEAR(stddev / 255.0, 0.05, 0.05 * 0.05);  // within 5 % of 0.05
 }
 
@@ -96,9 +96,13 @@ TEST_F(CameraTest, CubeLandsWhereThePinholeModelPutsIt) {
   // cube: x 3.5..4.5, y -0.5..0.5, z -0.5..0.5 relative to the camera; its near face at x=3.5
   double fx = (320 / 2.0) / std::tan(1.2 / 2);
   double half_w = fx * 0.5 / 3.5, half_h = fx * 0.5 / 3.5;
-  int x_min = static_cast<int>(std::lround(160 - half_w)), x_max = static_cast<int>(std::lround(160 + half_w)) - 1;
-  int y_min = static_cast<int>(std::lround(120 - half_h)), y_max = static_cast<int>(std::lround(120 + half_h)) - 1;
-  auto red = [&](int x, int y) { return static_cast<unsigned char>(img.bytes[3 * (y * 320 + x)]) > 128; };
+  int x_min = static_cast<int>(std::lround(160 - half_w)),
+      x_max = static_cast<int>(std::lround(160 + half_w)) - 1;
+  int y_min = static_cast<int>(std::lround(120 - half_h)),
+      y_max = static_cast<int>(std::lround(120 + half_h)) - 1;
+  auto red = [&](int x, int y) {
+    return static_cast<unsigned char>(img.bytes[3 * (y * 320 + x)]) > 128;
+  };
   int rx_min = 320, rx_max = -1, ry_min = 240, ry_max = -1;
   for (int y = 0; y < 240; ++y)
     for (int x = 0; x < 320; ++x)

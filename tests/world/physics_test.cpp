@@ -56,7 +56,8 @@ TEST(Physics, PendulumPeriodMatchesTheAnalyticResult) {
     last = now;
   }
   ASSERT_GE(crossings.size(), 3u);
-  double period = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  double period =
+      (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
   double expected = 2 * M_PI * std::sqrt(1.0 / 9.81);
   EXPECT_NEAR(period, expected, 0.005 * expected);
 }
@@ -108,8 +109,8 @@ TEST(Physics, SameWorldGivesTheSameTrajectoryBitForBit) {
     PhysicsWorld p(load_world(kData + "/wheel_robot.sdf"));
     double w = 0;
     LinkState s = drive(p, 3.0, 2.0, &w);
-    return std::vector<double>{s.position.x(), s.position.y(), s.position.z(), s.rotation.w(),
-                               s.rotation.z(), w};
+    return std::vector<double>{s.position.x(), s.position.y(), s.position.z(),
+                               s.rotation.w(), s.rotation.z(), w};
   };
   EXPECT_EQ(run(), run());
 }
