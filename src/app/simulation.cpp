@@ -204,6 +204,12 @@ int run_simulation(const RunOptions& options) {
   if (cfg.datapack_processor != "tf")
     log.info("warning: DataPackProcessor " + cfg.datapack_processor +
              " is not available yet; running tf");
+  for (const char* key : {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT",
+                          "ComputationalGraph"}) {
+    if (cfg.json.contains(key) && !cfg.json[key].empty()) {
+      log.info(std::string("warning: ") + key + " is not supported yet; ignored");
+    }
+  }
 
   std::vector<std::unique_ptr<loop::EngineHandle>> engines;
   std::unique_ptr<loop::FtiLoop> fti;

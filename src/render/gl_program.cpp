@@ -1,6 +1,5 @@
 #include "render/gl_program.h"
 
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -8,43 +7,11 @@
 namespace convoy::render {
 namespace {
 
-const char* kVertexShader = R"(
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-uniform mat4 u_model_view;
-uniform mat3 u_normal_matrix;
-uniform mat4 u_projection;
-out vec3 v_position;  // eye space
-out vec3 v_normal;
-#ifdef TEXTURED
-layout(location = 2) in vec2 a_uv;
-out vec2 v_uv;
-#endif
-void main() {
-  vec4 p = u_model_view * vec4(a_position, 1.0);
-  v_position = p.xyz;
-  v_normal = u_normal_matrix * a_normal;
-#ifdef TEXTURED
-  v_uv = a_uv;
-#endif
-  gl_Position = u_projection * p;
-}
-)";
-
 // Light i (arrays of LIGHTS): position and direction in eye space, direction.w = range,
 // attenuation = (constant, linear, quadratic), spot = (cos(outer/2),
-// 1 / (cos(inner/2) - cos(outer/2)), falloff).
-const char* kFragmentHead = R"(
-precision highp float;
-in vec3 v_position;
-in vec3 v_normal;
-uniform vec4 u_diffuse;
-uniform vec4 u_ambient;
-uniform vec4 u_specular;
-uniform vec4 u_emissive;
-uniform float u_shininess;
-uniform bool u_double_sided;
-uniform vec3 u_scene_ambient;
+// 1 / (cos(inner/2) - cos(outer/2)), falloff). The functions add light i's diffuse and
+// specular irradiance at eye-space point p with unit normal n to g_diffuse and g_specular.
+const char* kLighting = R"(
 #if LIGHTS > 0
 uniform vec3 u_light_position[LIGHTS];
 uniform vec4 u_light_direction[LIGHTS];
@@ -52,6 +19,98 @@ uniform vec3 u_light_diffuse[LIGHTS];
 uniform vec3 u_light_specular[LIGHTS];
 uniform vec3 u_light_attenuation[LIGHTS];
 uniform vec3 u_light_spot[LIGHTS];
+uniform float u_shininess;
+vec3 g_diffuse = vec3(0.0);
+vec3 g_specular = vec3(0.0);
+
+void shade(int i, vec3 p, vec3 n, vec3 l, float gain) {
+  float ndl = dot(n, l);
+  float ndh = max(dot(n, normalize(l - normalize(p))), 1e-6);
+  float spec = ndl > 0.0 ? pow(ndh, u_shininess) : 0.0;
+  g_diffuse += (gain * max(ndl, 0.0)) * u_light_diffuse[i];
+  g_specular += (gain * spec) * u_light_specular[i];
+}
+
+float attenuation(int i, float dist) {
+  vec3 a = u_light_attenuation[i];
+  return dist > u_light_direction[i].w ? 0.0 : 1.0 / max(a.x + (a.y + a.z * dist) * dist, 1e-6);
+}
+
+void directional(int i, vec3 p, vec3 n) { shade(i, p, n, -u_light_direction[i].xyz, 1.0); }
+
+void point(int i, vec3 p, vec3 n) {
+  vec3 d = u_light_position[i] - p;
+  float dist = length(d);
+  shade(i, p, n, d / dist, attenuation(i, dist));
+}
+
+void spot(int i, vec3 p, vec3 n) {
+  vec3 d = u_light_position[i] - p;
+  float dist = length(d);
+  vec3 l = d / dist;
+  vec3 s = u_light_spot[i];
+  float rho = dot(-l, u_light_direction[i].xyz);
+  float cone = rho < s.x ? 0.0 : pow(clamp((rho - s.x) * s.y, 1e-6, 1.0), s.z);
+  shade(i, p, n, l, attenuation(i, dist) * cone);
+}
+#else
+const vec3 g_diffuse = vec3(0.0);
+const vec3 g_specular = vec3(0.0);
+#endif
+)";
+
+const char* kVertexShader = R"(
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_model_view;
+uniform mat3 u_normal_matrix;
+uniform mat4 u_projection;
+#ifdef TEXTURED
+layout(location = 2) in vec2 a_uv;
+out vec2 v_uv;
+#endif
+#ifdef PER_VERTEX
+uniform vec4 u_specular;
+out vec3 v_diffuse;   // light arriving, to be multiplied by the surface's diffuse colour
+out vec3 v_specular;  // specular light leaving
+#else
+out vec3 v_normal;
+#endif
+out vec3 v_position;  // eye space
+LIGHTING_CODE
+void main() {
+  vec4 p = u_model_view * vec4(a_position, 1.0);
+  v_position = p.xyz;
+  vec3 normal = u_normal_matrix * a_normal;
+#ifdef PER_VERTEX
+  vec3 n = normalize(normal);
+  LIGHT_CALLS
+  v_diffuse = g_diffuse;
+  v_specular = g_specular * u_specular.rgb;
+#else
+  v_normal = normal;
+#endif
+#ifdef TEXTURED
+  v_uv = a_uv;
+#endif
+  gl_Position = u_projection * p;
+}
+)";
+
+const char* kFragmentShader = R"(
+precision highp float;
+in vec3 v_position;
+uniform vec4 u_diffuse;
+uniform vec4 u_ambient;
+uniform vec4 u_emissive;
+uniform vec3 u_scene_ambient;
+#ifdef PER_VERTEX
+in vec3 v_diffuse;
+in vec3 v_specular;
+#else
+in vec3 v_normal;
+uniform vec4 u_specular;
+uniform bool u_double_sided;
 #endif
 #ifdef TEXTURED
 in vec2 v_uv;
@@ -65,74 +124,23 @@ layout(location = 1) out vec4 out_depth;
 uniform vec4 u_instance_id;
 layout(location = 2) out vec4 out_id;
 #endif
-
-vec3 n;
-vec3 to_eye;
-vec3 kd;
-
-// Diffuse plus Blinn-Phong specular of light i arriving along unit vector l with `gain`.
-vec3 shade(int i, vec3 l, float gain) {
-  float ndl = dot(n, l);
-  float ndh = max(dot(n, normalize(l + to_eye)), 1e-6);
-#ifdef NOSPEC
-  float spec = 0.0;
-#elif defined(SCHLICK)
-  float spec = ndl > 0.0 ? ndh / (u_shininess - u_shininess * ndh + ndh) : 0.0;
-#else
-  float spec = ndl > 0.0 ? pow(ndh, u_shininess) : 0.0;
-#endif
-  return gain * (u_light_diffuse[i] * kd * max(ndl, 0.0) + u_light_specular[i] * u_specular.rgb * spec);
-}
-
-// Attenuated gain of a point or spot light i at distance `dist`.
-float attenuation(int i, float dist) {
-  vec3 a = u_light_attenuation[i];
-  return dist > u_light_direction[i].w ? 0.0 : 1.0 / max(a.x + (a.y + a.z * dist) * dist, 1e-6);
-}
-
-vec3 directional(int i) { return shade(i, -u_light_direction[i].xyz, 1.0); }
-
-vec3 point(int i) {
-#ifdef NOPOINT
-  return vec3(0.0);
-#endif
-  vec3 d = u_light_position[i] - v_position;
-  float dist = length(d);
-  return shade(i, d / dist, attenuation(i, dist));
-}
-
-vec3 spot(int i) {
-  vec3 d = u_light_position[i] - v_position;
-  float dist = length(d);
-  vec3 l = d / dist;
-  vec3 s = u_light_spot[i];
-  float rho = dot(-l, u_light_direction[i].xyz);
-  float cone = rho < s.x ? 0.0 : pow(clamp((rho - s.x) * s.y, 1e-6, 1.0), s.z);
-  return shade(i, l, attenuation(i, dist) * cone);
-}
-
+LIGHTING_CODE
 void main() {
-#ifdef FLAT
-  out_color = u_diffuse;
-  return;
-#endif
-#ifdef NORMAL
-  out_color = vec4(normalize(v_normal) * u_diffuse.rgb, 1.0);
-  return;
-#endif
-  n = normalize(v_normal);
-  if (u_double_sided && !gl_FrontFacing) n = -n;
-  to_eye = normalize(-v_position);
 #ifdef TEXTURED
   vec3 tex = texture(u_texture, v_uv).rgb;
 #else
   vec3 tex = vec3(1.0);
 #endif
-  kd = u_diffuse.rgb * tex;
   vec3 color = u_emissive.rgb + u_scene_ambient * u_ambient.rgb * tex;
-)";
-
-const char* kFragmentTail = R"(
+#ifdef PER_VERTEX
+  color += v_diffuse * u_diffuse.rgb * tex + v_specular;
+#else
+  vec3 n = normalize(v_normal);
+  if (u_double_sided && !gl_FrontFacing) n = -n;
+  vec3 p = v_position;
+  LIGHT_CALLS
+  color += g_diffuse * u_diffuse.rgb * tex + g_specular * u_specular.rgb;
+#endif
   out_color = vec4(color, 1.0);
 #ifdef DEPTH
   out_depth = vec4(-v_position.z, 0.0, 0.0, 1.0);
@@ -142,6 +150,13 @@ const char* kFragmentTail = R"(
 #endif
 }
 )";
+
+std::string replace_all(std::string text, const std::string& from, const std::string& to) {
+  for (size_t at = 0; (at = text.find(from, at)) != std::string::npos; at += to.size()) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
 
 GLuint compile(GLenum stage, const std::string& source) {
   GLuint shader = glCreateShader(stage);
@@ -168,24 +183,23 @@ GLuint compile(GLenum stage, const std::string& source) {
 SurfaceProgram build_surface_program(const ProgramKey& key) {
   std::string header = "#version 300 es\n#define LIGHTS " + std::to_string(key.lights.size()) + "\n";
   if (key.textured) header += "#define TEXTURED\n";
-  if (getenv("DBG")) header += std::string("#define ") + getenv("DBG") + "\n";
   if (key.depth) header += "#define DEPTH\n";
   if (key.ids) header += "#define IDS\n";
-  std::string body;
+  if (key.per_vertex) header += "#define PER_VERTEX\n";
+  std::string calls;
   for (size_t i = 0; i < key.lights.size(); ++i) {
     const char* f = key.lights[i] == 'D' ? "directional" : key.lights[i] == 'P' ? "point" : "spot";
-    body += "  color += " + std::string(f) + "(" + std::to_string(i) + ");\n";
+    calls += std::string(f) + "(" + std::to_string(i) + ", p.xyz, n);\n  ";
   }
-  // Without lights the helper functions would index empty arrays: leave them out.
-  std::string head = kFragmentHead;
-  if (key.lights.empty()) {
-    const size_t from = head.find("// Diffuse plus"), to = head.find("void main()");
-    head.erase(from, to - from);
-  }
-  const GLuint vs = compile(GL_VERTEX_SHADER, header + kVertexShader);
+  // The lighting code goes into the stage that lights.
+  auto stage = [&](const char* source, bool lights_here) {
+    std::string s = replace_all(source, "LIGHTING_CODE", lights_here ? kLighting : "");
+    return header + replace_all(s, "LIGHT_CALLS", lights_here ? calls : "");
+  };
+  const GLuint vs = compile(GL_VERTEX_SHADER, stage(kVertexShader, key.per_vertex));
   GLuint fs = 0;
   try {
-    fs = compile(GL_FRAGMENT_SHADER, header + head + body + kFragmentTail);
+    fs = compile(GL_FRAGMENT_SHADER, stage(kFragmentShader, !key.per_vertex));
   } catch (...) {
     glDeleteShader(vs);
     throw;

@@ -4,9 +4,12 @@
 // each combination of lights, texturing and outputs gets its own program with only the code
 // it needs: lights unrolled by type, no texture lookup without a texture.
 //
+// Lighting is computed in eye space, per pixel; or per vertex for meshes whose triangles
+// cover only a few pixels each, where it looks the same: there a software rasteriser would
+// otherwise shade every tiny triangle's whole 4x4 block, which costs half the frame.
+//
 // Outputs: location 0 the lit colour (RGBA8), location 1 the distance along the optical axis
 // in metres (R32F, with depth), location 2 the instance id as RGBA8 bytes (with ids).
-// Lighting is computed per pixel in eye space.
 #pragma once
 
 #include <GLES3/gl3.h>
@@ -20,6 +23,7 @@ struct ProgramKey {
   bool textured = false;
   bool depth = false;
   bool ids = false;
+  bool per_vertex = false;  // lighting in the vertex shader
 
   auto operator<=>(const ProgramKey&) const = default;
 };

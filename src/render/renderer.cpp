@@ -60,8 +60,8 @@ void check_spec(const CameraSpec& s) {
 }
 
 struct Draw {
-  bool textured;    // draws are grouped by program,
-  double distance;  // then go front to back (by their bounding sphere's centre)
+  bool textured, per_vertex;  // draws are grouped by program,
+  double distance;            // then go front to back (by their bounding sphere's centre)
   int instance;
   glm::mat4 model_view;
   glm::mat3 normal_matrix;
@@ -85,6 +85,7 @@ struct Renderer::Impl {
   uint64_t frame_number = 0;
   std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
+  double per_vertex_below = Renderer::kPerVertexLightingBelow;
   RenderStats stats;
   // Reused from frame to frame.
   std::vector<Draw> draws;
@@ -153,6 +154,7 @@ void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene&
 void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
                                    const CameraSpec& spec) {
   const double tx = std::tan(spec.hfov / 2), ty = tx * spec.height / spec.width;
+  const double focal_px = spec.width / 2.0 / tx;
   const double nx = std::sqrt(1 + tx * tx), ny = std::sqrt(1 + ty * ty);
   draws.clear();
   const auto& instances = scene.instances();
@@ -169,17 +171,25 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
     if (c.z - r > -spec.near_clip || -c.z - r > spec.far_clip) continue;
     if ((std::abs(c.x) + c.z * tx) / nx > r || (std::abs(c.y) + c.z * ty) / ny > r) continue;
     const glm::dmat3 normal = glm::transpose(glm::inverse(glm::dmat3(mv)));
-    draws.push_back(Draw{inst.material.texture >= 0, -c.z, i, glm::mat4(mv), glm::mat3(normal)});
+    // Light per vertex where triangles are small on screen (see gl_program.h).
+    const double radius_px = r * focal_px / std::max(-c.z, 1e-9);
+    const double px_per_triangle = std::numbers::pi * radius_px * radius_px /
+                                   (0.5 * scene.meshes()[inst.mesh].triangle_count());
+    const bool per_vertex = -c.z > r && !inst.material.double_sided &&
+                            px_per_triangle < per_vertex_below;
+    draws.push_back(Draw{inst.material.texture >= 0, per_vertex, -c.z, i, glm::mat4(mv),
+                         glm::mat3(normal)});
   }
   std::sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) {
     if (a.textured != b.textured) return b.textured;
+    if (a.per_vertex != b.per_vertex) return b.per_vertex;
     return a.distance != b.distance ? a.distance < b.distance : a.instance < b.instance;
   });
 }
 
 void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& view,
                           const CameraSpec& spec, const GpuScene& gpu) {
-  stats = RenderStats{static_cast<int>(draws.size()), 0};
+  stats = RenderStats{static_cast<int>(draws.size()), 0, 0};
   ++frame_number;
   const SurfaceProgram* program = nullptr;
   int bound_mesh = -1;
@@ -188,8 +198,9 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
   const Material* last = nullptr;
   for (const Draw& d : draws) {
     const Scene::Instance& inst = scene.instances()[d.instance];
-    if (!program || d.textured != key.textured) {
+    if (!program || d.textured != key.textured || d.per_vertex != key.per_vertex) {
       key.textured = d.textured;
+      key.per_vertex = d.per_vertex;
       program = &this->program(key);
       glUseProgram(program->id);
       if (program_frame[program->id] != frame_number) {
@@ -231,6 +242,11 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
     }
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
     stats.triangles_drawn += mesh.index_count / 3;
+    static const size_t flush_every = getenv("FLUSH_TRIS") ? atol(getenv("FLUSH_TRIS")) : 0;
+    static size_t since = 0;
+    since += mesh.index_count / 3;
+    if (flush_every && since >= flush_every) { glFlush(); since = 0; }
+    stats.per_vertex_lit += d.per_vertex;
   }
   glBindVertexArray(0);
   if (!culling) glEnable(GL_CULL_FACE);
@@ -289,6 +305,10 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
 Renderer::~Renderer() = default;
 
 const RenderStats& Renderer::last_stats() const { return impl_->stats; }
+
+void Renderer::set_per_vertex_lighting_below(double pixels_per_triangle) {
+  impl_->per_vertex_below = pixels_per_triangle;
+}
 
 const std::string& Renderer::description() const { return impl_->context.description(); }
 
