@@ -98,8 +98,8 @@ EglContext::EglContext() {
 
   bool ok = false;
   if (has_extension(client, "EGL_MESA_platform_surfaceless")) {
-    ok = attempt("surfaceless",
-                 eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
+    ok = attempt("surfaceless", eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA,
+                                                      EGL_DEFAULT_DISPLAY, nullptr));
   } else {
     failures += "\n  surfaceless: EGL_MESA_platform_surfaceless not offered";
   }
@@ -110,8 +110,7 @@ EglContext::EglContext() {
     std::vector<EGLDeviceEXT> devices(16);
     if (query_devices && query_devices(16, devices.data(), &count)) {
       for (EGLint i = 0; i < count && !ok; ++i) {
-        ok = attempt("device",
-                     eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr));
+        ok = attempt("device", eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr));
       }
     }
   }
@@ -122,8 +121,8 @@ EglContext::EglContext() {
   }
   const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
   const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  description_ = std::string(version ? version : "?") + ", " + (renderer ? renderer : "?") +
-                 ", " + description_;
+  description_ = std::string(version ? version : "?") + ", " + (renderer ? renderer : "?") + ", " +
+                 description_;
   int gl_major = 0;
   if (version) std::sscanf(version, "OpenGL ES %d", &gl_major);
   if (gl_major < 3) {

@@ -25,10 +25,12 @@ vec3 g_specular = vec3(0.0);
 
 void shade(int i, vec3 p, vec3 n, vec3 l, float gain) {
   float ndl = dot(n, l);
+  g_diffuse += (gain * max(ndl, 0.0)) * u_light_diffuse[i];
+#ifdef SPECULAR
   float ndh = max(dot(n, normalize(l - normalize(p))), 1e-6);
   float spec = ndl > 0.0 ? pow(ndh, u_shininess) : 0.0;
-  g_diffuse += (gain * max(ndl, 0.0)) * u_light_diffuse[i];
   g_specular += (gain * spec) * u_light_specular[i];
+#endif
 }
 
 float attenuation(int i, float dist) {
@@ -70,23 +72,39 @@ layout(location = 2) in vec2 a_uv;
 out vec2 v_uv;
 #endif
 #ifdef PER_VERTEX
+uniform vec4 u_diffuse;
+uniform vec4 u_ambient;
 uniform vec4 u_specular;
-out vec3 v_diffuse;   // light arriving, to be multiplied by the surface's diffuse colour
-out vec3 v_specular;  // specular light leaving
+uniform vec4 u_emissive;
+uniform vec3 u_scene_ambient;
+out vec3 v_color;  // the lit colour; times the texture's where textured,
+#ifdef TEXTURED
+out vec3 v_added;  // plus this
+#endif
 #else
 out vec3 v_normal;
 #endif
+#if defined(DEPTH) || !defined(PER_VERTEX)
 out vec3 v_position;  // eye space
+#endif
 LIGHTING_CODE
 void main() {
   vec4 p = u_model_view * vec4(a_position, 1.0);
+#if defined(DEPTH) || !defined(PER_VERTEX)
   v_position = p.xyz;
+#endif
   vec3 normal = u_normal_matrix * a_normal;
 #ifdef PER_VERTEX
   vec3 n = normalize(normal);
   LIGHT_CALLS
-  v_diffuse = g_diffuse;
-  v_specular = g_specular * u_specular.rgb;
+  vec3 modulated = u_scene_ambient * u_ambient.rgb + g_diffuse * u_diffuse.rgb;
+  vec3 added = u_emissive.rgb + g_specular * u_specular.rgb;
+#ifdef TEXTURED
+  v_color = modulated;
+  v_added = added;
+#else
+  v_color = modulated + added;
+#endif
 #else
   v_normal = normal;
 #endif
@@ -99,17 +117,22 @@ void main() {
 
 const char* kFragmentShader = R"(
 precision highp float;
+#ifdef PER_VERTEX
+in vec3 v_color;
+#ifdef TEXTURED
+in vec3 v_added;
+#endif
+#ifdef DEPTH
 in vec3 v_position;
+#endif
+#else
+in vec3 v_position;
+in vec3 v_normal;
 uniform vec4 u_diffuse;
 uniform vec4 u_ambient;
+uniform vec4 u_specular;
 uniform vec4 u_emissive;
 uniform vec3 u_scene_ambient;
-#ifdef PER_VERTEX
-in vec3 v_diffuse;
-in vec3 v_specular;
-#else
-in vec3 v_normal;
-uniform vec4 u_specular;
 uniform bool u_double_sided;
 #endif
 #ifdef TEXTURED
@@ -131,10 +154,14 @@ void main() {
 #else
   vec3 tex = vec3(1.0);
 #endif
-  vec3 color = u_emissive.rgb + u_scene_ambient * u_ambient.rgb * tex;
 #ifdef PER_VERTEX
-  color += v_diffuse * u_diffuse.rgb * tex + v_specular;
+#ifdef TEXTURED
+  vec3 color = v_color * tex + v_added;
 #else
+  vec3 color = v_color;
+#endif
+#else
+  vec3 color = u_emissive.rgb + u_scene_ambient * u_ambient.rgb * tex;
   vec3 n = normalize(v_normal);
   if (u_double_sided && !gl_FrontFacing) n = -n;
   vec3 p = v_position;
@@ -181,11 +208,13 @@ GLuint compile(GLenum stage, const std::string& source) {
 }  // namespace
 
 SurfaceProgram build_surface_program(const ProgramKey& key) {
-  std::string header = "#version 300 es\n#define LIGHTS " + std::to_string(key.lights.size()) + "\n";
+  std::string header =
+      "#version 300 es\n#define LIGHTS " + std::to_string(key.lights.size()) + "\n";
   if (key.textured) header += "#define TEXTURED\n";
   if (key.depth) header += "#define DEPTH\n";
   if (key.ids) header += "#define IDS\n";
   if (key.per_vertex) header += "#define PER_VERTEX\n";
+  if (key.specular) header += "#define SPECULAR\n";
   std::string calls;
   for (size_t i = 0; i < key.lights.size(); ++i) {
     const char* f = key.lights[i] == 'D' ? "directional" : key.lights[i] == 'P' ? "point" : "spot";

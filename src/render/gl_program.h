@@ -24,6 +24,7 @@ struct ProgramKey {
   bool depth = false;
   bool ids = false;
   bool per_vertex = false;  // lighting in the vertex shader
+  bool specular = true;     // false: the material has no specular colour (no highlights to compute)
 
   auto operator<=>(const ProgramKey&) const = default;
 };

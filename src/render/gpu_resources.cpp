@@ -30,8 +30,8 @@ GpuMesh upload_mesh(const MeshData& mesh) {
                GL_STATIC_DRAW);
   glGenBuffers(1, &g.ibo);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ibo);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, mesh.indices.size() * sizeof(uint32_t),
-               mesh.indices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, mesh.indices.size() * sizeof(uint32_t), mesh.indices.data(),
+               GL_STATIC_DRAW);
   const GLsizei stride = kFloatsPerVertex * sizeof(float);
   const GLint sizes[3] = {3, 3, 2};
   const size_t offsets[3] = {0, 3 * sizeof(float), 6 * sizeof(float)};
@@ -96,9 +96,9 @@ const GpuScene& GpuSceneCache::sync(const Scene& scene) {
                          [&](const auto& s) { return s->uid == scene.uid(); });
   if (it == scenes_.end()) {
     if (scenes_.size() >= kMaxScenes) {
-      auto oldest = std::min_element(scenes_.begin(), scenes_.end(), [](const auto& a, const auto& b) {
-        return a->last_use < b->last_use;
-      });
+      auto oldest =
+          std::min_element(scenes_.begin(), scenes_.end(),
+                           [](const auto& a, const auto& b) { return a->last_use < b->last_use; });
       release(oldest->get());
       scenes_.erase(oldest);
     }

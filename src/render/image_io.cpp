@@ -86,7 +86,8 @@ bool decode_jpeg(FILE* file, Image* image, JpegError* err) {
   image->channels = 4;
   image->data.resize(static_cast<size_t>(image->width) * image->height * 4);
   while (info.output_scanline < info.output_height) {
-    JSAMPROW row = image->data.data() + static_cast<size_t>(info.output_scanline) * image->width * 4;
+    JSAMPROW row =
+        image->data.data() + static_cast<size_t>(info.output_scanline) * image->width * 4;
     jpeg_read_scanlines(&info, &row, 1);
   }
   jpeg_finish_decompress(&info);
@@ -98,7 +99,8 @@ Image load_jpeg(const std::string& path) {
   File f = open_file(path, "rb");
   Image image;
   JpegError err;
-  if (!decode_jpeg(f.get(), &image, &err)) fail(path, std::string("cannot decode JPEG: ") + err.message);
+  if (!decode_jpeg(f.get(), &image, &err))
+    fail(path, std::string("cannot decode JPEG: ") + err.message);
   return image;
 }
 #endif

@@ -12,7 +12,7 @@ namespace convoy::render {
 
 struct Image {
   int width = 0, height = 0, channels = 0;  // channels: 4 from load_image_rgba, 3 from read_ppm
-  std::vector<uint8_t> data;                 // height x width x channels, row 0 = top
+  std::vector<uint8_t> data;                // height x width x channels, row 0 = top
 };
 
 // Loads a PNG or JPEG file (told apart by its signature) as 8-bit RGBA. Throws

@@ -187,8 +187,7 @@ void validate_mesh(const MeshData& mesh, const char* what) {
          std::to_string(3 * n));
   }
   if (!mesh.uvs.empty() && mesh.uvs.size() != 2 * n) {
-    fail("uvs.size() = " + std::to_string(mesh.uvs.size()) + ", expected " +
-         std::to_string(2 * n));
+    fail("uvs.size() = " + std::to_string(mesh.uvs.size()) + ", expected " + std::to_string(2 * n));
   }
   if (mesh.indices.size() % 3 != 0) fail("indices.size() is not a multiple of 3");
   for (uint32_t i : mesh.indices) {

@@ -1,9 +1,10 @@
 #include "render/mesh_loader.h"
 
-#include <algorithm>
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -63,9 +64,9 @@ LoadedMesh convert(const aiMesh* in, const aiMaterial* material, const fs::path&
       const double nx = q.x / scale[0], ny = q.y / scale[1], nz = q.z / scale[2];
       const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
       if (len > 0) {
-        m.normals.insert(m.normals.end(), {static_cast<float>(nx / len),
-                                           static_cast<float>(ny / len),
-                                           static_cast<float>(nz / len)});
+        m.normals.insert(m.normals.end(),
+                         {static_cast<float>(nx / len), static_cast<float>(ny / len),
+                          static_cast<float>(nz / len)});
       } else {
         m.normals.insert(m.normals.end(), {0.0f, 0.0f, 1.0f});
       }
@@ -128,11 +129,12 @@ std::vector<LoadedMesh> load_mesh(const std::string& path, const std::array<floa
   }
 
   Assimp::Importer importer;
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals |
-                aiProcess_PreTransformVertices | aiProcess_SortByPType |
-                aiProcess_ValidateDataStructure);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
+                                  aiProcess_SortByPType | aiProcess_ValidateDataStructure);
   if (!scene || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || scene->mNumMeshes == 0) {
     const std::string why = importer.GetErrorString();
     fail(path, why.empty() ? "no triangle meshes in the file" : why);
@@ -144,9 +146,9 @@ std::vector<LoadedMesh> load_mesh(const std::string& path, const std::array<floa
   std::vector<LoadedMesh> parts;
   for (unsigned i = 0; i < scene->mNumMeshes; ++i) {
     const aiMesh* mesh = scene->mMeshes[i];
-    const aiMaterial* material =
-        mesh->mMaterialIndex < scene->mNumMaterials ? scene->mMaterials[mesh->mMaterialIndex]
-                                                    : nullptr;
+    const aiMaterial* material = mesh->mMaterialIndex < scene->mNumMaterials
+                                     ? scene->mMaterials[mesh->mMaterialIndex]
+                                     : nullptr;
     LoadedMesh part = convert(mesh, material, folder, y_up_to_z_up, scale);
     if (!part.mesh.indices.empty()) parts.push_back(std::move(part));
   }

@@ -20,7 +20,7 @@ struct LoadedMesh {
   // The file's material for this part (Material's defaults where the file says nothing).
   Rgba diffuse{0.7f, 0.7f, 0.7f, 1.0f};
   Rgba ambient{0.7f, 0.7f, 0.7f, 1.0f};
-  Rgba specular{0.1f, 0.1f, 0.1f, 1.0f};
+  Rgba specular{0.0f, 0.0f, 0.0f, 1.0f};
   Rgba emissive{0.0f, 0.0f, 0.0f, 0.0f};
   float shininess = 32.0f;
   // The diffuse texture's file, resolved against the mesh file's folder; empty if none.

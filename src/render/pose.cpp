@@ -31,8 +31,8 @@ Pose make_pose(double x, double y, double z, double roll, double pitch, double y
 }
 
 Pose make_pose_quat(const std::array<double, 3>& xyz, const std::array<double, 4>& wxyz) {
-  const double n = std::sqrt(wxyz[0] * wxyz[0] + wxyz[1] * wxyz[1] + wxyz[2] * wxyz[2] +
-                             wxyz[3] * wxyz[3]);
+  const double n =
+      std::sqrt(wxyz[0] * wxyz[0] + wxyz[1] * wxyz[1] + wxyz[2] * wxyz[2] + wxyz[3] * wxyz[3]);
   if (!(n > 0) || !std::isfinite(n)) {
     throw std::invalid_argument("make_pose_quat: quaternion has no direction");
   }

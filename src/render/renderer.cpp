@@ -49,30 +49,46 @@ void check_spec(const CameraSpec& s) {
     throw std::invalid_argument("Renderer::render: CameraSpec " + why);
   };
   if (s.width <= 0 || s.height <= 0) {
-    fail("size must be positive, got " + std::to_string(s.width) + "x" +
-         std::to_string(s.height));
+    fail("size must be positive, got " + std::to_string(s.width) + "x" + std::to_string(s.height));
   }
-  if (!(s.hfov > 0 && s.hfov < std::numbers::pi)) fail("hfov must be in (0, pi), got " + std::to_string(s.hfov));
+  if (!(s.hfov > 0 && s.hfov < std::numbers::pi))
+    fail("hfov must be in (0, pi), got " + std::to_string(s.hfov));
   if (!(s.near_clip > 0 && s.far_clip > s.near_clip && std::isfinite(s.far_clip))) {
     fail("clip must satisfy 0 < near < far, got near " + std::to_string(s.near_clip) + ", far " +
          std::to_string(s.far_clip));
   }
 }
 
+// Triangles submitted between two glFlush calls (see Impl::draw).
+constexpr size_t kFlushEveryTriangles = 16384;
+
+// Bits of Draw::variant: which program draws it.
+constexpr unsigned kTextured = 1, kPerVertex = 2, kSpecular = 4;
+
 struct Draw {
-  bool textured, per_vertex;  // draws are grouped by program,
-  double distance;            // then go front to back (by their bounding sphere's centre)
+  // Order: things around the camera (ground, walls) after the rest, so that what stands in
+  // front of them hides their pixels before they are shaded; then by program; then front to
+  // back by bounding sphere's centre.
+  bool surrounds_camera;
+  unsigned variant;
+  double distance;
   int instance;
   glm::mat4 model_view;
   glm::mat3 normal_matrix;
 };
 
+// Drops the alpha bytes, four pixels (16 bytes in, 12 out) at a time.
 void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels) {
-  for (size_t i = 0; i < pixels; ++i) {
-    dst[3 * i] = src[4 * i];
-    dst[3 * i + 1] = src[4 * i + 1];
-    dst[3 * i + 2] = src[4 * i + 2];
+  size_t i = 0;
+  for (; i + 4 <= pixels; i += 4) {
+    uint32_t p[4], q[3];
+    std::memcpy(p, src + 4 * i, 16);
+    q[0] = (p[0] & 0xffffff) | (p[1] << 24);
+    q[1] = ((p[1] >> 8) & 0xffff) | (p[2] << 16);
+    q[2] = ((p[2] >> 16) & 0xff) | (p[3] << 8);
+    std::memcpy(dst + 3 * i, q, 12);
   }
+  for (; i < pixels; ++i) std::memcpy(dst + 3 * i, src + 4 * i, 3);
 }
 
 }  // namespace
@@ -155,6 +171,10 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
                                    const CameraSpec& spec) {
   const double tx = std::tan(spec.hfov / 2), ty = tx * spec.height / spec.width;
   const double focal_px = spec.width / 2.0 / tx;
+  bool lights_have_specular = false;
+  for (const Light& l : scene.lights()) {
+    lights_have_specular |= l.specular[0] > 0 || l.specular[1] > 0 || l.specular[2] > 0;
+  }
   const double nx = std::sqrt(1 + tx * tx), ny = std::sqrt(1 + ty * ty);
   draws.clear();
   const auto& instances = scene.instances();
@@ -175,14 +195,17 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
     const double radius_px = r * focal_px / std::max(-c.z, 1e-9);
     const double px_per_triangle = std::numbers::pi * radius_px * radius_px /
                                    (0.5 * scene.meshes()[inst.mesh].triangle_count());
-    const bool per_vertex = -c.z > r && !inst.material.double_sided &&
-                            px_per_triangle < per_vertex_below;
-    draws.push_back(Draw{inst.material.texture >= 0, per_vertex, -c.z, i, glm::mat4(mv),
-                         glm::mat3(normal)});
+    const bool per_vertex =
+        -c.z > r && !inst.material.double_sided && px_per_triangle < per_vertex_below;
+    const auto& ks = inst.material.specular;
+    const bool specular = lights_have_specular && (ks[0] > 0 || ks[1] > 0 || ks[2] > 0);
+    const unsigned variant = (inst.material.texture >= 0 ? kTextured : 0) |
+                             (per_vertex ? kPerVertex : 0) | (specular ? kSpecular : 0);
+    draws.push_back(Draw{glm::length(c) < r, variant, -c.z, i, glm::mat4(mv), glm::mat3(normal)});
   }
   std::sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) {
-    if (a.textured != b.textured) return b.textured;
-    if (a.per_vertex != b.per_vertex) return b.per_vertex;
+    if (a.surrounds_camera != b.surrounds_camera) return b.surrounds_camera;
+    if (a.variant != b.variant) return a.variant < b.variant;
     return a.distance != b.distance ? a.distance < b.distance : a.instance < b.instance;
   });
 }
@@ -192,15 +215,19 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
   stats = RenderStats{static_cast<int>(draws.size()), 0, 0};
   ++frame_number;
   const SurfaceProgram* program = nullptr;
+  unsigned variant = 0;
   int bound_mesh = -1;
   GLuint bound_texture = 0;
   bool culling = true;
   const Material* last = nullptr;
+  size_t triangles_queued = 0;
   for (const Draw& d : draws) {
     const Scene::Instance& inst = scene.instances()[d.instance];
-    if (!program || d.textured != key.textured || d.per_vertex != key.per_vertex) {
-      key.textured = d.textured;
-      key.per_vertex = d.per_vertex;
+    if (!program || d.variant != variant) {
+      variant = d.variant;
+      key.textured = variant & kTextured;
+      key.per_vertex = variant & kPerVertex;
+      key.specular = variant & kSpecular;
       program = &this->program(key);
       glUseProgram(program->id);
       if (program_frame[program->id] != frame_number) {
@@ -242,11 +269,14 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
     }
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
     stats.triangles_drawn += mesh.index_count / 3;
-    static const size_t flush_every = getenv("FLUSH_TRIS") ? atol(getenv("FLUSH_TRIS")) : 0;
-    static size_t since = 0;
-    since += mesh.index_count / 3;
-    if (flush_every && since >= flush_every) { glFlush(); since = 0; }
-    stats.per_vertex_lit += d.per_vertex;
+    // Hand what is queued to the rasteriser threads every so often: llvmpipe rasterises a
+    // batch while this thread prepares the next, instead of waiting for the whole frame.
+    triangles_queued += mesh.index_count / 3;
+    if (triangles_queued >= kFlushEveryTriangles) {
+      glFlush();
+      triangles_queued = 0;
+    }
+    stats.per_vertex_lit += (d.variant & kPerVertex) != 0;
   }
   glBindVertexArray(0);
   if (!culling) glEnable(GL_CULL_FACE);
@@ -356,8 +386,7 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   if (want_boxes) glClearBufferfv(GL_COLOR, 2, zero);
   glClearBufferfv(GL_DEPTH, 0, &far_depth);
 
-  const glm::dmat4 view =
-      glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
+  const glm::dmat4 view = glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
   glActiveTexture(GL_TEXTURE0);
   s.collect_draws(scene, view, spec);
   s.draw(key, scene, view, spec, gpu);

@@ -39,7 +39,7 @@ struct CameraSpec {
 // outside the image). Instances sharing a model_id make one box.
 struct BoundingBox {
   uint32_t model_id;
-  uint32_t class_id;  // that of the model's first instance (lowest index)
+  uint32_t class_id;               // that of the model's first instance (lowest index)
   int x_min, y_min, x_max, y_max;  // inclusive pixel coordinates, y = 0 the top row
   uint32_t pixel_count;            // visible pixels
 };
@@ -79,8 +79,8 @@ class Renderer {
   // reusing its buffers. The first render of a Scene uploads its meshes and textures; later
   // renders upload only what was added since. Throws std::invalid_argument for a bad spec and
   // std::runtime_error on a GPU error.
-  void render(const Scene& scene, const Pose& camera_world_pose, const CameraSpec& spec,
-              Frame* out, bool want_depth = false, bool want_boxes = false);
+  void render(const Scene& scene, const Pose& camera_world_pose, const CameraSpec& spec, Frame* out,
+              bool want_depth = false, bool want_boxes = false);
 
   // Lighting is per pixel, except for an instance whose triangles cover on average fewer than
   // this many pixels (estimated from its bounding sphere): there it is computed per vertex,

@@ -30,10 +30,10 @@ using Rgba = std::array<float, 4>;
 struct Material {
   Rgba diffuse{0.7f, 0.7f, 0.7f, 1.0f};
   Rgba ambient{0.7f, 0.7f, 0.7f, 1.0f};   // multiplied by the scene's ambient light
-  Rgba specular{0.1f, 0.1f, 0.1f, 1.0f};
+  Rgba specular{0.0f, 0.0f, 0.0f, 1.0f};  // SDF's default: no highlights
   Rgba emissive{0.0f, 0.0f, 0.0f, 0.0f};  // added as is
-  float shininess = 32.0f;                 // Blinn-Phong exponent
-  int texture = -1;          // Scene::add_texture index; it multiplies diffuse and ambient
+  float shininess = 32.0f;                // Blinn-Phong exponent
+  int texture = -1;           // Scene::add_texture index; it multiplies diffuse and ambient
   bool double_sided = false;  // draw back faces too (lit with the flipped normal)
 
   bool operator==(const Material&) const = default;

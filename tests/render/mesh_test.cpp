@@ -1,0 +1,253 @@
+// Tests of the renderer's CPU side: primitive shapes, poses, mesh files, image files.
+// No OpenGL needed.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "render/image_io.h"
+#include "render/mesh_loader.h"
+#include "render/scene.h"
+
+namespace convoy::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+class MeshFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("convoy_mesh_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  fs::path dir_;
+};
+
+std::array<float, 3> min_corner(const MeshData& m) {
+  std::array<float, 3> lo{1e30f, 1e30f, 1e30f};
+  for (size_t i = 0; i < m.positions.size(); ++i) lo[i % 3] = std::min(lo[i % 3], m.positions[i]);
+  return lo;
+}
+
+std::array<float, 3> max_corner(const MeshData& m) {
+  std::array<float, 3> hi{-1e30f, -1e30f, -1e30f};
+  for (size_t i = 0; i < m.positions.size(); ++i) hi[i % 3] = std::max(hi[i % 3], m.positions[i]);
+  return hi;
+}
+
+// Every triangle's winding agrees with its vertices' normals (faces point outwards).
+void expect_outward_winding(const MeshData& m) {
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const float* a = &m.positions[3 * m.indices[t]];
+    const float* b = &m.positions[3 * m.indices[t + 1]];
+    const float* c = &m.positions[3 * m.indices[t + 2]];
+    const float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const float e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                        e1[0] * e2[1] - e1[1] * e2[0]};
+    const float* vn = &m.normals[3 * m.indices[t]];
+    ASSERT_GT(n[0] * vn[0] + n[1] * vn[1] + n[2] * vn[2], 0) << "triangle " << t / 3;
+  }
+}
+
+TEST(PrimitivesTest, ShapesHaveTheirSizesAndFaceOutwards) {
+  const MeshData box = make_box(1, 2, 3);
+  EXPECT_EQ(box.triangle_count(), 12u);
+  EXPECT_EQ(min_corner(box), (std::array<float, 3>{-0.5f, -1, -1.5f}));
+  EXPECT_EQ(max_corner(box), (std::array<float, 3>{0.5f, 1, 1.5f}));
+  expect_outward_winding(box);
+
+  const MeshData cyl = make_cylinder(0.5f, 2, 16);
+  EXPECT_EQ(cyl.triangle_count(), 4u * 16);
+  EXPECT_NEAR(max_corner(cyl)[2], 1, 1e-6);
+  EXPECT_NEAR(max_corner(cyl)[0], 0.5, 1e-6);
+  expect_outward_winding(cyl);
+
+  const MeshData sphere = make_sphere(2, 8, 12);
+  EXPECT_EQ(sphere.triangle_count(), 2u * 12 * 7);
+  for (size_t i = 0; i < sphere.positions.size(); i += 3) {
+    EXPECT_NEAR(std::hypot(sphere.positions[i], sphere.positions[i + 1], sphere.positions[i + 2]),
+                2, 1e-5);
+  }
+  expect_outward_winding(sphere);
+
+  const MeshData plane = make_plane(4, 2);
+  EXPECT_EQ(plane.triangle_count(), 2u);
+  EXPECT_EQ(plane.normals[2], 1);
+  expect_outward_winding(plane);
+
+  EXPECT_THROW(make_box(0, 1, 1), std::invalid_argument);
+  EXPECT_THROW(make_sphere(1, 1, 3), std::invalid_argument);
+}
+
+TEST(PrimitivesTest, SceneComputesMissingNormalsAndRejectsBadMeshes) {
+  MeshData tri;
+  tri.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  tri.indices = {0, 1, 2};
+  Scene scene;
+  scene.add_mesh(tri);
+  EXPECT_EQ(scene.meshes()[0].normals, (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}));
+  tri.indices = {0, 1, 3};
+  EXPECT_THROW(scene.add_mesh(tri), std::invalid_argument);
+}
+
+TEST(PoseTest, RollPitchYawAndQuaternionAgree) {
+  const Pose a = make_pose(1, 2, 3, 0.3, -0.2, 1.1);
+  // The same rotation as a quaternion: q = qz(yaw) * qy(pitch) * qx(roll).
+  const double cr = std::cos(0.15), sr = std::sin(0.15), cp = std::cos(-0.1), sp = std::sin(-0.1),
+               cy = std::cos(0.55), sy = std::sin(0.55);
+  const Pose b =
+      make_pose_quat({1, 2, 3}, {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
+                                 cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy});
+  for (int i = 0; i < 16; ++i) EXPECT_NEAR(a[i], b[i], 1e-12) << i;
+  // Yaw 90 degrees turns +X into +Y.
+  const Pose yaw = make_pose(0, 0, 0, 0, 0, std::numbers::pi / 2);
+  EXPECT_NEAR(yaw[1], 1, 1e-12);
+  const Pose c = compose(make_pose(1, 0, 0), with_scale(identity_pose(), 2, 3, 4));
+  EXPECT_EQ(c[0], 2);
+  EXPECT_EQ(c[5], 3);
+  EXPECT_EQ(c[10], 4);
+  EXPECT_EQ(c[12], 1);
+}
+
+TEST_F(MeshFiles, LoadsObjWithMaterialAndScale) {
+  write("part.mtl", "newmtl paint\nKd 0.2 0.4 0.6\nKs 0.5 0.5 0.5\nNs 50\n");
+  const std::string obj = write("part.obj",
+                                "mtllib part.mtl\n"
+                                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
+                                "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                "usemtl paint\n"
+                                "f 1/1 4/4 3/3 2/2\n"  // the bottom square, facing -z
+                                "f 1 2 5\n");
+  const auto parts = load_mesh(obj, {2, 3, 0.5f});
+  ASSERT_EQ(parts.size(), 1u);
+  const LoadedMesh& p = parts[0];
+  EXPECT_EQ(p.mesh.triangle_count(), 3u);
+  EXPECT_EQ(max_corner(p.mesh), (std::array<float, 3>{2, 3, 0.5f}));
+  EXPECT_EQ(min_corner(p.mesh), (std::array<float, 3>{0, 0, 0}));
+  EXPECT_FLOAT_EQ(p.diffuse[0], 0.2f);
+  EXPECT_FLOAT_EQ(p.diffuse[1], 0.4f);
+  EXPECT_FLOAT_EQ(p.diffuse[2], 0.6f);
+  EXPECT_FLOAT_EQ(p.shininess, 50);
+  EXPECT_EQ(p.mesh.normals.size(), p.mesh.positions.size());
+  EXPECT_EQ(p.mesh.uvs.size(), 2 * p.mesh.vertex_count());
+  const Material m = p.material(4);
+  EXPECT_EQ(m.texture, 4);
+  EXPECT_EQ(m.diffuse, p.diffuse);
+}
+
+TEST_F(MeshFiles, LoadsStlWithScale) {
+  const std::string stl = write("wedge.stl",
+                                "solid wedge\n"
+                                " facet normal 0 0 1\n  outer loop\n"
+                                "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n"
+                                "  endloop\n endfacet\n"
+                                " facet normal 0 -1 0\n  outer loop\n"
+                                "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 0 1\n"
+                                "  endloop\n endfacet\n"
+                                "endsolid wedge\n");
+  const auto parts = load_mesh(stl, {0.001f, 0.001f, 0.001f});  // millimetres, as CAD exports
+  ASSERT_EQ(parts.size(), 1u);
+  EXPECT_EQ(parts[0].mesh.triangle_count(), 2u);
+  const auto hi = max_corner(parts[0].mesh);
+  EXPECT_FLOAT_EQ(hi[0], 0.001f);
+  EXPECT_FLOAT_EQ(hi[2], 0.001f);
+  expect_outward_winding(parts[0].mesh);
+}
+
+TEST_F(MeshFiles, ColladaIsTurnedZUpLikeGazebo) {
+  auto dae = [&](const std::string& up) {
+    return write(
+        up + ".dae",
+        "<?xml version=\"1.0\"?>\n"
+        "<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+        "<asset><unit meter=\"0.01\"/><up_axis>" +
+            up +
+            "</up_axis></asset>"
+            "<library_geometries><geometry id=\"g\"><mesh>"
+            "<source id=\"p\"><float_array id=\"pa\" count=\"9\">0 0 0 100 0 0 0 0 200"
+            "</float_array><technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\">"
+            "<param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/>"
+            "<param name=\"Z\" type=\"float\"/></accessor></technique_common></source>"
+            "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>"
+            "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/>"
+            "<p>0 1 2</p></triangles></mesh></geometry></library_geometries>"
+            "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\">"
+            "<instance_geometry url=\"#g\"/></node></visual_scene></library_visual_scenes>"
+            "<scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>\n");
+  };
+  // Z_UP: axes kept; centimetres become metres.
+  auto z_up = load_mesh(dae("Z_UP"));
+  ASSERT_EQ(z_up.size(), 1u);
+  EXPECT_NEAR(max_corner(z_up[0].mesh)[0], 1, 1e-6);
+  EXPECT_NEAR(max_corner(z_up[0].mesh)[2], 2, 1e-6);
+  // Y_UP: the file's up (+Y) becomes +Z, its +Z becomes -Y.
+  auto y_up = load_mesh(dae("Y_UP"), {1, 1, 1});
+  ASSERT_EQ(y_up.size(), 1u);
+  EXPECT_NEAR(min_corner(y_up[0].mesh)[1], -2, 1e-6);
+  EXPECT_NEAR(max_corner(y_up[0].mesh)[2], 0, 1e-6);
+}
+
+TEST_F(MeshFiles, ErrorsNameTheFile) {
+  const std::string missing = (dir_ / "nope.obj").string();
+  try {
+    load_mesh(missing);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+  }
+  const std::string junk = write("junk.stl", "this is not a mesh");
+  try {
+    load_mesh(junk);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(junk), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_mesh(write("x.fbx", "")), std::runtime_error);
+}
+
+TEST_F(MeshFiles, ImageFilesRoundTrip) {
+  const uint8_t rgb[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  const std::string ppm = (dir_ / "a.ppm").string();
+  write_ppm(ppm, 2, 2, rgb);
+  const Image back = read_ppm(ppm);
+  EXPECT_EQ(back.width, 2);
+  EXPECT_EQ(back.height, 2);
+  EXPECT_EQ(back.data, std::vector<uint8_t>(rgb, rgb + 12));
+
+  // 2x2 RGB PNG: red green / blue white.
+  const unsigned char png[] = {
+      0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44,
+      0x52, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x02, 0x08, 0x02, 0x00, 0x00, 0x00, 0xfd,
+      0xd4, 0x9a, 0x73, 0x00, 0x00, 0x00, 0x12, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0xf8,
+      0xcf, 0xc0, 0xc0, 0x00, 0xc2, 0x0c, 0xff, 0x81, 0x00, 0x00, 0x1f, 0xee, 0x05, 0xfb, 0x0b,
+      0xd9, 0x68, 0x8b, 0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82};
+  const std::string png_path =
+      write("t.png", std::string(reinterpret_cast<const char*>(png), sizeof png));
+  Scene scene;
+  try {
+    const Image image = load_image_rgba(png_path);
+    EXPECT_EQ(image.width, 2);
+    EXPECT_EQ(image.channels, 4);
+    EXPECT_EQ(image.data, (std::vector<uint8_t>{255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255,
+                                                255, 255, 255}));
+    EXPECT_EQ(scene.add_texture_file(png_path), 0);
+  } catch (const std::runtime_error& e) {
+    // Only acceptable when the library was built without libpng.
+    EXPECT_NE(std::string(e.what()).find("libpng not found"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(scene.add_texture_file(write("bad.png", "not an image")), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace convoy::render
