@@ -1,0 +1,403 @@
+#include "opendrive/parser.h"
+
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace convoy::opendrive {
+namespace {
+
+using tinyxml2::XMLElement;
+
+// Walks the children of `parent` named `name` (all children when name is null).
+template <typename F>
+void for_each_child(const XMLElement* parent, const char* name, F&& f) {
+  if (!parent) return;
+  for (const XMLElement* e = parent->FirstChildElement(name); e; e = e->NextSiblingElement(name)) {
+    f(e);
+  }
+}
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) { net_.source = source_; }
+
+  Network read(const tinyxml2::XMLDocument& doc);
+
+ private:
+  [[noreturn]] void fail(const XMLElement* e, const std::string& where,
+                         const std::string& what) const {
+    std::string msg = source_;
+    if (e) msg += ":" + std::to_string(e->GetLineNum());
+    msg += ": ";
+    if (!where.empty()) msg += where + ": ";
+    throw std::runtime_error(msg + what);
+  }
+
+  std::string text(const XMLElement* e, const char* name, const std::string& where) const {
+    const char* v = e->Attribute(name);
+    if (!v) fail(e, where, std::string("missing attribute '") + name + "'");
+    return v;
+  }
+  std::string text_or(const XMLElement* e, const char* name, const std::string& fallback) const {
+    const char* v = e->Attribute(name);
+    return v ? v : fallback;
+  }
+  double number(const XMLElement* e, const char* name, const std::string& where) const {
+    return to_number(e, name, text(e, name, where), where);
+  }
+  double number_or(const XMLElement* e, const char* name, double fallback,
+                   const std::string& where) const {
+    const char* v = e->Attribute(name);
+    return v ? to_number(e, name, v, where) : fallback;
+  }
+  int integer(const XMLElement* e, const char* name, const std::string& where) const {
+    const double v = number(e, name, where);
+    if (v != std::floor(v) || std::abs(v) > 1e9) {
+      fail(e, where,
+           std::string("attribute '") + name + "' must be an integer, got '" +
+               text(e, name, where) + "'");
+    }
+    return static_cast<int>(v);
+  }
+  double to_number(const XMLElement* e, const char* name, const std::string& value,
+                   const std::string& where) const {
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(value.c_str(), &end);
+    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (value.empty() || end == value.c_str() || *end != '\0' || errno == ERANGE ||
+        !std::isfinite(v)) {
+      fail(e, where, std::string("attribute '") + name + "' is not a number: '" + value + "'");
+    }
+    return v;
+  }
+  CubicRecord cubic(const XMLElement* e, const char* start_name, double start_base,
+                    const std::string& where) const {
+    return {start_base + number(e, start_name, where), number(e, "a", where), number(e, "b", where),
+            number(e, "c", where), number(e, "d", where)};
+  }
+
+  void read_header(const XMLElement* e);
+  Road read_road(const XMLElement* e, size_t index);
+  RoadLink read_link(const XMLElement* e, const std::string& where);
+  Geometry read_geometry(const XMLElement* e, const std::string& where);
+  std::vector<CubicRecord> read_records(const XMLElement* parent, const char* name,
+                                        const char* start_name, double start_base,
+                                        const std::string& where);
+  LaneSection read_section(const XMLElement* e, const std::string& where);
+  Lane read_lane(const XMLElement* e, int side, double section_s, const std::string& where);
+  RoadMark read_road_mark(const XMLElement* e, double section_s, const std::string& where);
+
+  struct PendingLink {
+    const XMLElement* element;
+    std::string where;
+    std::string target;
+  };
+
+  std::string source_;
+  Network net_;
+  std::vector<PendingLink> links_;
+};
+
+Network Reader::read(const tinyxml2::XMLDocument& doc) {
+  const XMLElement* root = doc.RootElement();
+  if (!root || std::strcmp(root->Name(), "OpenDRIVE") != 0) {
+    fail(root, "",
+         std::string("root element is '") + (root ? root->Name() : "") + "', expected 'OpenDRIVE'");
+  }
+  read_header(root->FirstChildElement("header"));
+  size_t index = 0;
+  for_each_child(root, "road", [&](const XMLElement* e) {
+    Road road = read_road(e, index++);
+    if (net_.find_road(road.id)) fail(e, "road " + road.id, "duplicate road id");
+    net_.roads.push_back(std::move(road));
+  });
+  if (net_.roads.empty()) fail(root, "", "no <road> elements");
+  for (const PendingLink& link : links_) {
+    if (!net_.find_road(link.target)) {
+      fail(link.element, link.where, "links to unknown road '" + link.target + "'");
+    }
+  }
+  return std::move(net_);
+}
+
+void Reader::read_header(const XMLElement* e) {
+  if (!e) {
+    net_.warnings.push_back(source_ + ": no <header>");
+    return;
+  }
+  Header& h = net_.header;
+  h.rev_major = static_cast<int>(number_or(e, "revMajor", 1, "header"));
+  h.rev_minor = static_cast<int>(number_or(e, "revMinor", 6, "header"));
+  h.name = text_or(e, "name", "");
+  h.version = text_or(e, "version", "");
+  h.date = text_or(e, "date", "");
+  h.vendor = text_or(e, "vendor", "");
+  h.north = number_or(e, "north", 0, "header");
+  h.south = number_or(e, "south", 0, "header");
+  h.east = number_or(e, "east", 0, "header");
+  h.west = number_or(e, "west", 0, "header");
+  if (const XMLElement* geo = e->FirstChildElement("geoReference"); geo && geo->GetText()) {
+    h.geo_reference = geo->GetText();
+  }
+  if (h.rev_major != 1) {
+    net_.warnings.push_back(source_ + ": header: OpenDRIVE revision " +
+                            std::to_string(h.rev_major) + "." + std::to_string(h.rev_minor) +
+                            " (1.x expected)");
+  }
+}
+
+Road Reader::read_road(const XMLElement* e, size_t index) {
+  Road road;
+  road.id = text(e, "id", "road #" + std::to_string(index));
+  const std::string where = "road " + road.id;
+  road.name = text_or(e, "name", "");
+  road.length = number(e, "length", where);
+  if (road.length < 0) fail(e, where, "negative length");
+  road.junction = text_or(e, "junction", "-1");
+  road.rule = text_or(e, "rule", "RHT");
+  if (road.rule != "RHT" && road.rule != "LHT") {
+    fail(e, where, "rule must be RHT or LHT, got '" + road.rule + "'");
+  }
+  if (const XMLElement* link = e->FirstChildElement("link")) {
+    if (const XMLElement* p = link->FirstChildElement("predecessor")) {
+      road.predecessor = read_link(p, where + " predecessor");
+    }
+    if (const XMLElement* s = link->FirstChildElement("successor")) {
+      road.successor = read_link(s, where + " successor");
+    }
+  }
+
+  const XMLElement* plan_view = e->FirstChildElement("planView");
+  if (!plan_view) fail(e, where, "missing <planView>");
+  int g = 0;
+  for_each_child(plan_view, "geometry", [&](const XMLElement* ge) {
+    const std::string gwhere = where + " geometry " + std::to_string(g++);
+    Geometry geom = read_geometry(ge, gwhere);
+    if (!road.plan_view.empty() && geom.s < road.plan_view.back().s - 1e-9) {
+      fail(ge, gwhere, "s=" + std::to_string(geom.s) + " is before the previous geometry's");
+    }
+    road.plan_view.push_back(std::move(geom));
+  });
+  if (road.plan_view.empty()) fail(plan_view, where, "<planView> has no <geometry>");
+  const Geometry& last = road.plan_view.back();
+  if (std::abs(last.s + last.length - road.length) > 1e-3) {
+    net_.warnings.push_back(source_ + ": " + where +
+                            ": planView ends at s=" + std::to_string(last.s + last.length) +
+                            ", road length is " + std::to_string(road.length));
+  }
+
+  road.elevation_profile =
+      read_records(e->FirstChildElement("elevationProfile"), "elevation", "s", 0, where);
+  const XMLElement* lanes = e->FirstChildElement("lanes");
+  if (!lanes) fail(e, where, "missing <lanes>");
+  road.lane_offsets = read_records(lanes, "laneOffset", "s", 0, where);
+  int k = 0;
+  for_each_child(lanes, "laneSection", [&](const XMLElement* se) {
+    const std::string swhere = where + " laneSection " + std::to_string(k++);
+    LaneSection sec = read_section(se, swhere);
+    if (!road.sections.empty() && sec.s < road.sections.back().s) {
+      fail(se, swhere, "s=" + std::to_string(sec.s) + " is before the previous section's");
+    }
+    road.sections.push_back(std::move(sec));
+  });
+  if (road.sections.empty()) fail(lanes, where, "<lanes> has no <laneSection>");
+  for (size_t i = 0; i < road.sections.size(); ++i) {
+    road.sections[i].s_end = i + 1 < road.sections.size() ? road.sections[i + 1].s : road.length;
+  }
+  return road;
+}
+
+RoadLink Reader::read_link(const XMLElement* e, const std::string& where) {
+  RoadLink link{text(e, "elementType", where), text(e, "elementId", where),
+                text_or(e, "contactPoint", "")};
+  if (link.element_type != "road" && link.element_type != "junction") {
+    fail(e, where, "elementType must be road or junction, got '" + link.element_type + "'");
+  }
+  if (!link.contact_point.empty() && link.contact_point != "start" && link.contact_point != "end") {
+    fail(e, where, "contactPoint must be start or end, got '" + link.contact_point + "'");
+  }
+  if (link.element_type == "road") links_.push_back({e, where, link.element_id});
+  return link;
+}
+
+Geometry Reader::read_geometry(const XMLElement* e, const std::string& where) {
+  const double s = number(e, "s", where), x = number(e, "x", where), y = number(e, "y", where);
+  const double hdg = number(e, "hdg", where), length = number(e, "length", where);
+  if (length < 0) fail(e, where, "negative length");
+  const XMLElement* shape = nullptr;
+  for (const XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    const std::string name = c->Name();
+    if (name == "userData" || name == "include" || name == "dataQuality") continue;
+    if (shape) fail(c, where, "more than one shape element");
+    shape = c;
+  }
+  if (!shape) fail(e, where, "no shape (line, arc, spiral, poly3 or paramPoly3)");
+  const std::string type = shape->Name();
+  if (type == "line") return Geometry::line(s, x, y, hdg, length);
+  if (type == "arc") return Geometry::arc(s, x, y, hdg, length, number(shape, "curvature", where));
+  if (type == "spiral") {
+    return Geometry::spiral(s, x, y, hdg, length, number(shape, "curvStart", where),
+                            number(shape, "curvEnd", where));
+  }
+  if (type == "poly3") {
+    return Geometry::poly3(s, x, y, hdg, length,
+                           {number(shape, "a", where), number(shape, "b", where),
+                            number(shape, "c", where), number(shape, "d", where)});
+  }
+  if (type == "paramPoly3") {
+    const std::string range = text_or(shape, "pRange", "normalized");
+    if (range != "normalized" && range != "arcLength") {
+      fail(shape, where, "pRange must be arcLength or normalized, got '" + range + "'");
+    }
+    auto coeffs = [&](char axis) {
+      std::array<double, 4> c{};
+      for (int i = 0; i < 4; ++i) {
+        const std::string name = std::string(1, static_cast<char>('a' + i)) + axis;
+        c[i] = number(shape, name.c_str(), where);
+      }
+      return c;
+    };
+    return Geometry::param_poly3(s, x, y, hdg, length, coeffs('U'), coeffs('V'),
+                                 range == "normalized");
+  }
+  fail(shape, where, "unknown geometry type '" + type + "'");
+}
+
+std::vector<CubicRecord> Reader::read_records(const XMLElement* parent, const char* name,
+                                              const char* start_name, double start_base,
+                                              const std::string& where) {
+  std::vector<CubicRecord> out;
+  int i = 0;
+  for_each_child(parent, name, [&](const XMLElement* e) {
+    out.push_back(cubic(e, start_name, start_base, where + " " + name + " " + std::to_string(i++)));
+  });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const CubicRecord& a, const CubicRecord& b) { return a.start < b.start; });
+  return out;
+}
+
+LaneSection Reader::read_section(const XMLElement* e, const std::string& where) {
+  LaneSection sec;
+  sec.s = number(e, "s", where);
+  struct Side {
+    const char* name;
+    int sign;
+  };
+  for (const Side side : {Side{"left", 1}, Side{"center", 0}, Side{"right", -1}}) {
+    for_each_child(e->FirstChildElement(side.name), "lane", [&](const XMLElement* le) {
+      sec.lanes.push_back(read_lane(le, side.sign, sec.s, where));
+    });
+  }
+  std::sort(sec.lanes.begin(), sec.lanes.end(),
+            [](const Lane& a, const Lane& b) { return a.id < b.id; });
+  for (size_t i = 1; i < sec.lanes.size(); ++i) {
+    if (sec.lanes[i].id == sec.lanes[i - 1].id) {
+      fail(e, where, "duplicate lane id " + std::to_string(sec.lanes[i].id));
+    }
+  }
+  if (!sec.find_lane(0)) fail(e, where, "missing the centre lane (id 0 in <center>)");
+  // Lanes must be numbered without gaps outwards from the centre.
+  for (int id = sec.min_lane_id(); id <= sec.max_lane_id(); ++id) {
+    if (!sec.find_lane(id)) fail(e, where, "lane ids skip " + std::to_string(id));
+  }
+  return sec;
+}
+
+Lane Reader::read_lane(const XMLElement* e, int side, double section_s,
+                       const std::string& section_where) {
+  Lane lane;
+  lane.id = integer(e, "id", section_where + " lane");
+  const std::string where = section_where + " lane " + std::to_string(lane.id);
+  if ((side > 0 && lane.id <= 0) || (side < 0 && lane.id >= 0) || (side == 0 && lane.id != 0)) {
+    fail(e, where,
+         std::string("lane id does not belong in <") +
+             (side > 0   ? "left"
+              : side < 0 ? "right"
+                         : "center") +
+             ">");
+  }
+  lane.type = text_or(e, "type", "none");
+  const std::string level = text_or(e, "level", "false");
+  lane.level = level == "true" || level == "1";
+  if (const XMLElement* link = e->FirstChildElement("link")) {
+    if (const XMLElement* p = link->FirstChildElement("predecessor")) {
+      lane.predecessor = integer(p, "id", where + " predecessor");
+    }
+    if (const XMLElement* s = link->FirstChildElement("successor")) {
+      lane.successor = integer(s, "id", where + " successor");
+    }
+  }
+  if (const XMLElement* border = e->FirstChildElement("border")) {
+    fail(border, where, "lane <border> records are not supported; use <width>");
+  }
+  lane.widths = read_records(e, "width", "sOffset", section_s, where);
+  if (lane.id != 0 && lane.widths.empty()) {
+    net_.warnings.push_back(source_ + ": " + where + ": no <width>, taken as 0");
+  }
+  int m = 0;
+  for_each_child(e, "roadMark", [&](const XMLElement* me) {
+    lane.road_marks.push_back(
+        read_road_mark(me, section_s, where + " roadMark " + std::to_string(m++)));
+  });
+  std::stable_sort(lane.road_marks.begin(), lane.road_marks.end(),
+                   [](const RoadMark& a, const RoadMark& b) { return a.start < b.start; });
+  return lane;
+}
+
+RoadMark Reader::read_road_mark(const XMLElement* e, double section_s, const std::string& where) {
+  RoadMark mark;
+  mark.start = section_s + number(e, "sOffset", where);
+  mark.type = text(e, "type", where);
+  mark.weight = text_or(e, "weight", "standard");
+  mark.color = text_or(e, "color", "standard");
+  mark.width = number_or(e, "width", mark.weight == "bold" ? 0.25 : 0.12, where);
+  if (mark.width < 0) fail(e, where, "negative width");
+  if (const XMLElement* type = e->FirstChildElement("type")) {
+    int i = 0;
+    for_each_child(type, "line", [&](const XMLElement* le) {
+      const std::string lwhere = where + " line " + std::to_string(i++);
+      mark.lines.push_back({number(le, "length", lwhere), number(le, "space", lwhere),
+                            number_or(le, "tOffset", 0, lwhere),
+                            number_or(le, "sOffset", 0, lwhere),
+                            number_or(le, "width", 0, lwhere)});
+      if (mark.lines.back().length < 0 || mark.lines.back().space < 0) {
+        fail(le, lwhere, "negative length or space");
+      }
+    });
+  }
+  return mark;
+}
+
+}  // namespace
+
+Network parse(const std::string& xml, const std::string& source_name) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
+    // ErrorStr() reads "Error=NAME ErrorID=N (0xN) Line number=N: detail"; keep the detail.
+    std::string detail = doc.ErrorStr();
+    const size_t colon = detail.find(": ");
+    detail = colon == std::string::npos ? "" : " (" + detail.substr(colon + 2) + ")";
+    throw std::runtime_error(source_name + ":" + std::to_string(doc.ErrorLineNum()) +
+                             ": malformed XML: " + doc.ErrorName() + detail);
+  }
+  return Reader(source_name).read(doc);
+}
+
+Network load(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open file: " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse(text.str(), path);
+}
+
+}  // namespace convoy::opendrive
