@@ -42,13 +42,13 @@ void directional(int i, vec3 p, vec3 n) { shade(i, p, n, -u_light_direction[i].x
 
 void point(int i, vec3 p, vec3 n) {
   vec3 d = u_light_position[i] - p;
-  float dist = length(d);
+  float dist = max(length(d), 1e-6);
   shade(i, p, n, d / dist, attenuation(i, dist));
 }
 
 void spot(int i, vec3 p, vec3 n) {
   vec3 d = u_light_position[i] - p;
-  float dist = length(d);
+  float dist = max(length(d), 1e-6);
   vec3 l = d / dist;
   vec3 s = u_light_spot[i];
   float rho = dot(-l, u_light_direction[i].xyz);

@@ -5,8 +5,9 @@
 // it needs: lights unrolled by type, no texture lookup without a texture.
 //
 // Lighting is computed in eye space, per pixel; or per vertex for meshes whose triangles
-// cover only a few pixels each, where it looks the same: there a software rasteriser would
-// otherwise shade every tiny triangle's whole 4x4 block, which costs half the frame.
+// cover only a few pixels each, where it looks the same (mean difference under 2/255): there
+// llvmpipe would shade every tiny triangle's whole 4x4 pixel block (about 12% faster on a
+// 100k-triangle scene of small spheres).
 //
 // Outputs: location 0 the lit colour (RGBA8), location 1 the distance along the optical axis
 // in metres (R32F, with depth), location 2 the instance id as RGBA8 bytes (with ids).

@@ -1,9 +1,9 @@
 // Mesh files (SDF <mesh><uri>) through Assimp: COLLADA (.dae), Wavefront (.obj), STL.
 //
-// A file becomes one LoadedMesh per material: node transforms are baked into the vertices,
-// then `scale` (SDF <mesh><scale>) is applied along the file's axes. COLLADA files are turned
-// Z-up as Gazebo does (a Y_UP file's +Y becomes +Z; a Z_UP file keeps its axes), honouring
-// the file's <unit>. OBJ and STL vertices are taken as they are.
+// A file becomes one LoadedMesh per material: node transforms are baked into the vertices.
+// COLLADA files are turned Z-up as Gazebo does (a Y_UP file's +Y becomes +Z; a Z_UP file keeps
+// its axes) and their <unit> honoured; OBJ and STL vertices are taken as they are. Then
+// `scale` (SDF <mesh><scale>) multiplies x, y and z; a mirroring scale keeps faces outward.
 #pragma once
 
 #include <array>

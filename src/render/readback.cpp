@@ -1,11 +1,15 @@
 #include "render/readback.h"
 
 #include <algorithm>
+#include <bit>
 #include <climits>
 #include <cstring>
 #include <map>
 
 namespace convoy::render {
+
+// Pixels come as RGBA bytes and are handled as 32-bit words.
+static_assert(std::endian::native == std::endian::little, "RGBA bytes read as little-endian words");
 
 void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels) {
   // Four pixels (16 bytes in, 12 out) at a time, as little-endian words.

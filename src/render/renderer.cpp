@@ -3,8 +3,6 @@
 #include <GLES3/gl3.h>
 
 #include <algorithm>
-#include <bit>
-#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -19,11 +17,10 @@
 #include "render/egl_context.h"
 #include "render/gl_program.h"
 #include "render/gpu_resources.h"
+#include "render/readback.h"
 
 namespace convoy::render {
 namespace {
-
-static_assert(std::endian::native == std::endian::little, "instance ids are read as RGBA bytes");
 
 // The GL camera (x right, y up, looking down -z) in the SDF camera's frame (x forward, y left,
 // z up): its columns are GL's axes.
@@ -77,20 +74,6 @@ struct Draw {
   glm::mat3 normal_matrix;
 };
 
-// Drops the alpha bytes, four pixels (16 bytes in, 12 out) at a time.
-void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels) {
-  size_t i = 0;
-  for (; i + 4 <= pixels; i += 4) {
-    uint32_t p[4], q[3];
-    std::memcpy(p, src + 4 * i, 16);
-    q[0] = (p[0] & 0xffffff) | (p[1] << 24);
-    q[1] = ((p[1] >> 8) & 0xffff) | (p[2] << 16);
-    q[2] = ((p[2] >> 16) & 0xff) | (p[3] << 8);
-    std::memcpy(dst + 3 * i, q, 12);
-  }
-  for (; i < pixels; ++i) std::memcpy(dst + 3 * i, src + 4 * i, 3);
-}
-
 }  // namespace
 
 struct Renderer::Impl {
@@ -129,7 +112,6 @@ struct Renderer::Impl {
   void collect_draws(const Scene& scene, const glm::dmat4& view, const CameraSpec& spec);
   void draw(ProgramKey key, const Scene& scene, const glm::dmat4& view, const CameraSpec& spec,
             const GpuScene& gpu);
-  void compute_boxes(const Scene& scene, int width, int height, std::vector<BoundingBox>* boxes);
 };
 
 void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene& scene,
@@ -282,49 +264,6 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
   if (!culling) glEnable(GL_CULL_FACE);
 }
 
-void Renderer::Impl::compute_boxes(const Scene& scene, int width, int height,
-                                   std::vector<BoundingBox>* boxes) {
-  struct Extent {
-    int x_min = INT_MAX, y_min = INT_MAX, x_max = -1, y_max = -1;
-    uint32_t count = 0;
-  };
-  const auto& instances = scene.instances();
-  std::vector<Extent> extents(instances.size() + 1);  // by instance id (index + 1)
-  const uint32_t* id = ids.data();
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width;) {
-      const uint32_t v = id[static_cast<size_t>(y) * width + x];
-      int end = x + 1;
-      while (end < width && id[static_cast<size_t>(y) * width + end] == v) ++end;
-      if (v != 0 && v < extents.size()) {
-        Extent& e = extents[v];
-        e.x_min = std::min(e.x_min, x);
-        e.x_max = std::max(e.x_max, end - 1);
-        e.y_min = std::min(e.y_min, y);
-        e.y_max = y;
-        e.count += end - x;
-      }
-      x = end;
-    }
-  }
-  std::map<uint32_t, BoundingBox> by_model;
-  for (size_t i = 0; i < instances.size(); ++i) {
-    const Extent& e = extents[i + 1];
-    const uint32_t model = instances[i].model_id;
-    if (model == 0 || e.count == 0) continue;
-    auto [it, inserted] = by_model.try_emplace(
-        model, BoundingBox{model, instances[i].class_id, e.x_min, e.y_min, e.x_max, e.y_max, 0});
-    BoundingBox& b = it->second;
-    b.x_min = std::min(b.x_min, e.x_min);
-    b.y_min = std::min(b.y_min, e.y_min);
-    b.x_max = std::max(b.x_max, e.x_max);
-    b.y_max = std::max(b.y_max, e.y_max);
-    b.pixel_count += e.count;
-  }
-  boxes->clear();
-  for (const auto& [model, box] : by_model) boxes->push_back(box);
-}
-
 Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   // llvmpipe allocates its per-frame bins afresh each frame; returned to the system they
   // would fault in again every frame (4x slower at 100k triangles).
@@ -345,6 +284,7 @@ const std::string& Renderer::description() const { return impl_->context.descrip
 void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const CameraSpec& spec,
                       Frame* out, bool want_depth, bool want_boxes) {
   check_spec(spec);
+  if (!out) throw std::invalid_argument("Renderer::render: no Frame to render into");
   Impl& s = *impl_;
   s.context.make_current();
   if (spec.width > s.max_size || spec.height > s.max_size) {
@@ -417,7 +357,7 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
     s.ids.resize(pixels);
     glReadBuffer(GL_COLOR_ATTACHMENT2);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, s.ids.data());
-    s.compute_boxes(scene, w, h, &out->boxes);
+    boxes_from_ids(s.ids.data(), w, h, scene, &out->boxes);
   } else {
     out->boxes.clear();
   }

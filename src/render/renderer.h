@@ -2,8 +2,15 @@
 //
 // The world engine keeps a Scene in step with its bodies and asks a Renderer for each camera's
 // frame. Rendering is OpenGL ES 3 through EGL without a display (Mesa's llvmpipe on a plain
-// CPU machine), per-pixel Blinn-Phong lighting, no shadows, no anti-aliasing. The output is
+// CPU machine): Blinn-Phong lighting per pixel (per vertex on meshes whose triangles cover
+// under kPerVertexLightingBelow pixels), textures multiplying the diffuse and ambient colours.
+// Not drawn: shadows, transparency (alpha is ignored), anti-aliasing, sky boxes. The output is
 // deterministic: the same scene, pose and spec give the same bytes on the same machine.
+//
+// Cost (llvmpipe, 2 cores, 736x480): about 1 ms per frame for clearing and reading back, and
+// roughly 150 ns of CPU per triangle in view (tiny triangles cost as much as big ones), so a
+// 100k-triangle view renders at 80-90 frames/s; see benchmarks/render/render_bench.cpp.
+// Depth adds a float attachment and its readback, boxes an id attachment and a pass over it.
 //
 // Camera convention (Gazebo / SDF): the camera looks along its +X axis, +Z is up in the
 // image, +Y is to the image's left. The image is an ideal pinhole with square pixels:
@@ -69,7 +76,9 @@ class Renderer {
 
   // Starts the OpenGL ES context. Throws std::runtime_error saying why if EGL or OpenGL ES 3
   // cannot start. One Renderer per process is the intended use; it is not thread-safe, and
-  // must be used (and destroyed) by one thread at a time.
+  // must be used (and destroyed) by one thread at a time. It also calls
+  // tune_allocator_for_frames() (core/memory.h): llvmpipe allocates its bins afresh every
+  // frame, and memory handed back to the system would fault in again each time.
   Renderer();
   ~Renderer();
   Renderer(const Renderer&) = delete;

@@ -2,14 +2,15 @@
 //
 // A Scene is the renderer's input. Meshes and textures are added once and never change (the
 // Renderer uploads each to the GPU the first time it renders the Scene); instance poses and
-// visibility change every step. Defaults follow SDF 1.6 (<scene>, <material>, <light>).
+// visibility change every step. Defaults are SDF 1.6's (<scene>, <light>, <material>
+// specular), except that a Material is mid grey, as Gazebo draws a visual without one.
 // Colours are linear RGBA in [0, 1].
 //
 //   Scene scene;
 //   int box = scene.add_mesh(make_box(1, 1, 1));
 //   Material red;  red.diffuse = {1, 0, 0, 1};
 //   int car = scene.add_instance(box, red, make_pose(5, 0, 0.5), /*model_id=*/7, /*class=*/1);
-//   scene.add_light(Light{});           // the default: a white directional light
+//   scene.add_light(Light{});           // the default: white sunlight from straight above
 //   ...  scene.set_pose(car, make_pose(6, 0, 0.5));
 #pragma once
 
@@ -46,12 +47,12 @@ struct Light {
   enum Type { kDirectional, kPoint, kSpot };
   Type type = kDirectional;
   std::array<float, 3> position{0, 0, 10};
-  std::array<float, 3> direction{0.5f, 0.2f, -0.9f};
+  std::array<float, 3> direction{0, 0, -1};
   Rgba diffuse{1, 1, 1, 1};
   Rgba specular{0.1f, 0.1f, 0.1f, 1};
   float range = 10.0f;
   float attenuation_constant = 1.0f;
-  float attenuation_linear = 0.0f;
+  float attenuation_linear = 1.0f;
   float attenuation_quadratic = 0.0f;
   // Spot cone, full angles in radians: full intensity inside inner_angle, fading
   // ((cos a - cos outer/2) / (cos inner/2 - cos outer/2))^falloff to zero at outer_angle.

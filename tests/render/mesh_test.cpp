@@ -163,6 +163,10 @@ TEST_F(MeshFiles, LoadsStlWithScale) {
   EXPECT_FLOAT_EQ(hi[0], 0.001f);
   EXPECT_FLOAT_EQ(hi[2], 0.001f);
   expect_outward_winding(parts[0].mesh);
+  // A mirroring scale (SDF allows negative ones) keeps the faces pointing out.
+  const auto mirrored = load_mesh(stl, {-1, 1, 1});
+  EXPECT_FLOAT_EQ(min_corner(mirrored[0].mesh)[0], -1);
+  expect_outward_winding(mirrored[0].mesh);
 }
 
 TEST_F(MeshFiles, ColladaIsTurnedZUpLikeGazebo) {

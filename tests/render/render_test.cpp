@@ -196,6 +196,7 @@ TEST(RenderTest, PointAndSpotLightsFadeWithDistanceAndCone) {
   spot.spot_inner_angle = 0.3f;
   spot.spot_outer_angle = 0.5f;  // a disc of radius 3 tan(0.25) = 0.77 m on the floor
   spot.range = 20;
+  spot.attenuation_linear = 0;
   scene.add_light(spot);
   renderer->render(scene, identity_pose(), spec, &f);
   EXPECT_GT(red_at(8), 200);
@@ -384,6 +385,79 @@ TEST(RenderTest, TextureAppearsUpright) {
   expect_colour(-0.25, 0.25, {0, 255, 0}, "top right");
   expect_colour(0.25, -0.25, {0, 0, 255}, "bottom left");
   expect_colour(-0.25, -0.25, {255, 255, 255}, "bottom right");
+}
+
+TEST(RenderTest, PerVertexLightingLooksLikePerPixel) {
+  GET_RENDERER(renderer);
+  // Finely tessellated spheres far enough away that their triangles cover a pixel or two.
+  Scene scene;
+  scene.set_background({0, 0, 0, 1});
+  Light sun;
+  sun.direction = {0.3f, -0.6f, -0.7f};
+  scene.add_light(sun);
+  Light bulb;
+  bulb.type = Light::kPoint;
+  bulb.position = {6, 2, 2};
+  bulb.specular = {0.5f, 0.5f, 0.5f, 1};
+  scene.add_light(bulb);
+  Material shiny = plain(0.2f, 0.5f, 0.9f);
+  shiny.specular = {0.6f, 0.6f, 0.6f, 1};
+  const int sphere = scene.add_mesh(make_sphere(0.5f, 24, 48));
+  for (int i = 0; i < 5; ++i) scene.add_instance(sphere, shiny, make_pose(10, 2.0 - i, 0));
+  const CameraSpec spec{320, 240, 1.0, 0.1, 100};
+  Frame per_vertex, per_pixel;
+  renderer->render(scene, identity_pose(), spec, &per_vertex);
+  EXPECT_EQ(renderer->last_stats().per_vertex_lit, 5);
+  renderer->set_per_vertex_lighting_below(0);
+  renderer->render(scene, identity_pose(), spec, &per_pixel);
+  renderer->set_per_vertex_lighting_below(Renderer::kPerVertexLightingBelow);
+  EXPECT_EQ(renderer->last_stats().per_vertex_lit, 0);
+  double sum = 0;
+  int covered = 0;
+  for (size_t i = 0; i < per_pixel.rgb.size(); ++i) {
+    if (per_pixel.rgb[i] == 0 && per_vertex.rgb[i] == 0) continue;
+    sum += std::abs(int(per_pixel.rgb[i]) - int(per_vertex.rgb[i]));
+    ++covered;
+  }
+  ASSERT_GT(covered, 1000);
+  EXPECT_LT(sum / covered, 2.0);  // mean difference over the spheres, out of 255
+}
+
+TEST(RenderTest, LargeScenesKeepIdsAndDepthExact) {
+  GET_RENDERER(renderer);
+  // 64 spheres of 2208 triangles each: several batches for the rasteriser. Lit by ambient
+  // light only, each shows its own exact colour.
+  Scene scene;
+  scene.set_background({0, 0, 0, 1});
+  scene.set_ambient({1, 1, 1, 1});
+  const int sphere = scene.add_mesh(make_sphere(0.4f, 24, 48));
+  for (int i = 0; i < 64; ++i) {
+    Material m = plain(0, 0, 0);
+    m.ambient = {(40 + 3 * i) / 255.0f, (200 - 2 * i) / 255.0f, (i % 2 ? 255 : 128) / 255.0f, 1};
+    scene.add_instance(sphere, m, make_pose(8 + i % 3, (i % 8 - 3.5) * 0.9, (i / 8 - 3.5) * 0.9),
+                       100 + i, i % 3);
+  }
+  const CameraSpec spec{400, 300, 1.2, 0.1, 100};
+  Frame f, again;
+  renderer->render(scene, identity_pose(), spec, &f, true, true);
+  EXPECT_GT(renderer->last_stats().triangles_drawn, 100000u);
+  ASSERT_EQ(f.boxes.size(), 64u);
+  for (const BoundingBox& b : f.boxes) {
+    const int i = static_cast<int>(b.model_id) - 100;
+    const int r = 40 + 3 * i, g = 200 - 2 * i, bl = i % 2 ? 255 : 128;
+    const Rect seen =
+        find_pixels(f, [&](int pr, int pg, int pb) { return pr == r && pg == g && pb == bl; });
+    EXPECT_EQ(seen.count, static_cast<int>(b.pixel_count)) << "model " << b.model_id;
+    EXPECT_EQ(seen.x_min, b.x_min) << "model " << b.model_id;
+    EXPECT_EQ(seen.y_max, b.y_max) << "model " << b.model_id;
+  }
+  // Sphere 36, centred at (8, 0.45, 0.45), is 8 - 0.4 m ahead along the axis at its centre's
+  // pixel.
+  const auto centre = project(spec, 8, 0.45, 0.45);
+  EXPECT_NEAR(f.depth[int(centre[1]) * spec.width + int(centre[0])], 7.6, 0.02);
+  renderer->render(scene, identity_pose(), spec, &again, true, true);
+  EXPECT_EQ(f.rgb, again.rgb);
+  EXPECT_EQ(0, std::memcmp(f.depth.data(), again.depth.data(), f.depth.size() * sizeof(float)));
 }
 
 TEST(RenderTest, RejectsBadInput) {
