@@ -78,8 +78,10 @@ class PythonJsonEngine final : public Engine {
     py::str key(id.name());
     if (!datapacks.contains(key)) return;  // unknown id: empty datapack
     py::object data = datapacks[key];
-    // A datapack object (e.g. a GazeboCameraDataPack) sends its data.
-    if (py::hasattr(data, "_id") && py::hasattr(data, "_data")) data = data.attr("_data");
+    // A datapack object (e.g. a GazeboCameraDataPack) sends its data. (Dicts, the common
+    // case, skip the attribute probes, which cost an exception each.)
+    if (!PyDict_Check(data.ptr()) && py::hasattr(data, "_id") && py::hasattr(data, "_data"))
+      data = data.attr("_data");
     python::data_from_python(data, out);
   }
 

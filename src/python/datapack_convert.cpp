@@ -197,7 +197,7 @@ void data_from_python(py::handle data, engine::DataPack* out) {
     return;
   }
   try {
-    if (encode_proto(data, out)) return;
+    if (!PyDict_Check(data.ptr()) && encode_proto(data, out)) return;
     out->mutable_id()->set_type("json");
     std::string* bytes = out->mutable_json_msgpack();
     bytes->clear();
