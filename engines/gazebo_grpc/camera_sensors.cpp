@@ -175,9 +175,11 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
 }
 
 void CameraSensors::update(double t) {
+  now_ = t;
   if (cameras_.empty()) return;
   bool poses_fresh = false;
   for (auto& cam : cameras_) {
+    if (!cam.want_image && !cam.want_depth && !cam.want_boxes) continue;
     if (cam.rendered && t + 1e-9 < cam.next_update) continue;
     if (!poses_fresh) {
       for (const auto& tr : tracked_) {
@@ -206,6 +208,12 @@ void CameraSensors::render(Camera& cam) {
   cam.rendered = true;
 }
 
+void CameraSensors::first_render(Camera& cam) {
+  render(cam);
+  double rate = cam.desc->update_rate;
+  cam.next_update = rate > 0 ? now_ + 1.0 / rate : now_;
+}
+
 void CameraSensors::apply_noise(Camera& cam) {
   // Gazebo: each channel value (0..1) gets mean + stddev * N(0, 1), clamped to [0, 1]. The
   // normal samples come from the camera's fixed table, read from a random place each
@@ -222,9 +230,10 @@ void CameraSensors::apply_noise(Camera& cam) {
   }
 }
 
-void CameraSensors::image_datapack(size_t i, engine::DataPack* out) const {
-  const Camera& cam = cameras_[i];
-  if (!cam.rendered) return;
+void CameraSensors::image_datapack(size_t i, engine::DataPack* out) {
+  Camera& cam = cameras_[i];
+  cam.want_image = true;
+  if (!cam.rendered) first_render(cam);
   data::Camera c;
   c.set_image_width(static_cast<uint32_t>(cam.frame.width));
   c.set_image_height(static_cast<uint32_t>(cam.frame.height));
@@ -251,9 +260,9 @@ void CameraSensors::image_datapack(size_t i, engine::DataPack* out) const {
 
 void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) {
   Camera& cam = cameras_[i];
-  if (!cam.rendered) return;
   cam.want_depth = true;
-  if (!cam.has_depth) render(cam);  // (noise redrawn: a new sample of the same view)
+  if (!cam.rendered) first_render(cam);
+  else if (!cam.has_depth) render(cam);  // (noise redrawn: a new sample of the same view)
   nlohmann::json j;
   j["width"] = cam.frame.width;
   j["height"] = cam.frame.height;
@@ -265,9 +274,9 @@ void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) {
 
 void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
   Camera& cam = cameras_[i];
-  if (!cam.rendered) return;
   cam.want_boxes = true;
-  if (!cam.has_boxes) render(cam);
+  if (!cam.rendered) first_render(cam);
+  else if (!cam.has_boxes) render(cam);
   nlohmann::json boxes = nlohmann::json::array();
   for (const auto& b : cam.frame.boxes) {
     boxes.push_back({{"model", model_names_[b.model_id - 1]},

@@ -26,11 +26,12 @@ class CameraSensors {
 
   // Renders the cameras that are due at simulated time `t` (seconds).
   void update(double t);
-  // Depth images and boxes cost extra render passes: a camera makes them only once they
-  // have been asked for (the first request renders them for the current frame).
+  // A camera renders only once one of its datapacks has been asked for (the first request
+  // renders the current view), and depth images and boxes, which cost extra passes, only
+  // once they have been asked for: a world whose cameras nobody reads costs no rendering.
 
-  // The latest frame as a convoy.data.Camera datapack (empty until the first render).
-  void image_datapack(size_t i, engine::DataPack* out) const;
+  // The latest frame as a convoy.data.Camera datapack.
+  void image_datapack(size_t i, engine::DataPack* out);
   // The latest depth image (metres, float32, H x W) as a JSON datapack
   // {"width", "height", "depth": ndarray}.
   void depth_datapack(size_t i, engine::DataPack* out);
@@ -51,7 +52,8 @@ class CameraSensors {
     render::Frame frame;
     int depth_channels = 3;
     std::vector<int16_t> noise;  // mean + stddev * N(0,1) in 0..255 units, a fixed table
-    bool want_depth = false, want_boxes = false;  // asked for once: rendered from then on
+    bool want_image = false, want_depth = false, want_boxes = false;  // asked for once:
+                                                                      // rendered from then on
     bool has_depth = false, has_boxes = false;    // the current frame has them
   };
   struct Tracked {
@@ -61,6 +63,7 @@ class CameraSensors {
   };
   void build_scene(const WorldDesc& desc);
   void render(Camera& cam);
+  void first_render(Camera& cam);  // on the first request: render now, schedule the next
   void apply_noise(Camera& cam);
 
   const PhysicsWorld& physics_;
@@ -70,6 +73,7 @@ class CameraSensors {
   std::vector<Tracked> tracked_;
   std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
   std::mt19937_64 rng_;
+  double now_ = 0;  // simulated time of the last update()
 };
 
 }  // namespace convoy::world

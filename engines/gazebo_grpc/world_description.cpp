@@ -50,6 +50,10 @@ std::vector<fs::path> model_paths(const fs::path& world_file) {
   }
   dirs.push_back(world_file.parent_path());
   dirs.push_back(world_file.parent_path() / "models");
+  // Models the build generates (e.g. road meshes from OpenDRIVE): <bin>/../share/convoy/models
+  std::error_code ec;
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back(exe.parent_path().parent_path() / "share" / "convoy" / "models");
   return dirs;
 }
 

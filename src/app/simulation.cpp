@@ -142,6 +142,8 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   }
   spec.env = ec.env_params;
   spec.env.push_back("CONVOY_RUN_DIR=" + handle.log_file().parent_path().parent_path().string());
+  spec.env.push_back("CONVOY_BIN_DIR=" + bin_dir().string());
+  spec.env.push_back("CONVOY_SHARE_DIR=" + share_dir().string());
   spec.log_file = handle.log_file();
   spec.working_dir = cfg.dir;
   spec.search_dirs = {bin_dir()};

@@ -1,0 +1,425 @@
+#include "detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "convoy/datapacks.pb.h"
+#include "transport/blobs.h"
+
+namespace convoy::detector {
+
+YoloVersion parse_yolo_version(const std::string& s) {
+  if (s == "auto" || s.empty()) return YoloVersion::kAuto;
+  if (s == "v5") return YoloVersion::kV5;
+  if (s == "v8") return YoloVersion::kV8;
+  throw std::runtime_error("YoloVersion '" + s + "': must be \"auto\", \"v5\" or \"v8\"");
+}
+
+const std::vector<std::string>& coco_class_names() {
+  static const std::vector<std::string> names = {
+      "person",        "bicycle",      "car",
+      "motorcycle",    "airplane",     "bus",
+      "train",         "truck",        "boat",
+      "traffic light", "fire hydrant", "stop sign",
+      "parking meter", "bench",        "bird",
+      "cat",           "dog",          "horse",
+      "sheep",         "cow",          "elephant",
+      "bear",          "zebra",        "giraffe",
+      "backpack",      "umbrella",     "handbag",
+      "tie",           "suitcase",     "frisbee",
+      "skis",          "snowboard",    "sports ball",
+      "kite",          "baseball bat", "baseball glove",
+      "skateboard",    "surfboard",    "tennis racket",
+      "bottle",        "wine glass",   "cup",
+      "fork",          "knife",        "spoon",
+      "bowl",          "banana",       "apple",
+      "sandwich",      "orange",       "broccoli",
+      "carrot",        "hot dog",      "pizza",
+      "donut",         "cake",         "chair",
+      "couch",         "potted plant", "bed",
+      "dining table",  "toilet",       "tv",
+      "laptop",        "mouse",        "remote",
+      "keyboard",      "cell phone",   "microwave",
+      "oven",          "toaster",      "sink",
+      "refrigerator",  "book",         "clock",
+      "vase",          "scissors",     "teddy bear",
+      "hair drier",    "toothbrush"};
+  return names;
+}
+
+std::vector<std::string> read_class_names(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("ClassNamesFile '" + path + "': cannot open");
+  std::vector<std::string> names;
+  std::string line;
+  while (std::getline(in, line)) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t'))
+      line.pop_back();
+    names.push_back(line);
+  }
+  while (!names.empty() && names.back().empty()) names.pop_back();
+  if (names.empty()) throw std::runtime_error("ClassNamesFile '" + path + "': no class names");
+  return names;
+}
+
+Letterbox compute_letterbox(int width, int height, int size) {
+  Letterbox lb;
+  lb.size = size;
+  lb.scale = std::min(static_cast<double>(size) / width, static_cast<double>(size) / height);
+  int new_w = static_cast<int>(std::lround(width * lb.scale));
+  int new_h = static_cast<int>(std::lround(height * lb.scale));
+  lb.pad_x = (size - new_w) / 2;
+  lb.pad_y = (size - new_h) / 2;
+  return lb;
+}
+
+cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb) {
+  *lb = compute_letterbox(image.cols, image.rows, size);
+  int new_w = static_cast<int>(std::lround(image.cols * lb->scale));
+  int new_h = static_cast<int>(std::lround(image.rows * lb->scale));
+  cv::Mat resized;
+  if (new_w == image.cols && new_h == image.rows)
+    resized = image;
+  else
+    cv::resize(image, resized, cv::Size(new_w, new_h), 0, 0, cv::INTER_LINEAR);
+  cv::Mat out;
+  cv::copyMakeBorder(resized, out, lb->pad_y, size - new_h - lb->pad_y, lb->pad_x,
+                     size - new_w - lb->pad_x, cv::BORDER_CONSTANT, cv::Scalar::all(114));
+  return out;
+}
+
+cv::Rect2f unletterbox(const cv::Rect2f& box, const Letterbox& lb, int width, int height) {
+  auto fx = [&](double x) {
+    return static_cast<float>(std::clamp((x - lb.pad_x) / lb.scale, 0.0, double(width)));
+  };
+  auto fy = [&](double y) {
+    return static_cast<float>(std::clamp((y - lb.pad_y) / lb.scale, 0.0, double(height)));
+  };
+  float x0 = fx(box.x), y0 = fy(box.y), x1 = fx(box.x + box.width), y1 = fy(box.y + box.height);
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+std::vector<Detection> decode_yolo(const cv::Mat& output, YoloVersion version,
+                                   float conf_threshold, int num_classes,
+                                   YoloVersion* detected) {
+  // Drop leading singleton dimensions down to 2.
+  std::vector<int> dims(output.size.p, output.size.p + output.dims);
+  while (dims.size() > 2 && dims.front() == 1) dims.erase(dims.begin());
+  if (dims.size() != 2)
+    throw std::runtime_error("YOLO output has an unexpected shape (dims " +
+                             std::to_string(output.dims) + ")");
+  if (output.depth() != CV_32F) throw std::runtime_error("YOLO output is not float32");
+  cv::Mat m = cv::Mat(dims[0], dims[1], CV_32F, const_cast<void*>(
+                                                    static_cast<const void*>(output.ptr())));
+  if (!output.isContinuous()) m = m.clone();
+  const int rows = m.rows, cols = m.cols;
+  if (version == YoloVersion::kAuto) {
+    if (num_classes > 0 && cols == 5 + num_classes && rows != 4 + num_classes)
+      version = YoloVersion::kV5;
+    else if (num_classes > 0 && rows == 4 + num_classes && cols != 5 + num_classes)
+      version = YoloVersion::kV8;
+    else
+      version = rows < cols ? YoloVersion::kV8 : YoloVersion::kV5;
+  }
+  if (detected) *detected = version;
+  cv::Mat pred;  // [N, attrs]
+  if (version == YoloVersion::kV8)
+    cv::transpose(m, pred);
+  else
+    pred = m;
+  const int first_cls = version == YoloVersion::kV5 ? 5 : 4;
+  if (pred.cols <= first_cls)
+    throw std::runtime_error("YOLO output has " + std::to_string(pred.cols) +
+                             " values per box, too few for " +
+                             (version == YoloVersion::kV5 ? "v5" : "v8"));
+  std::vector<Detection> out;
+  for (int i = 0; i < pred.rows; ++i) {
+    const float* r = pred.ptr<float>(i);
+    int best = 0;
+    float best_score = r[first_cls];
+    for (int c = first_cls + 1; c < pred.cols; ++c) {
+      if (r[c] > best_score) {
+        best_score = r[c];
+        best = c - first_cls;
+      }
+    }
+    float score = version == YoloVersion::kV5 ? r[4] * best_score : best_score;
+    if (!(score > conf_threshold)) continue;
+    Detection d;
+    d.class_id = best;
+    d.confidence = score;
+    d.x_min = r[0] - r[2] / 2;
+    d.y_min = r[1] - r[3] / 2;
+    d.x_max = r[0] + r[2] / 2;
+    d.y_max = r[1] + r[3] / 2;
+    out.push_back(d);
+  }
+  return out;
+}
+
+void sort_by_confidence(std::vector<Detection>* dets) {
+  std::stable_sort(dets->begin(), dets->end(), [](const Detection& a, const Detection& b) {
+    return a.confidence > b.confidence;
+  });
+}
+
+std::vector<Detection> nms_per_class(const std::vector<Detection>& candidates,
+                                     float conf_threshold, float nms_threshold) {
+  std::map<int, std::vector<size_t>> by_class;
+  for (size_t i = 0; i < candidates.size(); ++i) by_class[candidates[i].class_id].push_back(i);
+  std::vector<Detection> kept;
+  for (const auto& [cls, idx] : by_class) {
+    std::vector<cv::Rect2d> boxes;
+    std::vector<float> scores;
+    for (size_t i : idx) {
+      const Detection& d = candidates[i];
+      boxes.emplace_back(d.x_min, d.y_min, d.x_max - d.x_min, d.y_max - d.y_min);
+      scores.push_back(d.confidence);
+    }
+    std::vector<int> keep;
+    // The threshold is already applied; NMSBoxes filters with score > threshold.
+    cv::dnn::NMSBoxes(boxes, scores, std::min(conf_threshold, 0.0f) - 1.0f, nms_threshold, keep);
+    for (int k : keep) kept.push_back(candidates[idx[k]]);
+  }
+  sort_by_confidence(&kept);
+  return kept;
+}
+
+void name_classes(std::vector<Detection>* dets, const std::vector<std::string>& names) {
+  for (auto& d : *dets) {
+    if (d.class_id >= 0 && static_cast<size_t>(d.class_id) < names.size())
+      d.class_name = names[d.class_id];
+    else
+      d.class_name = "class_" + std::to_string(d.class_id);
+  }
+}
+
+YoloDetector::YoloDetector(YoloOptions options) : options_(std::move(options)) {
+  if (options_.model_path.empty()) throw std::runtime_error("Backend yolo needs ModelPath");
+  if (!std::filesystem::exists(options_.model_path))
+    throw std::runtime_error("ModelPath '" + options_.model_path + "': no such file");
+  if (options_.input_size <= 0 || options_.input_size % 32 != 0)
+    throw std::runtime_error("InputSize " + std::to_string(options_.input_size) +
+                             ": must be a positive multiple of 32");
+  try {
+    net_ = cv::dnn::readNetFromONNX(options_.model_path);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("ModelPath '" + options_.model_path +
+                             "': cannot read ONNX model: " + e.what());
+  }
+  if (net_.empty())
+    throw std::runtime_error("ModelPath '" + options_.model_path +
+                             "': cannot read ONNX model: empty network");
+  net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+  net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+}
+
+std::vector<Detection> YoloDetector::detect(const cv::Mat& image) {
+  cv::Mat rgb = image;
+  if (image.channels() == 1) cv::cvtColor(image, rgb, cv::COLOR_GRAY2RGB);
+  Letterbox lb;
+  cv::Mat input = letterbox_image(rgb, options_.input_size, &lb);
+  cv::Mat blob = cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), false,
+                                        false, CV_32F);
+  net_.setInput(blob);
+  cv::Mat output;
+  try {
+    output = net_.forward();
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("ModelPath '" + options_.model_path +
+                             "': inference failed: " + e.what());
+  }
+  auto candidates = decode_yolo(output, options_.version, options_.conf_threshold,
+                                static_cast<int>(options_.class_names.size()));
+  auto dets = nms_per_class(candidates, options_.conf_threshold, options_.nms_threshold);
+  for (auto& d : dets) {
+    cv::Rect2f r = unletterbox({d.x_min, d.y_min, d.x_max - d.x_min, d.y_max - d.y_min}, lb,
+                               image.cols, image.rows);
+    d.x_min = r.x;
+    d.y_min = r.y;
+    d.x_max = r.x + r.width;
+    d.y_max = r.y + r.height;
+  }
+  name_classes(&dets, options_.class_names);
+  return dets;
+}
+
+HogDetector::HogDetector() { hog_.setSVMDetector(cv::HOGDescriptor::getDefaultPeopleDetector()); }
+
+std::vector<Detection> HogDetector::detect(const cv::Mat& image) {
+  cv::Mat grey;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_RGB2GRAY);
+  else
+    grey = image;
+  std::vector<Detection> dets;
+  if (grey.cols < hog_.winSize.width || grey.rows < hog_.winSize.height) return dets;
+  std::vector<cv::Rect> found;
+  std::vector<double> weights;
+  hog_.detectMultiScale(grey, found, weights);
+  for (size_t i = 0; i < found.size(); ++i) {
+    cv::Rect r = found[i] & cv::Rect(0, 0, image.cols, image.rows);
+    Detection d;
+    d.class_id = 0;
+    d.class_name = "person";
+    d.confidence = i < weights.size() ? static_cast<float>(weights[i]) : 1.0f;
+    d.x_min = static_cast<float>(r.x);
+    d.y_min = static_cast<float>(r.y);
+    d.x_max = static_cast<float>(r.x + r.width);
+    d.y_max = static_cast<float>(r.y + r.height);
+    dets.push_back(d);
+  }
+  sort_by_confidence(&dets);
+  return dets;
+}
+
+std::vector<Detection> detections_from_boxes(const nlohmann::json& j,
+                                             const std::vector<std::string>& names) {
+  std::vector<Detection> dets;
+  const nlohmann::json& boxes = j.is_object() ? j.value("boxes", nlohmann::json::array()) : j;
+  if (!boxes.is_array()) throw std::runtime_error("datapack 'boxes': \"boxes\" is not a list");
+  for (const auto& b : boxes) {
+    Detection d;
+    d.class_name = b.value("class", std::string());
+    auto it = std::find(names.begin(), names.end(), d.class_name);
+    d.class_id = it == names.end() ? -1 : static_cast<int>(it - names.begin());
+    d.confidence = 1.0f;
+    d.x_min = b.value("x_min", 0.0f);
+    d.y_min = b.value("y_min", 0.0f);
+    d.x_max = b.value("x_max", 0.0f);
+    d.y_max = b.value("y_max", 0.0f);
+    dets.push_back(d);
+  }
+  return dets;
+}
+
+namespace {
+
+cv::Mat make_image(int height, int width, size_t bytes, const uint8_t* data,
+                   const std::string& what) {
+  if (height <= 0 || width <= 0) return {};
+  size_t pixels = static_cast<size_t>(height) * width;
+  if (bytes == 0) return {};
+  if (bytes % pixels != 0)
+    throw std::runtime_error(what + ": " + std::to_string(bytes) + " bytes for a " +
+                             std::to_string(width) + "x" + std::to_string(height) + " image");
+  size_t depth = bytes / pixels;
+  cv::Mat out;
+  if (depth == 1 || depth == 3) {
+    out = cv::Mat(height, width, depth == 1 ? CV_8UC1 : CV_8UC3);
+    std::memcpy(out.data, data, bytes);
+  } else if (depth == 4) {
+    cv::Mat rgba(height, width, CV_8UC4, const_cast<uint8_t*>(data));
+    cv::cvtColor(rgba, out, cv::COLOR_RGBA2RGB);
+  } else {
+    throw std::runtime_error(what + ": unsupported image depth " + std::to_string(depth));
+  }
+  return out;
+}
+
+cv::Mat image_from_json(const engine::DataPack& dp) {
+  const std::string& raw = dp.json_msgpack();
+  nlohmann::json j = nlohmann::json::from_msgpack(raw.begin(), raw.end());
+  const std::string what = "datapack '" + dp.id().name() + "'";
+  if (!j.is_object() || !j.contains("current_image_frame"))
+    throw std::runtime_error(what + ": needs c_imageHeight, c_imageWidth, current_image_frame");
+  int h = j.value("c_imageHeight", 0);
+  int w = j.value("c_imageWidth", 0);
+  const auto& frame = j["current_image_frame"];
+  if (frame.is_array()) {
+    std::vector<uint8_t> bytes;
+    bytes.reserve(frame.size());
+    for (const auto& v : frame) bytes.push_back(static_cast<uint8_t>(v.get<int>()));
+    return make_image(h, w, bytes.size(), bytes.data(), what);
+  }
+  if (!frame.is_binary())
+    throw std::runtime_error(what + ": current_image_frame must be a list or a numpy array");
+  const auto& bin = frame.get_binary();
+  if (!bin.has_subtype() || (bin.subtype() != 1 && bin.subtype() != 2))
+    throw std::runtime_error(what + ": current_image_frame is not a numpy array");
+  const uint8_t* b = bin.data();
+  const uint8_t* e = b + bin.size();
+  auto bad = [&] { return std::runtime_error(what + ": bad numpy array header"); };
+  if (e - b < 2) throw bad();
+  size_t dlen = *b++;
+  if (static_cast<size_t>(e - b) < dlen + 1) throw bad();
+  std::string dtype(reinterpret_cast<const char*>(b), dlen);
+  b += dlen;
+  size_t ndim = *b++;
+  if (static_cast<size_t>(e - b) < ndim * 8) throw bad();
+  std::vector<uint64_t> shape(ndim);
+  for (size_t i = 0; i < ndim; ++i) {
+    uint64_t d = 0;
+    for (int k = 7; k >= 0; --k) d = (d << 8) | b[k];
+    shape[i] = d;
+    b += 8;
+  }
+  if (dtype != "|u1" && dtype != "<u1" && dtype != "u1" && dtype != "B")
+    throw std::runtime_error(what + ": current_image_frame dtype '" + dtype +
+                             "' is not supported (needs uint8)");
+  std::string_view data(reinterpret_cast<const char*>(b), static_cast<size_t>(e - b));
+  if (bin.subtype() == 2) {
+    if (data.size() != 4) throw bad();
+    uint32_t index = (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3];
+    data = transport::current_blob_reader().get(dp, index);
+  }
+  if (ndim >= 2 && (h <= 0 || w <= 0)) {
+    h = static_cast<int>(shape[0]);
+    w = static_cast<int>(shape[1]);
+  }
+  return make_image(h, w, data.size(), reinterpret_cast<const uint8_t*>(data.data()), what);
+}
+
+cv::Mat image_from_proto(const engine::DataPack& dp) {
+  const std::string what = "datapack '" + dp.id().name() + "'";
+  if (dp.proto().type_name() != "convoy.data.Camera")
+    throw std::runtime_error(what + ": protobuf type '" + dp.proto().type_name() +
+                             "' is not convoy.data.Camera");
+  data::Camera cam;
+  if (!cam.ParseFromString(dp.proto().data()))
+    throw std::runtime_error(what + ": cannot parse convoy.data.Camera");
+  std::string_view bytes = cam.image_data();
+  if (cam.image_blob() > 0) bytes = transport::current_blob_reader().get(dp, cam.image_blob() - 1);
+  size_t expected =
+      static_cast<size_t>(cam.image_height()) * cam.image_width() * cam.image_depth();
+  if (cam.image_depth() != 0 && bytes.size() != expected)
+    throw std::runtime_error(what + ": " + std::to_string(bytes.size()) + " bytes, expected " +
+                             std::to_string(expected));
+  return make_image(static_cast<int>(cam.image_height()), static_cast<int>(cam.image_width()),
+                    bytes.size(), reinterpret_cast<const uint8_t*>(bytes.data()), what);
+}
+
+}  // namespace
+
+cv::Mat image_from_datapack(const engine::DataPack& dp) {
+  switch (dp.payload_case()) {
+    case engine::DataPack::kProto:
+      return image_from_proto(dp);
+    case engine::DataPack::kJsonMsgpack:
+      return image_from_json(dp);
+    default:
+      return {};
+  }
+}
+
+nlohmann::json detections_json(const std::vector<Detection>& dets) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& d : dets) {
+    list.push_back({{"class", d.class_name},
+                    {"class_id", d.class_id},
+                    {"confidence", d.confidence},
+                    {"x_min", d.x_min},
+                    {"y_min", d.y_min},
+                    {"x_max", d.x_max},
+                    {"y_max", d.y_max}});
+  }
+  return list;
+}
+
+}  // namespace convoy::detector
