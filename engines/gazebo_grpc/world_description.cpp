@@ -382,13 +382,16 @@ class Loader {
   sdf::ParserConfig config() const {
     sdf::ParserConfig cfg;
     auto paths = paths_;
+    // Only a find callback: sdformat's own URI path list stops at the first folder, even
+    // when the model is not in it.
     cfg.SetFindCallback([paths](const std::string& uri) -> std::string {
+      const std::string scheme = "model://";
+      std::string rest = uri.rfind(scheme, 0) == 0 ? uri.substr(scheme.size()) : uri;
       for (const auto& dir : paths) {
-        if (fs::exists(dir / uri)) return (dir / uri).string();
+        if (fs::exists(dir / rest)) return (dir / rest).string();
       }
       return "";
     });
-    for (const auto& dir : paths_) cfg.AddURIPath("model://", dir.string());
     return cfg;
   }
 

@@ -1,0 +1,62 @@
+"""End-to-end tests of the autonomous-driving experiment (control only so far): the smart
+car follows the Parkring lane, and two runs give identical trajectories.
+
+Run with Debian's /usr/bin/python3 -m unittest test_autonomous_driving."""
+
+import csv
+import math
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+from test_core import BIN_DIR, CONVOY
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+EXP = os.path.join(REPO, "experiments", "autonomous_driving")
+WAYPOINTS = os.path.join(os.path.dirname(BIN_DIR), "share", "convoy", "models", "parkring_road",
+                         "waypoints_lane-1.csv")
+
+
+def cross_track(points, lane):
+    def dist(p):
+        best = 1e9
+        for i in range(len(lane)):
+            (ax, ay), (bx, by) = lane[i], lane[(i + 1) % len(lane)]
+            dx, dy = bx - ax, by - ay
+            t = max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / (dx * dx + dy * dy)))
+            best = min(best, math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy))
+        return best
+    return [dist(p) for p in points]
+
+
+class ControlOnly(unittest.TestCase):
+    def run_control(self, seconds):
+        d = tempfile.mkdtemp(prefix="convoy-ad-")
+        self.addCleanup(shutil.rmtree, d, True)
+        r = subprocess.run([CONVOY, "run", "-q", "-c", os.path.join(EXP, "simulation_config_control.json"),
+                            "--run-dir", os.path.join(d, "run"), "-o", "SimulationTimeout=%g" % seconds],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(d, "run", "trajectory.csv"), "rb") as f:
+            return f.read()
+
+    def test_car_follows_the_lane_and_runs_are_identical(self):
+        a = self.run_control(25)
+        b = self.run_control(25)
+        self.assertEqual(a, b, "two control-only runs differ")
+        rows = list(csv.DictReader(a.decode().splitlines()))
+        self.assertEqual(len(rows), 1250)
+        last = rows[-1]
+        self.assertGreater(int(last["target_index"]), 55)  # ~130 m along the lane
+        with open(WAYPOINTS) as f:
+            lane = [(float(r["x"]), float(r["y"])) for r in csv.DictReader(f)]
+        errors = cross_track([(float(r["x"]), float(r["y"])) for r in rows[::25]], lane)
+        self.assertLess(sum(errors) / len(errors), 0.3)
+        self.assertLess(max(errors), 1.0)
+
+
+if __name__ == "__main__":
+    unittest.main()
