@@ -126,12 +126,18 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
             parts.emplace_back(
                 render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z()), material);
             break;
-          case Shape::kCylinder:
-            parts.emplace_back(render::make_cylinder(v.shape.size.x(), v.shape.size.z()), material);
+          case Shape::kCylinder: {
+            // Tessellation grows with size: thin posts need few segments.
+            int segments = std::clamp(static_cast<int>(12 + 20 * v.shape.size.x()), 12, 32);
+            parts.emplace_back(render::make_cylinder(v.shape.size.x(), v.shape.size.z(), segments),
+                               material);
             break;
-          case Shape::kSphere:
-            parts.emplace_back(render::make_sphere(v.shape.size.x()), material);
+          }
+          case Shape::kSphere: {
+            int stacks = std::clamp(static_cast<int>(8 + 2 * v.shape.size.x()), 8, 16);
+            parts.emplace_back(render::make_sphere(v.shape.size.x(), stacks, 2 * stacks), material);
             break;
+          }
           case Shape::kPlane: {
             double sx = v.shape.size.x() > 0 ? v.shape.size.x() : 1000;
             double sy = v.shape.size.y() > 0 ? v.shape.size.y() : 1000;
