@@ -22,34 +22,33 @@ YoloVersion parse_yolo_version(const std::string& s) {
 }
 
 const std::vector<std::string>& coco_class_names() {
-  static const std::vector<std::string> names = {
-      "person",        "bicycle",      "car",
-      "motorcycle",    "airplane",     "bus",
-      "train",         "truck",        "boat",
-      "traffic light", "fire hydrant", "stop sign",
-      "parking meter", "bench",        "bird",
-      "cat",           "dog",          "horse",
-      "sheep",         "cow",          "elephant",
-      "bear",          "zebra",        "giraffe",
-      "backpack",      "umbrella",     "handbag",
-      "tie",           "suitcase",     "frisbee",
-      "skis",          "snowboard",    "sports ball",
-      "kite",          "baseball bat", "baseball glove",
-      "skateboard",    "surfboard",    "tennis racket",
-      "bottle",        "wine glass",   "cup",
-      "fork",          "knife",        "spoon",
-      "bowl",          "banana",       "apple",
-      "sandwich",      "orange",       "broccoli",
-      "carrot",        "hot dog",      "pizza",
-      "donut",         "cake",         "chair",
-      "couch",         "potted plant", "bed",
-      "dining table",  "toilet",       "tv",
-      "laptop",        "mouse",        "remote",
-      "keyboard",      "cell phone",   "microwave",
-      "oven",          "toaster",      "sink",
-      "refrigerator",  "book",         "clock",
-      "vase",          "scissors",     "teddy bear",
-      "hair drier",    "toothbrush"};
+  static const std::vector<std::string> names = {"person",        "bicycle",      "car",
+                                                 "motorcycle",    "airplane",     "bus",
+                                                 "train",         "truck",        "boat",
+                                                 "traffic light", "fire hydrant", "stop sign",
+                                                 "parking meter", "bench",        "bird",
+                                                 "cat",           "dog",          "horse",
+                                                 "sheep",         "cow",          "elephant",
+                                                 "bear",          "zebra",        "giraffe",
+                                                 "backpack",      "umbrella",     "handbag",
+                                                 "tie",           "suitcase",     "frisbee",
+                                                 "skis",          "snowboard",    "sports ball",
+                                                 "kite",          "baseball bat", "baseball glove",
+                                                 "skateboard",    "surfboard",    "tennis racket",
+                                                 "bottle",        "wine glass",   "cup",
+                                                 "fork",          "knife",        "spoon",
+                                                 "bowl",          "banana",       "apple",
+                                                 "sandwich",      "orange",       "broccoli",
+                                                 "carrot",        "hot dog",      "pizza",
+                                                 "donut",         "cake",         "chair",
+                                                 "couch",         "potted plant", "bed",
+                                                 "dining table",  "toilet",       "tv",
+                                                 "laptop",        "mouse",        "remote",
+                                                 "keyboard",      "cell phone",   "microwave",
+                                                 "oven",          "toaster",      "sink",
+                                                 "refrigerator",  "book",         "clock",
+                                                 "vase",          "scissors",     "teddy bear",
+                                                 "hair drier",    "toothbrush"};
   return names;
 }
 
@@ -105,9 +104,8 @@ cv::Rect2f unletterbox(const cv::Rect2f& box, const Letterbox& lb, int width, in
   return {x0, y0, x1 - x0, y1 - y0};
 }
 
-std::vector<Detection> decode_yolo(const cv::Mat& output, YoloVersion version,
-                                   float conf_threshold, int num_classes,
-                                   YoloVersion* detected) {
+std::vector<Detection> decode_yolo(const cv::Mat& output, YoloVersion version, float conf_threshold,
+                                   int num_classes, YoloVersion* detected) {
   // Drop leading singleton dimensions down to 2.
   std::vector<int> dims(output.size.p, output.size.p + output.dims);
   while (dims.size() > 2 && dims.front() == 1) dims.erase(dims.begin());
@@ -115,8 +113,8 @@ std::vector<Detection> decode_yolo(const cv::Mat& output, YoloVersion version,
     throw std::runtime_error("YOLO output has an unexpected shape (dims " +
                              std::to_string(output.dims) + ")");
   if (output.depth() != CV_32F) throw std::runtime_error("YOLO output is not float32");
-  cv::Mat m = cv::Mat(dims[0], dims[1], CV_32F, const_cast<void*>(
-                                                    static_cast<const void*>(output.ptr())));
+  cv::Mat m =
+      cv::Mat(dims[0], dims[1], CV_32F, const_cast<void*>(static_cast<const void*>(output.ptr())));
   if (!output.isContinuous()) m = m.clone();
   const int rows = m.rows, cols = m.cols;
   if (version == YoloVersion::kAuto) {
@@ -169,8 +167,8 @@ void sort_by_confidence(std::vector<Detection>* dets) {
   });
 }
 
-std::vector<Detection> nms_per_class(const std::vector<Detection>& candidates,
-                                     float conf_threshold, float nms_threshold) {
+std::vector<Detection> nms_per_class(const std::vector<Detection>& candidates, float conf_threshold,
+                                     float nms_threshold) {
   std::map<int, std::vector<size_t>> by_class;
   for (size_t i = 0; i < candidates.size(); ++i) by_class[candidates[i].class_id].push_back(i);
   std::vector<Detection> kept;
@@ -183,8 +181,8 @@ std::vector<Detection> nms_per_class(const std::vector<Detection>& candidates,
       scores.push_back(d.confidence);
     }
     std::vector<int> keep;
-    // The threshold is already applied; NMSBoxes filters with score > threshold.
-    cv::dnn::NMSBoxes(boxes, scores, std::min(conf_threshold, 0.0f) - 1.0f, nms_threshold, keep);
+    // NMSBoxes also drops scores <= the threshold (which must not be negative).
+    cv::dnn::NMSBoxes(boxes, scores, std::max(conf_threshold, 0.0f), nms_threshold, keep);
     for (int k : keep) kept.push_back(candidates[idx[k]]);
   }
   sort_by_confidence(&kept);
@@ -225,8 +223,8 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& image) {
   if (image.channels() == 1) cv::cvtColor(image, rgb, cv::COLOR_GRAY2RGB);
   Letterbox lb;
   cv::Mat input = letterbox_image(rgb, options_.input_size, &lb);
-  cv::Mat blob = cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), false,
-                                        false, CV_32F);
+  cv::Mat blob =
+      cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), false, false, CV_32F);
   net_.setInput(blob);
   cv::Mat output;
   try {
@@ -386,8 +384,7 @@ cv::Mat image_from_proto(const engine::DataPack& dp) {
     throw std::runtime_error(what + ": cannot parse convoy.data.Camera");
   std::string_view bytes = cam.image_data();
   if (cam.image_blob() > 0) bytes = transport::current_blob_reader().get(dp, cam.image_blob() - 1);
-  size_t expected =
-      static_cast<size_t>(cam.image_height()) * cam.image_width() * cam.image_depth();
+  size_t expected = static_cast<size_t>(cam.image_height()) * cam.image_width() * cam.image_depth();
   if (cam.image_depth() != 0 && bytes.size() != expected)
     throw std::runtime_error(what + ": " + std::to_string(bytes.size()) + " bytes, expected " +
                              std::to_string(expected));

@@ -49,12 +49,11 @@ cv::Rect2f unletterbox(const cv::Rect2f& box, const Letterbox& lb, int width, in
 // Decodes a raw YOLO output (leading singleton dimensions are ignored, the rest is
 // [N, 5+C] for v5 or [4+C, N] for v8). `num_classes` (0: unknown) helps the auto detection.
 // Returns candidates above `conf_threshold`, boxes in network coordinates.
-std::vector<Detection> decode_yolo(const cv::Mat& output, YoloVersion version,
-                                   float conf_threshold, int num_classes = 0,
-                                   YoloVersion* detected = nullptr);
+std::vector<Detection> decode_yolo(const cv::Mat& output, YoloVersion version, float conf_threshold,
+                                   int num_classes = 0, YoloVersion* detected = nullptr);
 // Per-class non-maximum suppression (cv::dnn::NMSBoxes); result sorted by confidence desc.
-std::vector<Detection> nms_per_class(const std::vector<Detection>& candidates,
-                                     float conf_threshold, float nms_threshold);
+std::vector<Detection> nms_per_class(const std::vector<Detection>& candidates, float conf_threshold,
+                                     float nms_threshold);
 void sort_by_confidence(std::vector<Detection>* dets);
 // Fills class_name from `names` ("class_<k>" when out of range).
 void name_classes(std::vector<Detection>* dets, const std::vector<std::string>& names);

@@ -1,4 +1,5 @@
-// EngineType "detector" (registered in detector_engine.cpp): runs an object detector on the latest camera image.
+// EngineType "detector" (registered in detector_engine.cpp): runs an object detector on the latest
+// camera image.
 //
 // Config keys (schema.json):
 //   Backend             "ground_truth" (default) | "yolo" | "hog"
@@ -35,8 +36,8 @@ class DetectorEngine final : public Engine {
     name_ = name;
     backend_ = config.value("Backend", std::string("ground_truth"));
     std::string names_file = config.value("ClassNamesFile", std::string());
-    names_ = names_file.empty() ? detector::coco_class_names()
-                                : detector::read_class_names(names_file);
+    names_ =
+        names_file.empty() ? detector::coco_class_names() : detector::read_class_names(names_file);
     if (backend_ == "yolo") {
       detector::YoloOptions o;
       o.model_path = config.value("ModelPath", std::string());
