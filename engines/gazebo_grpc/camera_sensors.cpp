@@ -62,7 +62,7 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
   for (const auto& model : desc.models)
     for (const auto& link : model.links)
       for (const auto& cam : link.cameras)
-        cameras_.push_back({&cam, physics.link_index(link.name), 0, false, {}, 3});
+        cameras_.push_back({&cam, physics.link_index(link.name), 0, 0, false, {}, 3});
   if (cameras_.empty()) return;
   renderer_ = std::make_unique<render::Renderer>();
   build_scene(desc);
@@ -111,10 +111,23 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
     ++model_id;
     model_names_.push_back(model.name);
     model_classes_.push_back(class_of(model.name));
-    bool only_planes = true;
-    for (const auto& link : model.links)
-      for (const auto& v : link.visuals) only_planes &= v.shape.kind == Shape::kPlane;
-    uint32_t label = only_planes ? 0 : model_id;  // the ground gets no box
+    // The ground gets no box: a model that shows only planes, or a static one that collides
+    // only as planes (a road mesh on a ground plane).
+    bool visual_planes = true, collision_planes = true, collides = false;
+    for (const auto& link : model.links) {
+      for (const auto& v : link.visuals) visual_planes &= v.shape.kind == Shape::kPlane;
+      for (const auto& c : link.collisions) {
+        collides = true;
+        collision_planes &= c.shape.kind == Shape::kPlane;
+      }
+    }
+    bool ground = visual_planes || (model.is_static && collides && collision_planes);
+    uint32_t label = ground ? 0 : model_id;
+    for (auto& cam : cameras_) {
+      for (const auto& link : model.links)
+        for (const auto& c : link.cameras)
+          if (&c == cam.desc) cam.own_model = model_id;
+    }
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
       for (const auto& v : link.visuals) {
@@ -285,6 +298,7 @@ void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
   else if (!cam.has_boxes) render(cam);
   nlohmann::json boxes = nlohmann::json::array();
   for (const auto& b : cam.frame.boxes) {
+    if (b.model_id == cam.own_model) continue;  // the camera's own vehicle
     boxes.push_back({{"model", model_names_[b.model_id - 1]},
                      {"class", model_classes_[b.model_id - 1]},
                      {"instance", b.model_id},

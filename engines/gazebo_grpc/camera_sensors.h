@@ -36,7 +36,8 @@ class CameraSensors {
   // {"width", "height", "depth": ndarray}.
   void depth_datapack(size_t i, engine::DataPack* out);
   // The latest ground truth as a JSON datapack: {"boxes": [{"model", "class", "instance",
-  // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}.
+  // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}: every visible model but the ground
+  // and the camera's own.
   void boxes_datapack(size_t i, engine::DataPack* out);
 
   // The object class of a model: its <convoy:class> element if any, else its name without
@@ -47,6 +48,7 @@ class CameraSensors {
   struct Camera {
     const CameraDesc* desc;
     int link;  // physics link index
+    uint32_t own_model = 0;  // the model carrying the camera: not in its ground truth
     double next_update = 0;
     bool rendered = false;
     render::Frame frame;

@@ -1,0 +1,180 @@
+"""Evaluator engine: writes the run's outputs into the run folder ($CONVOY_RUN_DIR).
+
+  camera.mp4       the camera with the detector's boxes, labels and confidences drawn (also
+                   shown live in a window when a display exists)
+  birds_eye.png    the driven path over the road and the reference waypoints
+  summary.json     lap, cross-track error, real-time factor, camera frames/s, detections per
+                   class, the detector's precision and recall against ground truth
+Progress goes to the log every simulated 5 s."""
+import csv
+import json
+import math
+import os
+import time
+
+import cv2
+import numpy as np
+from nrp_core.engines.python_json import EngineScript
+
+import relateAngle_computation
+
+# Ground-truth classes (model names) as the detector's (COCO) classes; only these are scored.
+TRUTH_TO_DETECTOR = {"pedestrian": "person", "car": "car", "bus": "bus"}
+SCORED = set(TRUTH_TO_DETECTOR) | set(TRUTH_TO_DETECTOR.values())
+IOU_MATCH = 0.5
+MIN_PIXELS = 150  # objects (and detections) smaller than this in the image are not scored
+FPS = 30
+
+
+def iou(a, b):
+    ix = max(0, min(a[2], b[2]) - max(a[0], b[0]) + 1)
+    iy = max(0, min(a[3], b[3]) - max(a[1], b[1]) + 1)
+    inter = ix * iy
+    ua = (a[2] - a[0] + 1) * (a[3] - a[1] + 1) + (b[2] - b[0] + 1) * (b[3] - b[1] + 1) - inter
+    return inter / ua if ua > 0 else 0.0
+
+
+class Script(EngineScript):
+    def initialize(self):
+        self._registerDataPack("observation")
+        self.dir = os.environ.get("CONVOY_RUN_DIR", ".")
+        self.video = None
+        self.window = bool(os.environ.get("DISPLAY"))
+        self.frames = 0
+        self.last_frame_key = None
+        self.path = []
+        self.per_class = {}
+        self.tp = self.fp = self.fn = 0
+        self.wall0 = time.perf_counter()
+        self.lane = relateAngle_computation.load_waypoints()
+
+    def _draw(self, img, dets):
+        for d in dets:
+            p1, p2 = (int(d["x_min"]), int(d["y_min"])), (int(d["x_max"]), int(d["y_max"]))
+            cv2.rectangle(img, p1, p2, (0, 255, 255), 2)
+            label = "%s %.2f" % (d["class"], d["confidence"])
+            cv2.putText(img, label, (p1[0], max(12, p1[1] - 4)), cv2.FONT_HERSHEY_SIMPLEX, 0.45,
+                        (0, 255, 255), 1, cv2.LINE_AA)
+
+    def _score(self, dets, truth):
+        wanted = [t for t in truth if t["class"] in TRUTH_TO_DETECTOR and t["pixels"] >= MIN_PIXELS]
+        used = set()
+        for d in dets:
+            area = (d["x_max"] - d["x_min"] + 1) * (d["y_max"] - d["y_min"] + 1)
+            if d["class"] not in SCORED or area < MIN_PIXELS:
+                continue
+            best, best_i = 0.0, None
+            for i, t in enumerate(wanted):
+                if i in used or d["class"] not in (t["class"], TRUTH_TO_DETECTOR[t["class"]]):
+                    continue
+                v = iou((d["x_min"], d["y_min"], d["x_max"], d["y_max"]),
+                        (t["x_min"], t["y_min"], t["x_max"], t["y_max"]))
+                if v > best:
+                    best, best_i = v, i
+            if best >= IOU_MATCH:
+                used.add(best_i)
+                self.tp += 1
+            else:
+                self.fp += 1
+        self.fn += len(wanted) - len(used)
+
+    def runLoop(self, timestep_ns):
+        obs = self._getDataPack("observation")
+        if obs is None:
+            return
+        if "x" in obs:
+            self.path.append((self._time_ns * 1e-9, obs["x"], obs["y"]))
+        det = obs.get("detections")
+        frame = obs.get("frame")
+        # a new camera frame (30 Hz) differs from the last one (its noise does, at least)
+        key = None if frame is None else hash(frame[::29, ::31].tobytes())
+        if frame is not None and det is not None and key != self.last_frame_key:
+            self.last_frame_key = key
+            dets = det.get("detections", [])
+            for d in dets:
+                self.per_class[d["class"]] = self.per_class.get(d["class"], 0) + 1
+            self._score(dets, obs.get("truth", []))
+            img = cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2BGR)
+            self._draw(img, dets)
+            if self.video is None:
+                h, w = img.shape[:2]
+                self.video = cv2.VideoWriter(os.path.join(self.dir, "camera.mp4"),
+                                             cv2.VideoWriter_fourcc(*"mp4v"), FPS, (w, h))
+            self.video.write(img)
+            self.frames += 1
+            if self.window:
+                try:
+                    cv2.imshow("detected image", img)
+                    cv2.waitKey(1)
+                except cv2.error:
+                    self.window = False
+        if self._time_ns % 5_000_000_000 == 0 and self.path:
+            print("t=%6.1f s  frames %d  detections %s" % (self._time_ns * 1e-9, self.frames,
+                                                           json.dumps(self.per_class)), flush=True)
+
+    def _birds_eye(self, path):
+        pts = np.array([(x, y) for x, y in self.lane] + [(x, y) for _, x, y in self.path] or [(0, 0)])
+        lo, hi = pts.min(axis=0) - 15, pts.max(axis=0) + 15
+        scale = 1000.0 / max(hi - lo)
+        size = (int((hi[1] - lo[1]) * scale) + 1, int((hi[0] - lo[0]) * scale) + 1)
+        img = np.full(size + (3,), 255, np.uint8)
+
+        def px(x, y):
+            return int((x - lo[0]) * scale), int((hi[1] - y) * scale)
+
+        road = np.array([px(x, y) for x, y in self.lane], np.int32)
+        cv2.polylines(img, [road], True, (200, 200, 200), max(2, int(7.0 * scale)))
+        cv2.polylines(img, [road], True, (0, 160, 0), 1)
+        if len(self.path) > 1:
+            cv2.polylines(img, [np.array([px(x, y) for _, x, y in self.path], np.int32)], False,
+                          (0, 0, 220), 2)
+        cv2.putText(img, "reference waypoints (green), driven path (red)", (10, 24),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.6, (0, 0, 0), 1, cv2.LINE_AA)
+        cv2.imwrite(path, img)
+
+    def _cross_track(self):
+        lane = self.lane
+        errors = []
+        for _, x, y in self.path[::5]:
+            best = 1e9
+            for i in range(len(lane)):
+                (ax, ay), (bx, by) = lane[i], lane[(i + 1) % len(lane)]
+                dx, dy = bx - ax, by - ay
+                t = max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / (dx * dx + dy * dy)))
+                best = min(best, math.hypot(x - ax - t * dx, y - ay - t * dy))
+            errors.append(best)
+        return errors
+
+    def shutdown(self):
+        if self.video is not None:
+            self.video.release()
+        self._birds_eye(os.path.join(self.dir, "birds_eye.png"))
+        wall = time.perf_counter() - self.wall0
+        sim = self._time_ns * 1e-9
+        control = {}
+        try:
+            with open(os.path.join(self.dir, "control_summary.json")) as f:
+                control = json.load(f)
+        except OSError:
+            pass
+        errors = self._cross_track()
+        summary = {
+            "lap_completed": control.get("lap_completed"),
+            "lap_time_s": control.get("lap_time_s"),
+            "cross_track_error_m": {"mean": sum(errors) / len(errors) if errors else None,
+                                    "max": max(errors) if errors else None},
+            "sim_time_s": sim,
+            "wall_time_s": wall,
+            "real_time_factor": sim / wall if wall > 0 else None,
+            "camera_frames": self.frames,
+            "camera_frames_per_s": self.frames / wall if wall > 0 else None,
+            "detections_per_class": self.per_class,
+            "detector_precision": self.tp / (self.tp + self.fp) if self.tp + self.fp else None,
+            "detector_recall": self.tp / (self.tp + self.fn) if self.tp + self.fn else None,
+            "iou_match": IOU_MATCH,
+        }
+        with open(os.path.join(self.dir, "summary_driving.json"), "w") as f:
+            json.dump(summary, f, indent=1)
+        print("outputs: %s, %s, %s" % (os.path.join(self.dir, "camera.mp4"),
+                                       os.path.join(self.dir, "birds_eye.png"),
+                                       os.path.join(self.dir, "summary_driving.json")), flush=True)
