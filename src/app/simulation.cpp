@@ -206,8 +206,8 @@ int run_simulation(const RunOptions& options) {
   if (cfg.datapack_processor != "tf")
     log.info("warning: DataPackProcessor " + cfg.datapack_processor +
              " is not available yet; running tf");
-  for (const char* key : {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT",
-                          "ComputationalGraph"}) {
+  for (const char* key :
+       {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph"}) {
     if (cfg.json.contains(key) && !cfg.json[key].empty()) {
       log.info(std::string("warning: ") + key + " is not supported yet; ignored");
     }
@@ -263,6 +263,18 @@ int run_simulation(const RunOptions& options) {
       csv = std::fopen((run_dir / "steps.csv").c_str(), "w");
       if (csv) std::setvbuf(csv, nullptr, _IOFBF, 1 << 20);
       fti->set_step_log(csv);
+      if (!options.quiet) {
+        auto start = SteadyClock::now();
+        fti->set_progress(5.0, [&log, start, timeout = cfg.timeout_ns](int64_t sim_ns) {
+          double wall = std::chrono::duration<double>(SteadyClock::now() - start).count();
+          std::ostringstream s;
+          s.precision(1);
+          s << std::fixed << "progress: simulated " << sim_ns * 1e-9 << " s";
+          if (timeout > 0) s << " of " << timeout * 1e-9 << " s";
+          s << " (" << sim_ns * 1e-9 / wall << "x real time)";
+          log.info(s.str());
+        });
+      }
       fti->prime();
       fti->run(cfg.timeout_ns);
       if (interrupted()) {
@@ -308,7 +320,12 @@ int run_simulation(const RunOptions& options) {
       << " s wall, " << fti->cycles() << " loop cycles";
     log.info(s.str());
   }
-  log.info("run folder: " + run_dir.string());
+  std::string listing;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(run_dir, ec)) {
+    if (entry.is_regular_file()) listing += "\n  " + entry.path().filename().string();
+  }
+  log.info("run folder: " + run_dir.string() + listing);
   return code;
 }
 

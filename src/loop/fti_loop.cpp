@@ -170,6 +170,7 @@ void FtiLoop::run(int64_t until_ns) {
   engine::Reply reply;
   engine::Request request;
   int64_t last_cycle_ns = now_ns();
+  int64_t last_progress_ns = last_cycle_ns;
   while (!queue_.empty()) {
     const int64_t next = queue_.begin()->first;
     if (until_ns > 0 && next > until_ns) break;
@@ -209,6 +210,10 @@ void FtiLoop::run(int64_t until_ns) {
     write_row(t - last_cycle_ns);
     last_cycle_ns = t;
     ++cycles_;
+    if (progress_ && t - last_progress_ns >= progress_period_ns_) {
+      last_progress_ns = t;
+      progress_(sim_time_ns_);
+    }
   }
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <string>
 #include <unordered_map>
@@ -25,6 +26,11 @@ class FtiLoop {
 
   // Writes one CSV row per cycle (wall times per engine) to `csv` (may be null).
   void set_step_log(std::FILE* csv);
+  // Calls `report(sim_time_ns)` about every `period_s` of wall time while running.
+  void set_progress(double period_s, std::function<void(int64_t)> report) {
+    progress_period_ns_ = static_cast<int64_t>(period_s * 1e9);
+    progress_ = std::move(report);
+  }
 
   // Fetches the functions' inputs from every engine (after Initialize).
   void prime();
@@ -54,6 +60,8 @@ class FtiLoop {
   std::FILE* csv_ = nullptr;
   int64_t sim_time_ns_ = 0;
   uint64_t cycles_ = 0;
+  int64_t progress_period_ns_ = 0;
+  std::function<void(int64_t)> progress_;
 };
 
 }  // namespace convoy::loop
