@@ -61,6 +61,13 @@ PhysicsWorld::PhysicsWorld(const WorldDesc& desc) {
 
 void PhysicsWorld::build_model(const ModelDesc& model) {
   if (model.links.empty()) return;
+  // Static scenery that nothing can touch (no collision) and that carries no sensor is for
+  // the cameras only: DART's per-skeleton cost would buy nothing.
+  if (model.is_static) {
+    bool needed = false;
+    for (const auto& l : model.links) needed |= !l.collisions.empty() || !l.cameras.empty();
+    if (!needed) return;
+  }
   auto skel = dd::Skeleton::create(model.name);
   std::unordered_map<std::string, const LinkDesc*> links;
   for (const auto& l : model.links) links[l.name] = &l;
@@ -197,6 +204,7 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
       attach(nullptr, l, nullptr);  // a free (or, in a static model, welded) root
     }
   }
+  if (model.is_static) skel->setMobile(false);  // DART then skips its dynamics
   world_->addSkeleton(skel);
 }
 
