@@ -64,7 +64,7 @@ class DetectorEngine final : public Engine {
     add("detections", "json");
     add("camera_img", "json");
     add("camera", "convoy.data.Camera");
-    if (backend_ == "ground_truth") add("boxes", "json");
+    add("boxes", "json");  // used by the ground_truth backend, ignored by the others
     return ids;
   }
 
@@ -115,6 +115,8 @@ class DetectorEngine final : public Engine {
       }
       return;
     }
+    // Ground truth sent to an image backend (one config for every backend) is not needed.
+    if (dp.id().name() == "boxes") return;
     cv::Mat img = detector::image_from_datapack(dp);
     if (img.empty()) return;
     pending_image_ = std::move(img);
