@@ -61,8 +61,12 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
     : physics_(physics), rng_(seed) {
   for (const auto& model : desc.models)
     for (const auto& link : model.links)
-      for (const auto& cam : link.cameras)
-        cameras_.push_back({&cam, physics.link_index(link.name), 0, 0, false, {}, 3});
+      for (const auto& cam : link.cameras) {
+        Camera c;
+        c.desc = &cam;
+        c.link = physics.link_index(link.name);
+        cameras_.push_back(std::move(c));
+      }
   if (cameras_.empty()) return;
   renderer_ = std::make_unique<render::Renderer>();
   build_scene(desc);
@@ -280,8 +284,10 @@ void CameraSensors::image_datapack(size_t i, engine::DataPack* out) {
 void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) {
   Camera& cam = cameras_[i];
   cam.want_depth = true;
-  if (!cam.rendered) first_render(cam);
-  else if (!cam.has_depth) render(cam);  // (noise redrawn: a new sample of the same view)
+  if (!cam.rendered)
+    first_render(cam);
+  else if (!cam.has_depth)
+    render(cam);  // (noise redrawn: a new sample of the same view)
   nlohmann::json j;
   j["width"] = cam.frame.width;
   j["height"] = cam.frame.height;
@@ -294,8 +300,10 @@ void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) {
 void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
   Camera& cam = cameras_[i];
   cam.want_boxes = true;
-  if (!cam.rendered) first_render(cam);
-  else if (!cam.has_boxes) render(cam);
+  if (!cam.rendered)
+    first_render(cam);
+  else if (!cam.has_boxes)
+    render(cam);
   nlohmann::json boxes = nlohmann::json::array();
   for (const auto& b : cam.frame.boxes) {
     if (b.model_id == cam.own_model) continue;  // the camera's own vehicle

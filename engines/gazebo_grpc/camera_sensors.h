@@ -46,8 +46,8 @@ class CameraSensors {
 
  private:
   struct Camera {
-    const CameraDesc* desc;
-    int link;  // physics link index
+    const CameraDesc* desc = nullptr;
+    int link = -1;           // physics link index
     uint32_t own_model = 0;  // the model carrying the camera: not in its ground truth
     double next_update = 0;
     bool rendered = false;
@@ -56,7 +56,7 @@ class CameraSensors {
     std::vector<int16_t> noise;  // mean + stddev * N(0,1) in 0..255 units, a fixed table
     bool want_image = false, want_depth = false, want_boxes = false;  // asked for once:
                                                                       // rendered from then on
-    bool has_depth = false, has_boxes = false;    // the current frame has them
+    bool has_depth = false, has_boxes = false;                        // the current frame has them
   };
   struct Tracked {
     int link;                    // physics link index
