@@ -127,7 +127,8 @@ struct ModelInsert {
 
 // Loads the world file (plus extra models). `model://` URIs are looked up in
 // $CONVOY_MODEL_PATH, $GAZEBO_MODEL_PATH and $SDF_PATH (colon-separated), next to the file
-// (and in its models/ folder), and in the build's share/convoy/models. Throws std::runtime_error("<file>: <element>: <problem>").
+// (and in its models/ folder), and in the build's share/convoy/models. Throws
+// std::runtime_error("<file>: <element>: <problem>").
 WorldDesc load_world(const std::filesystem::path& file, const std::vector<ModelInsert>& extra = {});
 
 }  // namespace convoy::world
