@@ -26,10 +26,11 @@ int main(int argc, char** argv) {
       JointPid pid;
     };
     std::vector<C> cs;
-    for (const auto& [plugin, pids] : desc.models[1].joint_plugins)
-      for (const auto& pd : pids)
-        cs.push_back(
-            {p.joint_index(pd.joint), pd.velocity, JointPid(pd.p, pd.i, pd.d, pd.i_max, pd.i_min)});
+    for (const auto& m : desc.models)
+      for (const auto& [plugin, pids] : m.joint_plugins)
+        for (const auto& pd : pids)
+          cs.push_back({p.joint_index(pd.joint), pd.velocity,
+                        JointPid(pd.p, pd.i, pd.d, pd.i_max, pd.i_min)});
     const double sim_seconds = 20, dt = p.step_size();
     auto t0 = std::chrono::steady_clock::now();
     for (long i = 0; i < std::lround(sim_seconds / dt); ++i) {
@@ -45,7 +46,9 @@ int main(int argc, char** argv) {
     }
     double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     rtfs.push_back(sim_seconds / wall);
-    final_x = p.link_state(p.link_index("car::base_link")).position.x();
+    for (const auto& m : desc.models)
+      if (!m.joint_plugins.empty())
+        final_x = p.link_state(p.link_index(m.name + "::base_link")).position.x();
   }
   std::sort(rtfs.begin(), rtfs.end());
   std::printf(

@@ -57,6 +57,7 @@ PhysicsWorld::PhysicsWorld(const WorldDesc& desc) {
   world_->getConstraintSolver()->setCollisionDetector(
       dart::collision::BulletCollisionDetector::create());
   for (const auto& model : desc.models) build_model(model);
+  gate_every_ = std::max<int64_t>(1, std::llround(0.02 / world_->getTimeStep()));
 }
 
 void PhysicsWorld::build_model(const ModelDesc& model) {
@@ -205,13 +206,78 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
     }
   }
   if (model.is_static) skel->setMobile(false);  // DART then skips its dynamics
-  world_->addSkeleton(skel);
+
+  // Static scenery (static, with collisions, no infinite plane) stays out of the DART world:
+  // it has no dynamics, and DART would still visit it every step. gate_scenery() enters it
+  // into collision detection while a moving body is near.
+  bool has_plane = false, has_collision = false;
+  for (const auto& l : model.links) {
+    for (const auto& c : l.collisions) has_plane |= c.shape.kind == Shape::kPlane;
+    has_collision |= !l.collisions.empty();
+  }
+  const bool scenery = model.is_static && has_collision && !has_plane;
+  if (scenery)
+    scenery_.push_back({skel, {}, false});
+  else
+    world_->addSkeleton(skel);
+  for (size_t b = 0; b < skel->getNumBodyNodes(); ++b) {
+    dd::BodyNode* bn = skel->getBodyNode(b);
+    Eigen::AlignedBox3d box;  // in the body frame
+    for (const dd::ShapeNode* node : bn->getShapeNodesWith<dd::CollisionAspect>()) {
+      const auto& bb = node->getShape()->getBoundingBox();
+      for (int corner = 0; corner < 8; ++corner) {
+        Eigen::Vector3d p((corner & 1) ? bb.getMax().x() : bb.getMin().x(),
+                          (corner & 2) ? bb.getMax().y() : bb.getMin().y(),
+                          (corner & 4) ? bb.getMax().z() : bb.getMin().z());
+        box.extend(node->getRelativeTransform() * p);
+      }
+    }
+    if (box.isEmpty()) continue;
+    if (model.is_static) {
+      if (!scenery) continue;
+      const Eigen::Isometry3d& t = bn->getWorldTransform();
+      for (int corner = 0; corner < 8; ++corner)
+        scenery_.back().box.extend(
+            t * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)));
+    } else {
+      double radius = 0;
+      for (int corner = 0; corner < 8; ++corner)
+        radius = std::max(radius,
+                          box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)).norm());
+      moving_.push_back({bn, radius});
+    }
+  }
+}
+
+void PhysicsWorld::gate_scenery() {
+  // A moving body travels at most about |v| * window before the next decision; twice that
+  // plus half a metre keeps every contact that can happen before then.
+  const double window = static_cast<double>(gate_every_) * world_->getTimeStep();
+  auto group = world_->getConstraintSolver()->getCollisionGroup();
+  for (auto& s : scenery_) {
+    bool near = false;
+    for (const auto& m : moving_) {
+      const Eigen::Vector3d centre = m.body->getWorldTransform().translation();
+      const double reach = m.radius + 2.0 * m.body->getLinearVelocity().norm() * window + 0.5;
+      if (s.box.exteriorDistance(centre) <= reach) {
+        near = true;
+        break;
+      }
+    }
+    if (near == s.active) continue;
+    if (near)
+      group->subscribeTo(dd::ConstSkeletonPtr(s.skeleton));
+    else
+      group->unsubscribeFrom(s.skeleton.get());
+    s.active = near;
+  }
 }
 
 void PhysicsWorld::step() {
   for (auto& j : joints_) {
     if (j.effort != 0) j.joint->setForce(0, j.effort);
   }
+  if (steps_++ % gate_every_ == 0) gate_scenery();
   world_->step();
 }
 

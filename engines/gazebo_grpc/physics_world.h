@@ -57,6 +57,27 @@ class PhysicsWorld {
     double effort = 0;
   };
   void build_model(const ModelDesc& model);
+  // Static scenery far from every moving body is left out of collision detection (see
+  // step()); this re-decides which scenery takes part, from the moving bodies' state.
+  void gate_scenery();
+
+  // A static model with collision shapes but no infinite plane: it takes part in collision
+  // detection only while a moving body is near its bounding box.
+  struct Scenery {
+    dart::dynamics::SkeletonPtr skeleton;
+    Eigen::AlignedBox3d box;
+    bool active = true;
+  };
+  // A body of a mobile skeleton with collision shapes, and the radius of a sphere around its
+  // origin that holds them.
+  struct MovingBody {
+    dart::dynamics::BodyNode* body;
+    double radius;
+  };
+  std::vector<Scenery> scenery_;
+  std::vector<MovingBody> moving_;
+  int64_t steps_ = 0;
+  int64_t gate_every_ = 1;
 
   dart::simulation::WorldPtr world_;
   std::vector<JointRef> joints_;

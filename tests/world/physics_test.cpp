@@ -42,6 +42,28 @@ TEST(Physics, FreeFallMatchesTheAnalyticResult) {
   EXPECT_NEAR(s.position.z(), 100 - 0.5 * 9.81, 6e-3);
 }
 
+TEST(Physics, StaticSceneryFarAwayStillCollidesWhenABodyComesNear) {
+  PhysicsWorld p(load_world(kData + "/static_scenery.sdf"));
+  int dropped = p.link_index("dropped::body");
+  int thrown = p.link_index("thrown::body");
+  ASSERT_GE(dropped, 0);
+  ASSERT_GE(thrown, 0);
+  auto skel = p.dart_world()->getSkeleton("thrown");
+  ASSERT_TRUE(skel);
+  static_cast<dart::dynamics::FreeJoint*>(skel->getRootJoint())
+      ->setLinearVelocity(Eigen::Vector3d(30, 0, 0));
+  double max_x = 0;
+  for (int i = 0; i < 3000; ++i) {
+    p.step();
+    max_x = std::max(max_x, p.link_state(thrown).position.x());
+  }
+  // The dropped ball rests on the pedestal (top at 1 m), not on the ground.
+  EXPECT_NEAR(p.link_state(dropped).position.z(), 1.25, 0.01);
+  // The thrown ball never passes the wall's near face (x = 59.5).
+  EXPECT_LT(max_x, 59.5);
+  EXPECT_GT(max_x, 59.0);  // it did reach the wall
+}
+
 TEST(Physics, PendulumPeriodMatchesTheAnalyticResult) {
   PhysicsWorld p(load_world(kData + "/physics_basics.sdf"));
   int pivot = p.joint_index("pendulum::pivot");
