@@ -16,13 +16,15 @@
 // Datapack written: "detections" (JSON) {frame, time_ns, width, height, inference_ms,
 //   detections: [{class, class_id, confidence, x_min, y_min, x_max, y_max}]} sorted by
 //   confidence; empty until the first image (or boxes) was processed.
-// Each step runs the detector once if a new input arrived since the last step.
+// Each step runs the detector once if a new input arrived since the last step (an image
+// identical to the last one detected is not new: the camera did not render since).
 #pragma once
 
 #include <chrono>
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <string_view>
 
 #include "detector.h"
 #include "engine/engine.h"
@@ -119,6 +121,14 @@ class DetectorEngine final : public Engine {
     if (dp.id().name() == "boxes") return;
     cv::Mat img = detector::image_from_datapack(dp);
     if (img.empty()) return;
+    // A camera renders at its update_rate; between two frames the same image comes again
+    // (one per step). Its detections are those already made: detect new images only.
+    if (!img.isContinuous()) img = img.clone();
+    const size_t hash = std::hash<std::string_view>{}(
+        std::string_view(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize()));
+    if (!result_.is_null() && hash == last_image_hash_ && img.size() == last_image_size_) return;
+    last_image_hash_ = hash;
+    last_image_size_ = img.size();
     pending_image_ = std::move(img);
     pending_ = true;
   }
@@ -151,6 +161,8 @@ class DetectorEngine final : public Engine {
   int64_t frame_ = 0;
   bool pending_ = false;
   cv::Mat pending_image_;
+  size_t last_image_hash_ = 0;
+  cv::Size last_image_size_;
   nlohmann::json pending_boxes_;
   int width_ = 0, height_ = 0;
   nlohmann::json result_;

@@ -3,8 +3,9 @@
   camera.mp4       the camera with the detector's boxes, labels and confidences drawn (also
                    shown live in a window when a display exists)
   birds_eye.png    the driven path over the road and the reference waypoints
-  summary.json     lap, cross-track error, real-time factor, camera frames/s, detections per
-                   class, the detector's precision and recall against ground truth
+  summary.json     lap, cross-track error, physics real-time factor, camera frames/s,
+                   detections per class, the detector's precision and recall against ground
+                   truth (the coordinator adds its own fields to the file at the end)
 Progress goes to the log every simulated 5 s."""
 import csv
 import json
@@ -42,10 +43,11 @@ class Script(EngineScript):
         self.window = bool(os.environ.get("DISPLAY"))
         self.frames = 0
         self.last_frame_key = None
+        self.previous = None  # (frame, truth) of the previous observation
         self.path = []
         self.per_class = {}
         self.tp = self.fp = self.fn = 0
-        self.wall0 = time.perf_counter()
+        self.wall0 = None  # wall clock at the first step: start-up is not counted
         self.lane = relateAngle_computation.load_waypoints()
 
     def _draw(self, img, dets):
@@ -57,43 +59,67 @@ class Script(EngineScript):
                         (0, 255, 255), 1, cv2.LINE_AA)
 
     def _score(self, dets, truth):
-        wanted = [t for t in truth if t["class"] in TRUTH_TO_DETECTOR and t["pixels"] >= MIN_PIXELS]
+        """Greedy matching at IoU >= IOU_MATCH. Objects whose box is under MIN_PIXELS, or
+        mostly hidden (fewer than MIN_PIXELS visible pixels), are not scored: a detection of
+        one of them counts neither way."""
+        def box(b):
+            return (b["x_min"], b["y_min"], b["x_max"], b["y_max"])
+
+        def area(b):
+            return (b["x_max"] - b["x_min"] + 1) * (b["y_max"] - b["y_min"] + 1)
+
+        objects = [t for t in truth if t["class"] in TRUTH_TO_DETECTOR]
+        wanted = [t for t in objects if area(t) >= MIN_PIXELS and t["pixels"] >= MIN_PIXELS]
+        ignored = [t for t in objects if not (area(t) >= MIN_PIXELS and t["pixels"] >= MIN_PIXELS)]
+        same_class = lambda d, t: d["class"] in (t["class"], TRUTH_TO_DETECTOR[t["class"]])
         used = set()
         for d in dets:
-            area = (d["x_max"] - d["x_min"] + 1) * (d["y_max"] - d["y_min"] + 1)
-            if d["class"] not in SCORED or area < MIN_PIXELS:
+            if d["class"] not in SCORED or area(d) < MIN_PIXELS:
                 continue
             best, best_i = 0.0, None
             for i, t in enumerate(wanted):
-                if i in used or d["class"] not in (t["class"], TRUTH_TO_DETECTOR[t["class"]]):
+                if i in used or not same_class(d, t):
                     continue
-                v = iou((d["x_min"], d["y_min"], d["x_max"], d["y_max"]),
-                        (t["x_min"], t["y_min"], t["x_max"], t["y_max"]))
+                v = iou(box(d), box(t))
                 if v > best:
                     best, best_i = v, i
             if best >= IOU_MATCH:
                 used.add(best_i)
                 self.tp += 1
-            else:
+            elif not any(same_class(d, t) and iou(box(d), box(t)) >= IOU_MATCH for t in ignored):
                 self.fp += 1
         self.fn += len(wanted) - len(used)
 
     def runLoop(self, timestep_ns):
+        if self.wall0 is None:
+            self.wall0 = time.perf_counter()
+            self.sim0 = self._time_ns - timestep_ns
         obs = self._getDataPack("observation")
         if obs is None:
             return
         if "x" in obs:
             self.path.append((self._time_ns * 1e-9, obs["x"], obs["y"]))
+        if self._time_ns % 5_000_000_000 == 0 and self.path:
+            print("t=%6.1f s  frames %d  detections %s" % (self._time_ns * 1e-9, self.frames,
+                                                           json.dumps(self.per_class)), flush=True)
         det = obs.get("detections")
         frame = obs.get("frame")
+        # The detector answers one loop cycle later: the detections of this observation were
+        # made from the previous observation's frame (a TF's output reaches its engine in the
+        # next step). Score and draw them against that frame and its ground truth.
+        shown = self.previous
+        self.previous = None if frame is None else (frame, obs.get("truth", []))
+        if shown is None or det is None:
+            return
+        frame, truth = shown
         # a new camera frame (30 Hz) differs from the last one (its noise does, at least)
-        key = None if frame is None else hash(frame[::29, ::31].tobytes())
-        if frame is not None and det is not None and key != self.last_frame_key:
+        key = hash(frame[::29, ::31].tobytes())
+        if key != self.last_frame_key:
             self.last_frame_key = key
             dets = det.get("detections", [])
             for d in dets:
                 self.per_class[d["class"]] = self.per_class.get(d["class"], 0) + 1
-            self._score(dets, obs.get("truth", []))
+            self._score(dets, truth)
             img = cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2BGR)
             self._draw(img, dets)
             if self.video is None:
@@ -108,9 +134,6 @@ class Script(EngineScript):
                     cv2.waitKey(1)
                 except cv2.error:
                     self.window = False
-        if self._time_ns % 5_000_000_000 == 0 and self.path:
-            print("t=%6.1f s  frames %d  detections %s" % (self._time_ns * 1e-9, self.frames,
-                                                           json.dumps(self.per_class)), flush=True)
 
     def _birds_eye(self, path):
         pts = np.array([(x, y) for x, y in self.lane] + [(x, y) for _, x, y in self.path] or [(0, 0)])
@@ -149,8 +172,8 @@ class Script(EngineScript):
         if self.video is not None:
             self.video.release()
         self._birds_eye(os.path.join(self.dir, "birds_eye.png"))
-        wall = time.perf_counter() - self.wall0
-        sim = self._time_ns * 1e-9
+        wall = time.perf_counter() - self.wall0 if self.wall0 is not None else 0.0
+        sim = (self._time_ns - self.sim0) * 1e-9 if self.wall0 is not None else 0.0
         control = {}
         try:
             with open(os.path.join(self.dir, "control_summary.json")) as f:
@@ -163,9 +186,8 @@ class Script(EngineScript):
             "lap_time_s": control.get("lap_time_s"),
             "cross_track_error_m": {"mean": sum(errors) / len(errors) if errors else None,
                                     "max": max(errors) if errors else None},
-            "sim_time_s": sim,
-            "wall_time_s": wall,
-            "real_time_factor": sim / wall if wall > 0 else None,
+            # simulated over wall-clock time, from the first step to the last
+            "physics_real_time_factor": sim / wall if wall > 0 else None,
             "camera_frames": self.frames,
             "camera_frames_per_s": self.frames / wall if wall > 0 else None,
             "detections_per_class": self.per_class,
@@ -173,8 +195,8 @@ class Script(EngineScript):
             "detector_recall": self.tp / (self.tp + self.fn) if self.tp + self.fn else None,
             "iou_match": IOU_MATCH,
         }
-        with open(os.path.join(self.dir, "summary_driving.json"), "w") as f:
+        with open(os.path.join(self.dir, "summary.json"), "w") as f:
             json.dump(summary, f, indent=1)
         print("outputs: %s, %s, %s" % (os.path.join(self.dir, "camera.mp4"),
                                        os.path.join(self.dir, "birds_eye.png"),
-                                       os.path.join(self.dir, "summary_driving.json")), flush=True)
+                                       os.path.join(self.dir, "summary.json")), flush=True)

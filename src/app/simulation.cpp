@@ -8,6 +8,7 @@
 #include <ctime>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -161,17 +162,27 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   handle.attach(transport::make_socket_channel(fds[0]), child);
 }
 
+// summary.json: what an engine or function of the run wrote there (a JSON object, e.g. an
+// experiment's own figures), with the coordinator's fields on top.
 void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
-                   const loop::FtiLoop* loop, double wall_s, int exit_code,
+                   const loop::FtiLoop* loop, double wall_s, double loop_wall_s, int exit_code,
                    const std::string& error) {
-  nlohmann::json j;
+  nlohmann::json j = nlohmann::json::object();
+  if (std::ifstream in(file); in) {
+    j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object()) j = nlohmann::json::object();
+  }
   j["simulation"] = cfg.name;
   j["config"] = cfg.file.string();
   j["exit_code"] = exit_code;
   j["error"] = error;
   j["wall_s"] = wall_s;
   j["cycles"] = loop ? loop->cycles() : 0;
-  j["sim_time_s"] = loop ? static_cast<double>(loop->sim_time_ns()) * 1e-9 : 0.0;
+  const double sim_s = loop ? static_cast<double>(loop->sim_time_ns()) * 1e-9 : 0.0;
+  j["sim_time_s"] = sim_s;
+  // The loop alone, without start-up and shutdown: simulated over wall-clock time.
+  j["loop_wall_s"] = loop_wall_s;
+  j["real_time_factor"] = loop_wall_s > 0 ? sim_s / loop_wall_s : 0.0;
   std::ofstream(file) << j.dump(2) << "\n";
 }
 
@@ -201,6 +212,8 @@ int run_simulation(const RunOptions& options) {
   log.info("run folder: " + run_dir.string());
   for (const auto& w : cfg.warnings) log.info("warning: " + w);
   std::ofstream(run_dir / "config.json") << cfg.json.dump(2) << "\n";
+  std::error_code stale;
+  fs::remove(run_dir / "summary.json", stale);  // a reused folder's; the run writes its own
   if (cfg.loop != "FTILoop")
     log.info("warning: SimulationLoop " + cfg.loop + " is not available yet; running FTILoop");
   if (cfg.datapack_processor != "tf")
@@ -215,6 +228,8 @@ int run_simulation(const RunOptions& options) {
 
   std::vector<std::unique_ptr<loop::EngineHandle>> engines;
   std::unique_ptr<loop::FtiLoop> fti;
+  double loop_wall = 0;
+  std::optional<SteadyClock::time_point> loop_start;
   std::FILE* csv = nullptr;
   auto t0 = SteadyClock::now();
   int code = kExitOk;
@@ -275,6 +290,7 @@ int run_simulation(const RunOptions& options) {
           log.info(s.str());
         });
       }
+      loop_start = SteadyClock::now();
       fti->prime();
       fti->run(cfg.timeout_ns);
       if (interrupted()) {
@@ -295,6 +311,8 @@ int run_simulation(const RunOptions& options) {
       code = kExitInternal;
       error = e.what();
     }
+    if (loop_start)
+      loop_wall = std::chrono::duration<double>(SteadyClock::now() - *loop_start).count();
     if (code == kExitInterrupted) {
       log.info(error + ": shutting the engines down (Ctrl-C again to kill them)");
       interrupt_signal().store(0);
@@ -313,7 +331,7 @@ int run_simulation(const RunOptions& options) {
     if (csv) std::fclose(csv);
   }
   double wall = std::chrono::duration<double>(SteadyClock::now() - t0).count();
-  write_summary(run_dir / "summary.json", cfg, fti.get(), wall, code, error);
+  write_summary(run_dir / "summary.json", cfg, fti.get(), wall, loop_wall, code, error);
   if (fti) {
     std::ostringstream s;
     s << "simulated " << static_cast<double>(fti->sim_time_ns()) * 1e-9 << " s in " << wall

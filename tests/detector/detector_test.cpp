@@ -397,10 +397,18 @@ TEST_F(OnnxModels, EngineYoloRunsOncePerNewImage) {
   e.step(10'000'000);  // no new image: same detections
   EXPECT_EQ(detections_of(e)["frame"], 1);
   EXPECT_EQ(detections_of(e)["time_ns"], 20'000'000);
+  e.set_datapack(camera_json(test_image(480, 640), 2));  // the same image again
+  e.step(10'000'000);
+  EXPECT_EQ(detections_of(e)["frame"], 1);  // not detected again
+  cv::Mat changed = test_image(480, 640);
+  changed.at<cv::Vec3b>(479, 639)[0] ^= 1;  // one pixel differs: a new image
+  e.set_datapack(camera_json(changed, 2));
+  e.step(10'000'000);
+  EXPECT_EQ(detections_of(e)["frame"], 2);
   e.set_datapack(camera_proto(test_image(240, 320), true));
   e.step(10'000'000);
   j = detections_of(e);
-  EXPECT_EQ(j["frame"], 2);
+  EXPECT_EQ(j["frame"], 3);
   EXPECT_EQ(j["width"], 320);
   EXPECT_NEAR(j["detections"][1]["x_min"].get<double>(), 37.5, 1e-3);
 }

@@ -1,9 +1,11 @@
-"""End-to-end tests of the autonomous-driving experiment (control only so far): the smart
-car follows the Parkring lane, and two runs give identical trajectories.
+"""End-to-end tests of the autonomous-driving experiment: the smart car follows the Parkring
+lane, two control-only runs give identical trajectories, and a run of "both" writes the
+video, the bird's-eye plot and the summary.
 
 Run with Debian's /usr/bin/python3 -m unittest test_autonomous_driving."""
 
 import csv
+import json
 import math
 import os
 import shutil
@@ -60,3 +62,32 @@ class ControlOnly(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class Both(unittest.TestCase):
+    def test_run_writes_video_plot_and_summary(self):
+        d = tempfile.mkdtemp(prefix="convoy-ad-")
+        self.addCleanup(shutil.rmtree, d, True)
+        run = os.path.join(d, "run")
+        r = subprocess.run([CONVOY, "run", "-q", "-c", os.path.join(EXP, "simulation_config_both.json"),
+                            "--run-dir", run, "-o", "SimulationTimeout=3"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for name in ("camera.mp4", "birds_eye.png"):
+            self.assertGreater(os.path.getsize(os.path.join(run, name)), 1000, name)
+        with open(os.path.join(run, "summary.json")) as f:
+            s = json.load(f)
+        # the evaluator's fields
+        self.assertIs(s["lap_completed"], False)  # 3 s is no lap
+        self.assertLess(s["cross_track_error_m"]["max"], 1.0)
+        self.assertGreater(s["physics_real_time_factor"], 0)
+        self.assertGreater(s["camera_frames"], 80)  # 30 Hz for 3 s
+        self.assertGreater(s["camera_frames_per_s"], 0)
+        self.assertGreater(sum(s["detections_per_class"].values()), 0)
+        self.assertEqual(s["detector_precision"], 1.0)  # ground truth scored against itself
+        self.assertEqual(s["detector_recall"], 1.0)
+        # the coordinator's, added on top
+        self.assertEqual(s["exit_code"], 0)
+        self.assertAlmostEqual(s["sim_time_s"], 3.0)
+        self.assertGreater(s["loop_wall_s"], 0)
+        self.assertGreater(s["real_time_factor"], 0)

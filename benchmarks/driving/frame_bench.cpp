@@ -1,0 +1,110 @@
+// Rendering plus detection run standalone, in one process, without the co-simulation: the
+// reference for the framework's share of each camera frame's time (benchmarks/driving_bench.py).
+//
+// Each frame does the work the engines do for one camera frame of the autonomous-driving
+// experiment: the physics steps of one camera period (the car parked, as in the detection
+// config), rendering the camera (with the ground-truth pass when the backend needs it), and
+// detection. Prints the median over runs of frames per second and milliseconds per frame.
+//
+//   frame_bench WORLD.sdf [--backend ground_truth|hog|yolo] [--model M.onnx] [--frames 300]
+//               [--runs 5]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "camera_sensors.h"
+#include "detector.h"
+#include "physics_world.h"
+#include "world_description.h"
+
+using namespace convoy;
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr,
+                 "usage: frame_bench WORLD.sdf [--backend B] [--model M.onnx] [--frames N] "
+                 "[--runs R]\n");
+    return 2;
+  }
+  std::string world_file = argv[1], backend = "ground_truth", model;
+  int frames = 300, runs = 5;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    std::string k = argv[i], v = argv[i + 1];
+    if (k == "--backend")
+      backend = v;
+    else if (k == "--model")
+      model = v;
+    else if (k == "--frames")
+      frames = std::stoi(v);
+    else if (k == "--runs")
+      runs = std::stoi(v);
+  }
+  try {
+    world::WorldDesc desc = world::load_world(world_file);
+    world::PhysicsWorld physics(desc);
+    world::CameraSensors cameras(desc, physics, 7);
+    if (cameras.count() == 0) throw std::runtime_error(world_file + ": no camera");
+    const world::CameraDesc& cam = cameras.camera(0);
+    const double period = cam.update_rate > 0 ? 1.0 / cam.update_rate : 1.0 / 30;
+    const int substeps = std::max(1, static_cast<int>(std::lround(period / physics.step_size())));
+
+    std::unique_ptr<detector::YoloDetector> yolo;
+    std::unique_ptr<detector::HogDetector> hog;
+    if (backend == "yolo") {
+      detector::YoloOptions o;
+      o.model_path = model;
+      yolo = std::make_unique<detector::YoloDetector>(o);
+    } else if (backend == "hog") {
+      hog = std::make_unique<detector::HogDetector>();
+    } else if (backend != "ground_truth") {
+      throw std::runtime_error("--backend must be ground_truth, hog or yolo");
+    }
+    const auto& names = detector::coco_class_names();
+    const bool truth = backend == "ground_truth";
+
+    engine::DataPack image, boxes;
+    double t = 0;
+    size_t detections = 0;
+    auto one_frame = [&] {
+      for (int k = 0; k < substeps; ++k) physics.step();
+      t += substeps * physics.step_size();
+      cameras.update(t);
+      std::vector<detector::Detection> dets;
+      if (truth) {
+        cameras.boxes_datapack(0, &boxes);
+        const std::string& raw = boxes.json_msgpack();
+        dets = detector::detections_from_boxes(nlohmann::json::from_msgpack(raw.begin(), raw.end()),
+                                               names);
+      } else {
+        cameras.image_datapack(0, &image);
+        cv::Mat img = detector::image_from_datapack(image);
+        dets = yolo ? yolo->detect(img) : hog->detect(img);
+      }
+      detections += dets.size();
+    };
+    for (int i = 0; i < 10; ++i) one_frame();  // warm-up: first renders, programs
+    std::vector<double> ms;
+    for (int run = 0; run < runs; ++run) {
+      auto t0 = std::chrono::steady_clock::now();
+      for (int i = 0; i < frames; ++i) one_frame();
+      double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ms.push_back(1e3 * s / frames);
+    }
+    std::sort(ms.begin(), ms.end());
+    const double med = ms[ms.size() / 2];
+    std::printf(
+        "standalone physics + render + detect (backend %s, %dx%d, %d physics steps a frame): "
+        "%.2f ms/frame, %.1f frames/s (median of %d runs of %d frames; %.1f detections a "
+        "frame)\n",
+        backend.c_str(), cam.width, cam.height, substeps, med, 1e3 / med, runs, frames,
+        static_cast<double>(detections) / ((runs * frames) + 10));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "frame_bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
