@@ -1,7 +1,8 @@
 // Camera rendering benchmark: frames per second of a 736x480 camera over a scene of about
 // 100k triangles (spheres, cylinders and boxes on a ground plane, several materials, two
-// lights), for colour only, colour + depth, and colour + depth + bounding boxes. Each frame
-// moves every object, renders and reads the images back.
+// lights), for colour only, colour + depth, and colour + depth + bounding boxes, with the
+// renderer's levels of detail (Renderer::kLodPixelError); and colour only at full detail.
+// Each frame moves every object, renders and reads the images back.
 //
 //   render_bench [frames_per_run=300] [runs=5] [first_frame.ppm]
 #include <sys/resource.h>
@@ -45,8 +46,9 @@ std::vector<Body> build_scene(Scene* scene) {
   lamp.range = 40;
   scene->add_light(lamp);
 
-  const int sphere = scene->add_mesh(make_sphere(0.4f, 24, 48));  // 2208 triangles
-  const int cylinder = scene->add_mesh(make_cylinder(0.3f, 1.0f, 32));
+  // Levels of detail as the world engine makes them for SDF spheres and cylinders.
+  const int sphere = scene->add_mesh_levels(sphere_levels(0.4f, 24, 48));  // 2208 triangles
+  const int cylinder = scene->add_mesh_levels(cylinder_levels(0.3f, 1.0f, 32));
   const int box = scene->add_mesh(make_box(0.7f, 0.7f, 0.7f));
   const int ground = scene->add_mesh(make_plane(200, 200));
   Material grass;
@@ -99,23 +101,24 @@ int main(int argc, char** argv) {
   if (argc > 3) write_ppm(argv[3], frame.width, frame.height, frame.rgb.data());
   std::printf("render_bench: %s\n", renderer.description().c_str());
   const RenderStats& stats = renderer.last_stats();
-  std::printf(
-      "scene: %zu instances, %zu triangles; in view: %d instances (%d lit per vertex), %zu "
-      "triangles; %dx%d\n",
-      scene.instances().size(), triangles, stats.instances_drawn, stats.per_vertex_lit,
-      stats.triangles_drawn, spec.width, spec.height);
+  std::printf("scene: %zu instances, %zu triangles (full detail); in view: %d instances; %dx%d\n",
+              scene.instances().size(), triangles, stats.instances_drawn, spec.width, spec.height);
   std::printf("median of %d runs of %d frames (each: move all objects, render, read back)\n", runs,
               frames);
 
   struct Mode {
     const char* name;
     bool depth, boxes;
+    double lod_pixel_error;
   };
-  const Mode modes[] = {
-      {"rgb", false, false}, {"rgb+depth", true, false}, {"rgb+depth+boxes", true, true}};
+  const Mode modes[] = {{"rgb", false, false, Renderer::kLodPixelError},
+                        {"rgb+depth", true, false, Renderer::kLodPixelError},
+                        {"rgb+depth+boxes", true, true, Renderer::kLodPixelError},
+                        {"rgb, full detail", false, false, 0.0}};
   long step = 0;
   for (const Mode& mode : modes) {
     std::vector<double> fps, cpu_ms;
+    renderer.set_lod_pixel_error(mode.lod_pixel_error);
     for (int run = -1; run < runs; ++run) {  // run -1 warms up
       const int n = run < 0 ? 30 : frames;
       const double cpu_start = cpu_seconds();
@@ -136,9 +139,12 @@ int main(int argc, char** argv) {
     }
     std::sort(fps.begin(), fps.end());
     std::sort(cpu_ms.begin(), cpu_ms.end());
-    std::printf("  %-16s %7.1f frames/s  (runs: %.1f .. %.1f)  CPU %.1f ms/frame  boxes: %zu\n",
-                mode.name, fps[fps.size() / 2], fps.front(), fps.back(), cpu_ms[cpu_ms.size() / 2],
-                frame.boxes.size());
+    std::printf(
+        "  %-16s %7.1f frames/s  (runs: %.1f .. %.1f)  CPU %.1f ms/frame  triangles drawn %zu "
+        "(%d instances at a coarser level)  boxes: %zu\n",
+        mode.name, fps[fps.size() / 2], fps.front(), fps.back(), cpu_ms[cpu_ms.size() / 2],
+        renderer.last_stats().triangles_drawn, renderer.last_stats().coarser_level,
+        frame.boxes.size());
   }
   return 0;
 }

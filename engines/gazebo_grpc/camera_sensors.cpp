@@ -135,24 +135,27 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
       for (const auto& v : link.visuals) {
-        std::vector<std::pair<render::MeshData, render::Material>> parts;
+        std::vector<std::pair<render::MeshLevels, render::Material>> parts;
+        auto one = [](render::MeshData m) { return render::MeshLevels{{std::move(m)}, {0.0f}}; };
         Eigen::Isometry3d offset = v.pose;
         render::Material material = to_material(v.material);
         switch (v.shape.kind) {
           case Shape::kBox:
             parts.emplace_back(
-                render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z()), material);
+                one(render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z())),
+                material);
             break;
           case Shape::kCylinder: {
             // Tessellation grows with size: thin posts need few segments.
             int segments = std::clamp(static_cast<int>(12 + 20 * v.shape.size.x()), 12, 32);
-            parts.emplace_back(render::make_cylinder(v.shape.size.x(), v.shape.size.z(), segments),
-                               material);
+            parts.emplace_back(
+                render::cylinder_levels(v.shape.size.x(), v.shape.size.z(), segments), material);
             break;
           }
           case Shape::kSphere: {
             int stacks = std::clamp(static_cast<int>(8 + 2 * v.shape.size.x()), 8, 16);
-            parts.emplace_back(render::make_sphere(v.shape.size.x(), stacks, 2 * stacks), material);
+            parts.emplace_back(render::sphere_levels(v.shape.size.x(), stacks, 2 * stacks),
+                               material);
             break;
           }
           case Shape::kPlane: {
@@ -163,7 +166,7 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
                 Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), v.shape.normal)
                     .toRotationMatrix();
             offset = offset * t;
-            parts.emplace_back(render::make_plane(sx, sy), material);
+            parts.emplace_back(one(render::make_plane(sx, sy)), material);
             break;
           }
           case Shape::kMesh:
@@ -175,7 +178,7 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
                   part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
               render::Material m = v.material.has_material ? material : part.material(texture);
               if (v.material.has_material && texture >= 0) m.texture = texture;
-              parts.emplace_back(std::move(part.mesh), m);
+              parts.emplace_back(one(std::move(part.mesh)), m);
             }
             break;
         }
@@ -184,7 +187,7 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
           for (auto& p : parts) p.second.texture = texture;
         }
         for (auto& [mesh, mat] : parts) {
-          int mesh_index = scene_.add_mesh(mesh);
+          int mesh_index = scene_.add_mesh_levels(mesh);
           render::Pose world = to_pose(link.pose * offset);
           int inst = scene_.add_instance(mesh_index, mat, world, label,
                                          label ? static_cast<uint32_t>(model_id) : 0);

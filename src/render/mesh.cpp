@@ -133,6 +133,32 @@ MeshData make_sphere(float radius, int stacks, int slices) {
   return m;
 }
 
+MeshLevels sphere_levels(float radius, int stacks, int slices) {
+  MeshLevels out;
+  for (;;) {
+    out.meshes.push_back(make_sphere(radius, stacks, slices));
+    // The vertices lie on the sphere; the surface is farthest from it at a facet's centre,
+    // half a slice and half a stack from its corners.
+    out.errors.push_back(
+        static_cast<float>(radius * (1 - std::cos(kPi / slices) * std::cos(kPi / (2.0 * stacks)))));
+    if (slices / 2 < 8 || stacks / 2 < 2) break;
+    slices /= 2;
+    stacks /= 2;
+  }
+  return out;
+}
+
+MeshLevels cylinder_levels(float radius, float length, int segments) {
+  MeshLevels out;
+  for (;;) {
+    out.meshes.push_back(make_cylinder(radius, length, segments));
+    out.errors.push_back(static_cast<float>(radius * (1 - std::cos(kPi / segments))));
+    if (segments / 2 < 8) break;
+    segments /= 2;
+  }
+  return out;
+}
+
 MeshData make_plane(float sx, float sy) {
   check_positive("make_plane: size x", sx);
   check_positive("make_plane: size y", sy);

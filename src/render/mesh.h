@@ -30,6 +30,18 @@ MeshData make_sphere(float radius, int stacks = 16, int slices = 32);
 // SDF <plane>: a rectangle of sx by sy in the xy plane, centred, facing +z.
 MeshData make_plane(float sx, float sy);
 
+// A mesh and coarser versions of it, each with its geometric error: the largest distance
+// between its surface and the true shape's, in metres. The renderer's levels of detail (see
+// Scene::add_mesh_levels).
+struct MeshLevels {
+  std::vector<MeshData> meshes;  // finest first
+  std::vector<float> errors;     // growing
+};
+// make_sphere(radius, stacks, slices), then stacks and slices halved while slices stay >= 8.
+MeshLevels sphere_levels(float radius, int stacks, int slices);
+// make_cylinder(radius, length, segments), then segments halved while they stay >= 8.
+MeshLevels cylinder_levels(float radius, float length, int segments);
+
 // Fills `mesh->normals` with area-weighted smooth vertex normals.
 void compute_normals(MeshData* mesh);
 

@@ -70,6 +70,7 @@ struct Draw {
   unsigned variant;
   double distance;
   int instance;
+  int mesh;  // the instance's mesh, or a coarser level of it
   glm::mat4 model_view;
   glm::mat3 normal_matrix;
 };
@@ -85,6 +86,7 @@ struct Renderer::Impl {
   std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
   double per_vertex_below = Renderer::kPerVertexLightingBelow;
+  double lod_pixel_error = Renderer::kLodPixelError;
   RenderStats stats;
   // Reused from frame to frame.
   std::vector<Draw> draws;
@@ -173,17 +175,26 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
     if (c.z - r > -spec.near_clip || -c.z - r > spec.far_clip) continue;
     if ((std::abs(c.x) + c.z * tx) / nx > r || (std::abs(c.y) + c.z * ty) / ny > r) continue;
     const glm::dmat3 normal = glm::transpose(glm::inverse(glm::dmat3(mv)));
+    // Level of detail: the coarsest whose error, seen at the instance's nearest point, stays
+    // within lod_pixel_error pixels.
+    int mesh = inst.mesh;
+    const double px_per_metre_near = scale * focal_px / std::max(-c.z - r, spec.near_clip);
+    for (const Scene::Lod& lod : scene.mesh_lods()[inst.mesh]) {
+      if (lod.error * px_per_metre_near > lod_pixel_error) break;
+      mesh = lod.mesh;
+    }
     // Light per vertex where triangles are small on screen (see gl_program.h).
     const double radius_px = r * focal_px / std::max(-c.z, 1e-9);
-    const double px_per_triangle = std::numbers::pi * radius_px * radius_px /
-                                   (0.5 * scene.meshes()[inst.mesh].triangle_count());
+    const double px_per_triangle =
+        std::numbers::pi * radius_px * radius_px / (0.5 * scene.meshes()[mesh].triangle_count());
     const bool per_vertex =
         -c.z > r && !inst.material.double_sided && px_per_triangle < per_vertex_below;
     const auto& ks = inst.material.specular;
     const bool specular = lights_have_specular && (ks[0] > 0 || ks[1] > 0 || ks[2] > 0);
     const unsigned variant = (inst.material.texture >= 0 ? kTextured : 0) |
                              (per_vertex ? kPerVertex : 0) | (specular ? kSpecular : 0);
-    draws.push_back(Draw{glm::length(c) < r, variant, -c.z, i, glm::mat4(mv), glm::mat3(normal)});
+    draws.push_back(
+        Draw{glm::length(c) < r, variant, -c.z, i, mesh, glm::mat4(mv), glm::mat3(normal)});
   }
   std::sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) {
     if (a.surrounds_camera != b.surrounds_camera) return b.surrounds_camera;
@@ -194,7 +205,8 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
 
 void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& view,
                           const CameraSpec& spec, const GpuScene& gpu) {
-  stats = RenderStats{static_cast<int>(draws.size()), 0, 0};
+  stats = RenderStats{};
+  stats.instances_drawn = static_cast<int>(draws.size());
   ++frame_number;
   const SurfaceProgram* program = nullptr;
   unsigned variant = 0;
@@ -219,11 +231,12 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
       last = nullptr;
     }
     const SurfaceProgram& p = *program;
-    const GpuMesh& mesh = gpu.meshes[inst.mesh];
-    if (inst.mesh != bound_mesh) {
+    const GpuMesh& mesh = gpu.meshes[d.mesh];
+    if (d.mesh != bound_mesh) {
       glBindVertexArray(mesh.vao);
-      bound_mesh = inst.mesh;
+      bound_mesh = d.mesh;
     }
+    stats.coarser_level += d.mesh != inst.mesh;
     glUniformMatrix4fv(p.model_view, 1, GL_FALSE, glm::value_ptr(d.model_view));
     glUniformMatrix3fv(p.normal_matrix, 1, GL_FALSE, glm::value_ptr(d.normal_matrix));
     const Material& m = inst.material;
@@ -278,6 +291,8 @@ const RenderStats& Renderer::last_stats() const { return impl_->stats; }
 void Renderer::set_per_vertex_lighting_below(double pixels_per_triangle) {
   impl_->per_vertex_below = pixels_per_triangle;
 }
+
+void Renderer::set_lod_pixel_error(double pixels) { impl_->lod_pixel_error = pixels; }
 
 const std::string& Renderer::description() const { return impl_->context.description(); }
 

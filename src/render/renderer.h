@@ -67,6 +67,7 @@ struct RenderStats {
   int instances_drawn = 0;
   size_t triangles_drawn = 0;
   int per_vertex_lit = 0;  // instances lit per vertex (see set_per_vertex_lighting_below)
+  int coarser_level = 0;   // instances drawn with a coarser level of detail
 };
 
 class Renderer {
@@ -97,6 +98,12 @@ class Renderer {
   // everything per pixel.
   static constexpr double kPerVertexLightingBelow = 4.0;
   void set_per_vertex_lighting_below(double pixels_per_triangle);
+
+  // Levels of detail (Scene::add_mesh_levels): an instance is drawn with the coarsest level
+  // of its mesh whose geometric error, at the instance's nearest point, covers at most this
+  // many pixels. 0 draws every mesh at full detail.
+  static constexpr double kLodPixelError = 1.0;
+  void set_lod_pixel_error(double pixels);
 
   const RenderStats& last_stats() const;
   // OpenGL ES version, renderer and EGL platform, for logs.

@@ -57,6 +57,7 @@ Scene& Scene::operator=(Scene&& other) noexcept {
   uid_ = other.uid_;
   meshes_ = std::move(other.meshes_);
   bounds_ = std::move(other.bounds_);
+  lods_ = std::move(other.lods_);
   textures_ = std::move(other.textures_);
   instances_ = std::move(other.instances_);
   lights_ = std::move(other.lights_);
@@ -66,6 +67,7 @@ Scene& Scene::operator=(Scene&& other) noexcept {
   other.uid_ = next_uid();
   other.meshes_.clear();
   other.bounds_.clear();
+  other.lods_.clear();
   other.textures_.clear();
   other.instances_.clear();
   other.lights_.clear();
@@ -78,7 +80,20 @@ int Scene::add_mesh(const MeshData& mesh) {
   meshes_.push_back(mesh);
   if (meshes_.back().normals.empty()) compute_normals(&meshes_.back());
   bounds_.push_back(bounds_of(mesh));
+  lods_.emplace_back();
   return static_cast<int>(meshes_.size() - 1);
+}
+
+int Scene::add_mesh_levels(const MeshLevels& levels) {
+  if (levels.meshes.empty() || levels.meshes.size() != levels.errors.size()) {
+    throw std::invalid_argument("Scene::add_mesh_levels: need one error per mesh, and a mesh");
+  }
+  const int finest = add_mesh(levels.meshes[0]);
+  for (size_t i = 1; i < levels.meshes.size(); ++i) {
+    const int coarser = add_mesh(levels.meshes[i]);
+    lods_[finest].push_back(Lod{coarser, levels.errors[i]});
+  }
+  return finest;
 }
 
 int Scene::add_texture(const uint8_t* rgba, int width, int height) {

@@ -84,6 +84,11 @@ class Scene {
     std::array<float, 3> centre;
     float radius;
   };
+  // A coarser stand-in for a mesh and its geometric error (metres, in the mesh's frame).
+  struct Lod {
+    int mesh;
+    float error;
+  };
 
   Scene();
   Scene(const Scene&) = delete;
@@ -95,6 +100,10 @@ class Scene {
   // Returns the mesh's index. Computes normals if it has none; throws std::invalid_argument if
   // the arrays are inconsistent.
   int add_mesh(const MeshData& mesh);
+  // Adds every level of `levels` and returns the finest's index, to use as any mesh's. Where
+  // an instance of it is small on screen, the renderer draws the coarsest level whose error
+  // covers at most Renderer::kLodPixelError pixels there.
+  int add_mesh_levels(const MeshLevels& levels);
   // Copies a w x h RGBA8 image (row 0 = top) and returns its index.
   int add_texture(const uint8_t* rgba, int width, int height);
   // Loads a PNG or JPEG file (see image_io.h); throws std::runtime_error naming the file.
@@ -116,6 +125,8 @@ class Scene {
   uint64_t uid() const { return uid_; }  // unique per Scene object in this process
   const std::vector<MeshData>& meshes() const { return meshes_; }
   const std::vector<Bounds>& mesh_bounds() const { return bounds_; }
+  // By mesh: its coarser levels, finest first (empty for most meshes).
+  const std::vector<std::vector<Lod>>& mesh_lods() const { return lods_; }
   const std::vector<Texture>& textures() const { return textures_; }
   const std::vector<Instance>& instances() const { return instances_; }
   const std::vector<Light>& lights() const { return lights_; }
@@ -129,6 +140,7 @@ class Scene {
   uint64_t uid_;
   std::vector<MeshData> meshes_;
   std::vector<Bounds> bounds_;
+  std::vector<std::vector<Lod>> lods_;
   std::vector<Texture> textures_;
   std::vector<Instance> instances_;
   std::vector<Light> lights_;

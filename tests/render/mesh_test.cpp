@@ -253,5 +253,56 @@ TEST_F(MeshFiles, ImageFilesRoundTrip) {
   EXPECT_THROW(scene.add_texture_file(write("bad.png", "not an image")), std::runtime_error);
 }
 
+// The error each level claims bounds how far its surface strays from the true shape: sample
+// every triangle (corners, edge midpoints, centroid) and measure the distance to the sphere
+// or to the cylinder's side.
+TEST(LevelsTest, ErrorsBoundTheDistanceToTheTrueShape) {
+  auto max_gap = [](const MeshData& m, auto distance) {
+    double worst = 0;
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+      std::array<std::array<double, 3>, 3> v;
+      for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) v[k][c] = m.positions[3 * m.indices[t + k] + c];
+      const double w[7][3] = {{1, 0, 0},
+                              {0, 1, 0},
+                              {0, 0, 1},
+                              {.5, .5, 0},
+                              {0, .5, .5},
+                              {.5, 0, .5},
+                              {1. / 3, 1. / 3, 1. / 3}};
+      for (const auto& b : w) {
+        std::array<double, 3> p{};
+        for (int k = 0; k < 3; ++k)
+          for (int c = 0; c < 3; ++c) p[c] += b[k] * v[k][c];
+        worst = std::max(worst, distance(p));
+      }
+    }
+    return worst;
+  };
+  const MeshLevels spheres = sphere_levels(0.4f, 24, 48);
+  ASSERT_EQ(spheres.meshes.size(), 3u);  // 48, 24 and 12 slices
+  EXPECT_EQ(spheres.meshes[0].triangle_count(), make_sphere(0.4f, 24, 48).triangle_count());
+  for (size_t i = 0; i < spheres.meshes.size(); ++i) {
+    const double gap = max_gap(spheres.meshes[i], [](const std::array<double, 3>& p) {
+      return 0.4 - std::hypot(p[0], p[1], p[2]);
+    });
+    EXPECT_LE(gap, spheres.errors[i] * 1.0001) << "level " << i;
+    EXPECT_GE(gap, spheres.errors[i] * 0.5) << "level " << i;  // and not far too pessimistic
+    if (i > 0) {
+      EXPECT_GT(spheres.errors[i], spheres.errors[i - 1]);
+      EXPECT_LT(spheres.meshes[i].triangle_count(), spheres.meshes[i - 1].triangle_count());
+    }
+  }
+  const MeshLevels cylinders = cylinder_levels(0.3f, 1.0f, 32);
+  ASSERT_EQ(cylinders.meshes.size(), 3u);  // 32, 16 and 8 segments
+  for (size_t i = 0; i < cylinders.meshes.size(); ++i) {
+    const double gap = max_gap(cylinders.meshes[i], [](const std::array<double, 3>& p) {
+      return std::abs(p[2]) < 0.5 - 1e-6 ? 0.3 - std::hypot(p[0], p[1]) : 0.0;
+    });
+    EXPECT_LE(gap, cylinders.errors[i] * 1.0001) << "level " << i;
+    EXPECT_GE(gap, cylinders.errors[i] * 0.99) << "level " << i;
+  }
+}
+
 }  // namespace
 }  // namespace convoy::render

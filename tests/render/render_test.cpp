@@ -474,5 +474,57 @@ TEST(RenderTest, RejectsBadInput) {
   EXPECT_FALSE(renderer->description().empty());
 }
 
+// Levels of detail: far spheres are drawn coarser, near ones at full detail, and the image
+// stays within the tolerance of the full-detail one (silhouettes move by under a pixel).
+TEST(RenderTest, LevelsOfDetailLookTheSameAsFullDetail) {
+  GET_RENDERER(renderer);
+  Scene scene;
+  scene.set_background({0, 0, 0, 1});
+  Light sun;
+  sun.direction = {0.3f, -0.6f, -0.7f};
+  scene.add_light(sun);
+  const int sphere = scene.add_mesh_levels(sphere_levels(0.4f, 24, 48));
+  ASSERT_EQ(scene.mesh_lods()[sphere].size(), 2u);
+  for (int i = 0; i < 6; ++i)
+    scene.add_instance(sphere, plain(0.8f, 0.3f, 0.2f), make_pose(2 + 6 * i, 0.5 * (i % 2), 0),
+                       1 + i);
+  const CameraSpec spec{736, 480, 1.047, 0.1, 100};
+  Frame lod, full;
+  renderer->render(scene, identity_pose(), spec, &lod, false, true);
+  const RenderStats with_lod = renderer->last_stats();
+  renderer->set_lod_pixel_error(0);
+  renderer->render(scene, identity_pose(), spec, &full, false, true);
+  const RenderStats without = renderer->last_stats();
+  renderer->set_lod_pixel_error(Renderer::kLodPixelError);
+  EXPECT_EQ(without.coarser_level, 0);
+  EXPECT_EQ(without.triangles_drawn, 6 * make_sphere(0.4f, 24, 48).triangle_count());
+  EXPECT_GE(with_lod.coarser_level, 3);                              // the far ones
+  EXPECT_LT(with_lod.triangles_drawn, without.triangles_drawn / 2);  // 4 of 6 coarser
+  // The nearest sphere (2 m away, 280 px across) keeps every triangle: it is drawn first.
+  // Coverage: the pixels one image covers and the other does not lie on silhouettes only.
+  int differ = 0, covered = 0;
+  double colour = 0;
+  for (size_t p = 0; p < lod.rgb.size() / 3; ++p) {
+    const bool a = lod.rgb[3 * p] || lod.rgb[3 * p + 1] || lod.rgb[3 * p + 2];
+    const bool b = full.rgb[3 * p] || full.rgb[3 * p + 1] || full.rgb[3 * p + 2];
+    covered += a || b;
+    differ += a != b;
+    if (a && b)
+      for (int c = 0; c < 3; ++c)
+        colour += std::abs(int(lod.rgb[3 * p + c]) - int(full.rgb[3 * p + c]));
+  }
+  ASSERT_GT(covered, 40000);
+  EXPECT_LT(differ, covered / 100);
+  EXPECT_LT(colour / (3.0 * covered), 1.0);  // mean difference out of 255
+  // Ground truth is unchanged to the pixel box.
+  ASSERT_EQ(lod.boxes.size(), full.boxes.size());
+  for (size_t i = 0; i < lod.boxes.size(); ++i) {
+    EXPECT_NEAR(lod.boxes[i].x_min, full.boxes[i].x_min, 1);
+    EXPECT_NEAR(lod.boxes[i].x_max, full.boxes[i].x_max, 1);
+    EXPECT_NEAR(lod.boxes[i].y_min, full.boxes[i].y_min, 1);
+    EXPECT_NEAR(lod.boxes[i].y_max, full.boxes[i].y_max, 1);
+  }
+}
+
 }  // namespace
 }  // namespace convoy::render
