@@ -9,7 +9,8 @@
 //
 // Cost (llvmpipe, 2 cores, 736x480): about 1 ms per frame for clearing and reading back, and
 // roughly 150 ns of CPU per triangle in view (tiny triangles cost as much as big ones), so a
-// 100k-triangle view renders at 80-90 frames/s; see benchmarks/render/render_bench.cpp.
+// 100k-triangle view renders at 80-90 frames/s at full detail, and above 150 with the levels
+// of detail (set_lod_pixel_error); see benchmarks/render/render_bench.cpp.
 // Depth adds a float attachment and its readback, boxes an id attachment and a pass over it.
 //
 // Camera convention (Gazebo / SDF): the camera looks along its +X axis, +Z is up in the
