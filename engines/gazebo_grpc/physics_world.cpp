@@ -48,6 +48,14 @@ void set_frames(Props& p, const std::string& name, const Eigen::Isometry3d& pare
   p.mT_ChildBodyToJoint = child_world.inverse() * joint_world;
 }
 
+// The axis-aligned box holding `box` moved by `t`.
+Eigen::AlignedBox3d transformed(const Eigen::AlignedBox3d& box, const Eigen::Isometry3d& t) {
+  Eigen::AlignedBox3d out;
+  for (int c = 0; c < 8; ++c)
+    out.extend(t * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)));
+  return out;
+}
+
 }  // namespace
 
 PhysicsWorld::PhysicsWorld(const WorldDesc& desc) {
@@ -225,25 +233,17 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
     Eigen::AlignedBox3d box;  // in the body frame
     for (const dd::ShapeNode* node : bn->getShapeNodesWith<dd::CollisionAspect>()) {
       const auto& bb = node->getShape()->getBoundingBox();
-      for (int corner = 0; corner < 8; ++corner) {
-        Eigen::Vector3d p((corner & 1) ? bb.getMax().x() : bb.getMin().x(),
-                          (corner & 2) ? bb.getMax().y() : bb.getMin().y(),
-                          (corner & 4) ? bb.getMax().z() : bb.getMin().z());
-        box.extend(node->getRelativeTransform() * p);
-      }
+      box.extend(
+          transformed(Eigen::AlignedBox3d(bb.getMin(), bb.getMax()), node->getRelativeTransform()));
     }
     if (box.isEmpty()) continue;
-    if (model.is_static) {
-      if (!scenery) continue;
-      const Eigen::Isometry3d& t = bn->getWorldTransform();
-      for (int corner = 0; corner < 8; ++corner)
-        scenery_.back().box.extend(
-            t * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)));
-    } else {
-      double radius = 0;
-      for (int corner = 0; corner < 8; ++corner)
-        radius = std::max(radius,
-                          box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)).norm());
+    if (scenery) {
+      scenery_.back().box.extend(transformed(box, bn->getWorldTransform()));
+    } else if (!model.is_static) {
+      double radius = 0;  // the farthest corner from the body's origin
+      for (int c = 0; c < 8; ++c)
+        radius =
+            std::max(radius, box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)).norm());
       moving_.push_back({bn, radius});
     }
   }
@@ -254,11 +254,14 @@ void PhysicsWorld::gate_scenery() {
   // plus half a metre keeps every contact that can happen before then.
   const double window = static_cast<double>(gate_every_) * world_->getTimeStep();
   auto group = world_->getConstraintSolver()->getCollisionGroup();
+  reach_.clear();
+  for (const auto& m : moving_) {
+    reach_.emplace_back(m.body->getWorldTransform().translation(),
+                        m.radius + 2.0 * m.body->getLinearVelocity().norm() * window + 0.5);
+  }
   for (auto& s : scenery_) {
     bool near = false;
-    for (const auto& m : moving_) {
-      const Eigen::Vector3d centre = m.body->getWorldTransform().translation();
-      const double reach = m.radius + 2.0 * m.body->getLinearVelocity().norm() * window + 0.5;
+    for (const auto& [centre, reach] : reach_) {
       if (s.box.exteriorDistance(centre) <= reach) {
         near = true;
         break;

@@ -76,6 +76,7 @@ class PhysicsWorld {
   };
   std::vector<Scenery> scenery_;
   std::vector<MovingBody> moving_;
+  std::vector<std::pair<Eigen::Vector3d, double>> reach_;  // gate_scenery's, reused
   int64_t steps_ = 0;
   int64_t gate_every_ = 1;
 
