@@ -12,6 +12,13 @@ function(convoy_add_library name)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
 endfunction()
 
+# convoy_use_fast_malloc(target): links jemalloc into a program when it was found.
+function(convoy_use_fast_malloc target)
+  if(JEMALLOC_FOUND)
+    target_link_libraries(${target} PRIVATE PkgConfig::JEMALLOC)
+  endif()
+endfunction()
+
 # convoy_add_engine(type SOURCES ... DEPS ... [SCHEMA file] [ALIASES a b])
 # Builds bin/convoy-engine-<type> from the sources (which register the engine class
 # with CONVOY_REGISTER_ENGINE) and installs its config schema under share/convoy/engines.
@@ -21,6 +28,7 @@ function(convoy_add_engine type)
   add_executable(${target} ${ARG_SOURCES})
   target_compile_options(${target} PRIVATE ${CONVOY_WARNINGS})
   target_link_libraries(${target} PRIVATE convoy_engine_main ${ARG_DEPS})
+  convoy_use_fast_malloc(${target})
   if(ARG_SCHEMA)
     configure_file(${ARG_SCHEMA} ${CONVOY_SHARE_DIR}/engines/${type}.schema.json COPYONLY)
   endif()

@@ -140,43 +140,58 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
       }
     } else {
       const AxisDesc axis = j->axes.empty() ? AxisDesc{} : j->axes[0];
-      switch (j->type) {
-        case JointDesc::kRevolute:
-        case JointDesc::kContinuous: {
-          dd::RevoluteJoint::Properties p;
-          set_frames(p, j->name, parent_world, l.pose, j->pose);
-          p.mAxis = axis.xyz;
-          made = skel->createJointAndBodyNodePair<dd::RevoluteJoint>(parent_bn, p, bp);
-          break;
+      // A revolute or prismatic joint whose limits are equal cannot move (Gazebo holds it at
+      // the limit): weld it there, which DART also steps faster than a limited joint.
+      const bool locked = (j->type == JointDesc::kRevolute || j->type == JointDesc::kPrismatic) &&
+                          !j->axes.empty() && axis.lower == axis.upper;
+      if (locked) {
+        Eigen::Isometry3d at = j->pose;
+        if (j->type == JointDesc::kRevolute)
+          at.rotate(Eigen::AngleAxisd(axis.lower, axis.xyz.normalized()));
+        else
+          at.translate(axis.lower * axis.xyz.normalized());
+        dd::WeldJoint::Properties p;
+        set_frames(p, j->name, parent_world, l.pose, j->pose);
+        p.mT_ParentBodyToJoint = parent_world.inverse() * at;
+        made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
+      } else
+        switch (j->type) {
+          case JointDesc::kRevolute:
+          case JointDesc::kContinuous: {
+            dd::RevoluteJoint::Properties p;
+            set_frames(p, j->name, parent_world, l.pose, j->pose);
+            p.mAxis = axis.xyz;
+            made = skel->createJointAndBodyNodePair<dd::RevoluteJoint>(parent_bn, p, bp);
+            break;
+          }
+          case JointDesc::kPrismatic: {
+            dd::PrismaticJoint::Properties p;
+            set_frames(p, j->name, parent_world, l.pose, j->pose);
+            p.mAxis = axis.xyz;
+            made = skel->createJointAndBodyNodePair<dd::PrismaticJoint>(parent_bn, p, bp);
+            break;
+          }
+          case JointDesc::kFixed: {
+            dd::WeldJoint::Properties p;
+            set_frames(p, j->name, parent_world, l.pose, j->pose);
+            made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
+            break;
+          }
+          case JointDesc::kBall: {
+            dd::BallJoint::Properties p;
+            set_frames(p, j->name, parent_world, l.pose, j->pose);
+            made = skel->createJointAndBodyNodePair<dd::BallJoint>(parent_bn, p, bp);
+            break;
+          }
+          case JointDesc::kUniversal: {
+            dd::UniversalJoint::Properties p;
+            set_frames(p, j->name, parent_world, l.pose, j->pose);
+            p.mAxis[0] = axis.xyz;
+            p.mAxis[1] = j->axes.size() > 1 ? j->axes[1].xyz : Eigen::Vector3d::UnitY();
+            made = skel->createJointAndBodyNodePair<dd::UniversalJoint>(parent_bn, p, bp);
+            break;
+          }
         }
-        case JointDesc::kPrismatic: {
-          dd::PrismaticJoint::Properties p;
-          set_frames(p, j->name, parent_world, l.pose, j->pose);
-          p.mAxis = axis.xyz;
-          made = skel->createJointAndBodyNodePair<dd::PrismaticJoint>(parent_bn, p, bp);
-          break;
-        }
-        case JointDesc::kFixed: {
-          dd::WeldJoint::Properties p;
-          set_frames(p, j->name, parent_world, l.pose, j->pose);
-          made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
-          break;
-        }
-        case JointDesc::kBall: {
-          dd::BallJoint::Properties p;
-          set_frames(p, j->name, parent_world, l.pose, j->pose);
-          made = skel->createJointAndBodyNodePair<dd::BallJoint>(parent_bn, p, bp);
-          break;
-        }
-        case JointDesc::kUniversal: {
-          dd::UniversalJoint::Properties p;
-          set_frames(p, j->name, parent_world, l.pose, j->pose);
-          p.mAxis[0] = axis.xyz;
-          p.mAxis[1] = j->axes.size() > 1 ? j->axes[1].xyz : Eigen::Vector3d::UnitY();
-          made = skel->createJointAndBodyNodePair<dd::UniversalJoint>(parent_bn, p, bp);
-          break;
-        }
-      }
       dd::Joint* joint = made.first;
       for (size_t a = 0; a < joint->getNumDofs() && a < j->axes.size(); ++a) {
         const auto& ax = j->axes[a];

@@ -97,12 +97,12 @@ void check_functions(const std::vector<python::LoadedFunction>& functions,
   }
 }
 
-// Engines wait for the coordinator by yielding the CPU for a while before they sleep, but
-// only while there is a core for each of them; otherwise they would slow each other down.
-int engine_spin_us(const config::SimulationConfig& cfg) {
+// Engines whose next request usually comes within this time wait for it by yielding the CPU
+// rather than sleeping (EngineServer::set_spin_us): the slowest engine of a lock-step loop
+// then starts its next step without a wake-up; the others, which wait longer, sleep.
+int engine_spin_us() {
   if (const char* s = std::getenv("CONVOY_ENGINE_SPIN_US")) return std::atoi(s);
-  long cores = sysconf(_SC_NPROCESSORS_ONLN);
-  return static_cast<long>(cfg.engines.size()) <= cores ? 50 : 0;
+  return 300;
 }
 
 // Each local engine gets two arenas of this size (virtual: pages are used once written).
@@ -133,7 +133,7 @@ void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& c
   spec.program = ec.proc_cmd.empty() ? "convoy-engine-" + ec.type : ec.proc_cmd;
   spec.args = ec.proc_start_params;
   spec.args.insert(spec.args.end(),
-                   {"--convoy-fd", "3", "--convoy-spin-us", std::to_string(engine_spin_us(cfg))});
+                   {"--convoy-fd", "3", "--convoy-spin-us", std::to_string(engine_spin_us())});
   spec.pass_fds = {fds[1]};
   if (size_t bytes = shm_arena_bytes(); bytes > 0) {  // CONVOY_SHM_MB=0: blobs inline
     handle.create_arenas(bytes);

@@ -110,12 +110,20 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
   if (shm_in_fd >= 0) in_arena.attach(shm_in_fd);
   transport::ShmBlobReader reader(shm_in_fd >= 0 ? &in_arena : nullptr);
   transport::ScopedBlobContext blobs(writer.get(), &reader);
-  if (spin_us_ > 0) socket.set_spin(spin_us_ * 1000, true);
   std::string in, out;
   engine::Request request;
   engine::Reply reply;
+  const int64_t max_spin_ns = spin_us_ * 1000;
+  int64_t usual_gap_ns = -1;  // running average of the wait for the next request
   for (;;) {
+    const int64_t waited_from = now_ns();
+    if (max_spin_ns > 0 && usual_gap_ns >= 0 && usual_gap_ns <= max_spin_ns)
+      socket.set_spin(std::min(max_spin_ns, usual_gap_ns + usual_gap_ns / 4 + 20'000), true);
+    else
+      socket.set_spin(0);
     if (socket.recv(&in, Deadline::max()) != transport::RecvStatus::kOk) break;
+    const int64_t gap = now_ns() - waited_from;
+    usual_gap_ns = usual_gap_ns < 0 ? gap : (3 * usual_gap_ns + gap) / 4;
     request.Clear();
     reply.Clear();
     if (!request.ParseFromString(in)) {

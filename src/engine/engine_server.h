@@ -15,8 +15,9 @@ class EngineServer {
   // Handles one request. Returns false once the engine has been shut down.
   bool handle(const engine::Request& request, engine::Reply* reply);
 
-  // Waiting for the next request, yield the CPU in a loop for this long before sleeping
-  // (cheaper than a wake-up when there are cores to spare).
+  // Waiting for the next request, yield the CPU in a loop before sleeping (cheaper than a
+  // wake-up) when the coordinator usually comes back within `us`: for a little longer than
+  // its usual gap, at most `us`. An engine that usually waits longer sleeps at once.
   void set_spin_us(int64_t us) { spin_us_ = us; }
 
   // Serves requests on a connected stream socket until Shutdown or until the peer closes.

@@ -162,6 +162,35 @@ TEST(WorldDescription, IncludeWithModelUriMeshesAndJointTypes) {
   EXPECT_NEAR(p.link_state(p.link_index("tower_a::base")).position.z(), 0.5, 0.02);
 }
 
+TEST(Physics, JointsWithEqualLimitsHoldTheirChildAtTheLimit) {
+  // As in Gazebo: a revolute (or prismatic) joint whose lower and upper limits are equal
+  // cannot move, here a pendulum held 0.5 rad from the vertical and a slider held 0.2 m up.
+  std::string file = ::testing::TempDir() + "/locked_joints.sdf";
+  std::ofstream(file) << R"(<sdf version='1.7'><world name='w'>
+    <model name='pendulum'><pose>0 0 2 0 0 0</pose>
+      <link name='bob'><pose>0 0 -1 0 0 0</pose><inertial><mass>1</mass></inertial></link>
+      <joint name='pivot' type='revolute'><parent>world</parent><child>bob</child>
+        <pose>0 0 1 0 0 0</pose>
+        <axis><xyz>0 1 0</xyz><limit><lower>0.5</lower><upper>0.5</upper></limit></axis></joint>
+    </model>
+    <model name='slider'><pose>5 0 1 0 0 0</pose>
+      <link name='block'><inertial><mass>1</mass></inertial></link>
+      <joint name='rail' type='prismatic'><parent>world</parent><child>block</child>
+        <axis><xyz>0 0 1</xyz><limit><lower>0.2</lower><upper>0.2</upper></limit></axis></joint>
+    </model></world></sdf>)";
+  PhysicsWorld p(load_world(file));
+  EXPECT_LT(p.joint_index("pendulum::pivot"), 0);  // no degree of freedom left
+  for (int i = 0; i < 1000; ++i) p.step();
+  // The bob hangs 1 m from the pivot at (0, 0, 2), turned 0.5 rad about +y.
+  LinkState bob = p.link_state(p.link_index("pendulum::bob"));
+  EXPECT_NEAR(bob.position.x(), -std::sin(0.5), 1e-9);
+  EXPECT_NEAR(bob.position.z(), 2 - std::cos(0.5), 1e-9);
+  EXPECT_NEAR(bob.linear_velocity.norm(), 0, 1e-9);
+  LinkState block = p.link_state(p.link_index("slider::block"));
+  EXPECT_NEAR(block.position.z(), 1.2, 1e-9);
+  EXPECT_NEAR(block.linear_velocity.norm(), 0, 1e-9);
+}
+
 std::string error_of(const std::string& sdf_text) {
   std::string file = ::testing::TempDir() + "/bad_world.sdf";
   std::ofstream(file) << sdf_text;
