@@ -1,5 +1,7 @@
 #include "python/datapack_convert.h"
 
+#include <pybind11/numpy.h>
+
 #include <cstring>
 #include <stdexcept>
 
@@ -37,7 +39,9 @@ bool type_is(py::handle obj, const char* name) {
 }
 
 py::object uint8_array(std::string_view bytes, bool in_shm, ImageAccess access) {
-  py::object frombuffer = py::module_::import("numpy").attr("frombuffer");
+  static py::object* frombuffer_fn =
+      new py::object(py::module_::import("numpy").attr("frombuffer"));
+  const py::object& frombuffer = *frombuffer_fn;
   if (in_shm && access == ImageAccess::kView) {
     py::object view = py::reinterpret_steal<py::object>(PyMemoryView_FromMemory(
         const_cast<char*>(bytes.data()), static_cast<Py_ssize_t>(bytes.size()), PyBUF_READ));
@@ -58,10 +62,12 @@ std::vector<float> float_vector(py::handle value, size_t n, const char* what) {
   return out;
 }
 
-py::object float_array(const google::protobuf::RepeatedField<float>& values, size_t n) {
-  py::object arr = py::module_::import("numpy").attr("zeros")(n, "float32");
-  for (int i = 0; i < values.size() && static_cast<size_t>(i) < n; ++i)
-    arr[py::int_(i)] = values.Get(i);
+// A float32 array of n values, zero where the message has fewer.
+py::array_t<float> float_array(const google::protobuf::RepeatedField<float>& values, size_t n) {
+  py::array_t<float> arr(static_cast<py::ssize_t>(n));
+  float* out = arr.mutable_data();
+  for (size_t i = 0; i < n; ++i)
+    out[i] = i < static_cast<size_t>(values.size()) ? values.Get(static_cast<int>(i)) : 0.0f;
   return arr;
 }
 
@@ -90,8 +96,8 @@ py::object proto_data(const engine::DataPack& dp, ImageAccess access) {
   if (type == kLink) {
     data::Link l;
     if (!l.ParseFromString(p.data())) throw std::runtime_error("corrupt link datapack");
-    py::object rot = float_array(l.rotation(), 4);
-    if (l.rotation_size() == 0) rot[py::int_(3)] = 1.0f;
+    py::array_t<float> rot = float_array(l.rotation(), 4);
+    if (l.rotation_size() == 0) rot.mutable_data()[3] = 1.0f;
     return m.attr("LinkData")(float_array(l.position(), 3), rot,
                               float_array(l.linear_velocity(), 3),
                               float_array(l.angular_velocity(), 3));
