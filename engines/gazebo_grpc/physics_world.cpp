@@ -105,25 +105,70 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
     bp.mGravityMode = l.gravity;
     return bp;
   };
-  auto add_shapes = [&](dd::BodyNode* bn, const LinkDesc& l) {
+  // Gives body `bn` the collision shapes of link `l`, whose frame is `link_offset` in the
+  // body's frame, and registers the link as that body and offset.
+  auto add_shapes = [&](dd::BodyNode* bn, const LinkDesc& l, const Eigen::Isometry3d& link_offset) {
     for (const auto& c : l.collisions) {
       Eigen::Isometry3d offset = c.pose;
       auto shape = make_shape(c.shape, &offset);
       auto* node = bn->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(
           shape, l.name + "::" + c.name);
-      node->setRelativeTransform(offset);
+      node->setRelativeTransform(link_offset * offset);
       node->getDynamicsAspect()->setFrictionCoeff(c.mu);
     }
-    links_.push_back(bn);
+    links_.push_back({bn, link_offset, link_offset.isApprox(Eigen::Isometry3d::Identity(), 0)});
     link_names_.push_back(l.name);
     link_by_name_[l.name] = static_cast<int>(links_.size() - 1);
   };
+  // Adds the mass of link `l`, whose frame is `offset` in the body's frame, to body `bn`.
+  auto add_inertia = [](dd::BodyNode* bn, const LinkDesc& l, const Eigen::Isometry3d& offset) {
+    const dd::Inertia& host = bn->getInertia();
+    const double m1 = host.getMass(), m2 = l.mass, m = m1 + m2;
+    const Eigen::Vector3d c1 = host.getLocalCOM(), c2 = offset * l.com;
+    const Eigen::Vector3d c = m > 0 ? Eigen::Vector3d((m1 * c1 + m2 * c2) / m) : c1;
+    auto about_c = [&](double mass, const Eigen::Vector3d& at) -> Eigen::Matrix3d {
+      const Eigen::Vector3d d = at - c;  // parallel axis theorem
+      return mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+    };
+    const Eigen::Matrix3d moment = host.getMoment() + about_c(m1, c1) +
+                                   offset.linear() * l.inertia * offset.linear().transpose() +
+                                   about_c(m2, c2);
+    bn->setInertia(dd::Inertia(m, c, moment));
+  };
 
   // Builds the subtree hanging from `parent_bn` through joint `j` (nullptr: a root link).
-  std::function<void(dd::BodyNode*, const LinkDesc&, const JointDesc*)> attach;
-  attach = [&](dd::BodyNode* parent_bn, const LinkDesc& l, const JointDesc* j) {
-    Eigen::Isometry3d parent_world =
-        (j && j->parent != "world") ? links.at(j->parent)->pose : Eigen::Isometry3d::Identity();
+  // `parent_world` is where the parent body's frame is in the world as the SDF places the
+  // links (the identity for the world).
+  std::function<void(dd::BodyNode*, const Eigen::Isometry3d&, const LinkDesc&, const JointDesc*)>
+      attach;
+  attach = [&](dd::BodyNode* parent_bn, const Eigen::Isometry3d& parent_world, const LinkDesc& l,
+               const JointDesc* j) {
+    auto attach_children = [&](dd::BodyNode* bn, const Eigen::Isometry3d& bn_world) {
+      auto it = children.find(l.name);
+      if (it == children.end()) return;
+      for (const JointDesc* cj : it->second) attach(bn, bn_world, *links.at(cj->child), cj);
+    };
+    // A revolute or prismatic joint whose limits are equal cannot move (Gazebo holds it at
+    // the limit). Such a joint, or a fixed one, between two links makes them one rigid body:
+    // the child's mass and shapes join the parent's body, which DART steps faster than two
+    // bodies welded together.
+    const AxisDesc axis = (!j || j->axes.empty()) ? AxisDesc{} : j->axes[0];
+    const bool locked = j &&
+                        (j->type == JointDesc::kRevolute || j->type == JointDesc::kPrismatic) &&
+                        !j->axes.empty() && axis.lower == axis.upper;
+    Eigen::Isometry3d joint_at = j ? j->pose : Eigen::Isometry3d::Identity();  // held there
+    if (locked && j->type == JointDesc::kRevolute)
+      joint_at.rotate(Eigen::AngleAxisd(axis.lower, axis.xyz.normalized()));
+    else if (locked)
+      joint_at.translate(axis.lower * axis.xyz.normalized());
+    if (j && parent_bn && (locked || j->type == JointDesc::kFixed)) {
+      const Eigen::Isometry3d offset =
+          parent_world.inverse() * joint_at * j->pose.inverse() * l.pose;
+      add_inertia(parent_bn, l, offset);
+      add_shapes(parent_bn, l, offset);
+      attach_children(parent_bn, l.pose * offset.inverse());
+      return;
+    }
     std::pair<dd::Joint*, dd::BodyNode*> made;
     auto bp = body_props(l);
     if (!j) {
@@ -139,20 +184,10 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
         made.first->setPositions(dd::FreeJoint::convertToPositions(l.pose));
       }
     } else {
-      const AxisDesc axis = j->axes.empty() ? AxisDesc{} : j->axes[0];
-      // A revolute or prismatic joint whose limits are equal cannot move (Gazebo holds it at
-      // the limit): weld it there, which DART also steps faster than a limited joint.
-      const bool locked = (j->type == JointDesc::kRevolute || j->type == JointDesc::kPrismatic) &&
-                          !j->axes.empty() && axis.lower == axis.upper;
-      if (locked) {
-        Eigen::Isometry3d at = j->pose;
-        if (j->type == JointDesc::kRevolute)
-          at.rotate(Eigen::AngleAxisd(axis.lower, axis.xyz.normalized()));
-        else
-          at.translate(axis.lower * axis.xyz.normalized());
+      if (locked) {  // to the world: welded where it is held
         dd::WeldJoint::Properties p;
         set_frames(p, j->name, parent_world, l.pose, j->pose);
-        p.mT_ParentBodyToJoint = parent_world.inverse() * at;
+        p.mT_ParentBodyToJoint = parent_world.inverse() * joint_at;
         made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
       } else
         switch (j->type) {
@@ -214,18 +249,16 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
         joint_by_name_[j->name] = static_cast<int>(joints_.size() - 1);
       }
     }
-    add_shapes(made.second, l);
-    auto it = children.find(l.name);
-    if (it == children.end()) return;
-    for (const JointDesc* cj : it->second) attach(made.second, *links.at(cj->child), cj);
+    add_shapes(made.second, l, Eigen::Isometry3d::Identity());
+    attach_children(made.second, l.pose);
   };
 
   for (const auto& l : model.links) {
     auto tw = to_world.find(l.name);
     if (tw != to_world.end()) {
-      attach(nullptr, l, tw->second);  // jointed to the world frame
+      attach(nullptr, Eigen::Isometry3d::Identity(), l, tw->second);  // jointed to the world
     } else if (!has_parent.count(l.name)) {
-      attach(nullptr, l, nullptr);  // a free (or, in a static model, welded) root
+      attach(nullptr, Eigen::Isometry3d::Identity(), l, nullptr);  // a free or welded root
     }
   }
   if (model.is_static) skel->setMobile(false);  // DART then skips its dynamics
@@ -322,17 +355,19 @@ int PhysicsWorld::link_index(const std::string& name) const {
 }
 
 Eigen::Isometry3d PhysicsWorld::link_pose(int index) const {
-  return links_[index]->getWorldTransform();
+  const LinkRef& l = links_[index];
+  if (l.at_origin) return l.body->getWorldTransform();
+  return l.body->getWorldTransform() * l.offset;
 }
 
 LinkState PhysicsWorld::link_state(int index) const {
-  const dd::BodyNode* bn = links_[index];
+  const LinkRef& l = links_[index];
   LinkState s;
-  const Eigen::Isometry3d& t = bn->getWorldTransform();
+  const Eigen::Isometry3d t = link_pose(index);
   s.position = t.translation();
   s.rotation = Eigen::Quaterniond(t.linear());
-  s.linear_velocity = bn->getLinearVelocity();
-  s.angular_velocity = bn->getAngularVelocity();
+  s.linear_velocity = l.body->getLinearVelocity(l.offset.translation());
+  s.angular_velocity = l.body->getAngularVelocity();
   return s;
 }
 

@@ -1,6 +1,7 @@
 // The world's physics: DART with the Bullet collision detector, built from a WorldDesc.
-// Each SDF model is a DART skeleton; each link a body node; root links hang from the world
-// on a free joint (a weld for static models).
+// Each SDF model is a DART skeleton; each link a body node, except that links joined by a
+// fixed joint (or one whose limits are equal) share one; root links hang from the world on a
+// free joint (a weld for static models).
 #pragma once
 
 #include <dart/dart.hpp>
@@ -83,7 +84,14 @@ class PhysicsWorld {
   dart::simulation::WorldPtr world_;
   std::vector<JointRef> joints_;
   std::unordered_map<std::string, int> joint_by_name_;
-  std::vector<dart::dynamics::BodyNode*> links_;
+  // A link: the body it is part of (links joined by a fixed joint share one) and its frame
+  // in the body's frame.
+  struct LinkRef {
+    dart::dynamics::BodyNode* body;
+    Eigen::Isometry3d offset;
+    bool at_origin;  // offset is the identity
+  };
+  std::vector<LinkRef> links_;
   std::vector<std::string> link_names_;
   std::unordered_map<std::string, int> link_by_name_;
 };

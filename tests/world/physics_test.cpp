@@ -191,6 +191,53 @@ TEST(Physics, JointsWithEqualLimitsHoldTheirChildAtTheLimit) {
   EXPECT_NEAR(block.linear_velocity.norm(), 0, 1e-9);
 }
 
+TEST(Physics, LinksJoinedByAFixedJointMoveAsOneRigidBody) {
+  // A compound pendulum: a rod (1 kg, 0.5 m below the pivot) with a bob (1 kg, 1 m below,
+  // its own moment 0.01 about y, tilted) fixed to it. DART steps the two links as one body;
+  // the period must still be 2 pi sqrt(I / (m g d)), with I and d of both links together.
+  std::string file = ::testing::TempDir() + "/fixed_links.sdf";
+  std::ofstream(file) << R"(<sdf version='1.7'><world name='w'>
+    <model name='pend'><pose>0 0 3 0 0 0</pose>
+      <link name='rod'><pose>0 0 -0.5 0 0 0</pose><inertial><mass>1</mass>
+        <inertia><ixx>1e-9</ixx><iyy>1e-9</iyy><izz>1e-9</izz></inertia></inertial></link>
+      <link name='bob'><pose>0 0 -1 0.3 0 0.2</pose><inertial><mass>1</mass>
+        <inertia><ixx>0.01</ixx><iyy>0.01</iyy><izz>0.01</izz></inertia></inertial></link>
+      <joint name='pivot' type='revolute'><parent>world</parent><child>rod</child>
+        <pose>0 0 0.5 0 0 0</pose><axis><xyz>0 1 0</xyz></axis></joint>
+      <joint name='weld' type='fixed'><parent>rod</parent><child>bob</child></joint>
+    </model></world></sdf>)";
+  PhysicsWorld p(load_world(file));
+  EXPECT_EQ(p.dart_world()->getSkeleton("pend")->getNumBodyNodes(), 1u);
+  const int pivot = p.joint_index("pend::pivot"), bob = p.link_index("pend::bob");
+  ASSERT_GE(pivot, 0);
+  ASSERT_GE(bob, 0);
+  EXPECT_NEAR(p.link_state(bob).position.z(), 2.0, 1e-12);
+  EXPECT_NEAR(p.link_state(bob).rotation.angularDistance(
+                  Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()) *
+                                     Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()))),
+              0, 1e-12);
+  p.set_joint_position(pivot, 0.02);
+  std::vector<double> crossings;
+  double last = p.joint_state(pivot).position, max_speed_error = 0;
+  for (int i = 0; i < 10000; ++i) {
+    p.step();
+    JointState j = p.joint_state(pivot);
+    // The bob's velocity is that of a point 1 m from the pivot turning at the joint's rate.
+    max_speed_error = std::max(
+        max_speed_error, std::abs(p.link_state(bob).linear_velocity.norm() - std::abs(j.velocity)));
+    if (last > 0 && j.position <= 0)
+      crossings.push_back(p.time() - p.step_size() * j.position / (j.position - last));
+    last = j.position;
+  }
+  EXPECT_LT(max_speed_error, 1e-9);
+  ASSERT_GE(crossings.size(), 3u);
+  const double period =
+      (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  const double inertia = 1 * 0.25 + 1 * 1.0 + 0.01, mgd = 2 * 9.81 * 0.75;
+  const double expected = 2 * M_PI * std::sqrt(inertia / mgd);
+  EXPECT_NEAR(period, expected, 0.002 * expected);
+}
+
 std::string error_of(const std::string& sdf_text) {
   std::string file = ::testing::TempDir() + "/bad_world.sdf";
   std::ofstream(file) << sdf_text;
