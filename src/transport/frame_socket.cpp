@@ -55,16 +55,31 @@ bool FrameSocket::send(const std::string& payload) {
 }
 
 size_t FrameSocket::read_some(char* dst, size_t n, Deadline deadline, RecvStatus* status) {
-  int64_t spin_until = spin_ns_ > 0 ? now_ns() + spin_ns_ : 0;
+  const bool planned = plan_.spin_until || plan_.sleep_until || plan_.spin2_until;
+  int64_t spin_until = planned ? plan_.spin_until : spin_ns_ > 0 ? now_ns() + spin_ns_ : 0;
   for (;;) {
     ssize_t r = ::recv(fd_, dst, n, MSG_DONTWAIT);
     if (r > 0) return static_cast<size_t>(r);
-    if (r < 0 && errno == EAGAIN && spin_until && now_ns() < spin_until) {
-      if (spin_yield_)
-        sched_yield();
-      else
-        __builtin_ia32_pause();
-      continue;
+    if (r < 0 && errno == EAGAIN) {
+      const int64_t now = spin_until || planned ? now_ns() : 0;
+      if (spin_until && now < spin_until) {
+        if (spin_yield_ || planned)
+          sched_yield();
+        else
+          __builtin_ia32_pause();
+        continue;
+      }
+      if (planned && now < plan_.sleep_until) {
+        const int64_t ns = plan_.sleep_until - now;
+        timespec ts{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+        pollfd p{fd_, POLLIN, 0};
+        ::ppoll(&p, 1, &ts, nullptr);
+        continue;
+      }
+      if (planned && now < plan_.spin2_until) {
+        spin_until = plan_.spin2_until;
+        continue;
+      }
     }
     if (r == 0) {
       *status = RecvStatus::kClosed;
@@ -95,6 +110,10 @@ size_t FrameSocket::read_some(char* dst, size_t n, Deadline deadline, RecvStatus
 
 RecvStatus FrameSocket::recv(std::string* payload, Deadline deadline) {
   if (fd_ < 0) return RecvStatus::kClosed;
+  struct ClearPlan {  // plan_wait() holds for one recv
+    WaitPlan& plan;
+    ~ClearPlan() { plan = {}; }
+  } clear_plan{plan_};
   RecvStatus status = RecvStatus::kOk;
   constexpr size_t kChunk = 1 << 16;
   for (;;) {

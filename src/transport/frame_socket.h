@@ -33,6 +33,14 @@ class FrameSocket {
     spin_ns_ = ns;
     spin_yield_ = yield;
   }
+  // For the next recv only, a wait in three phases before blocking (steady-clock ns; a phase
+  // already over is skipped): yield the CPU until `spin_until`, then sleep (woken at once by
+  // data) until `sleep_until`, then yield again until `spin2_until`. For a caller that knows
+  // when a long reply is due: it spins for a short reply, leaves the core to others while a
+  // long one is computed, and spins again shortly before it is due.
+  void plan_wait(int64_t spin_until, int64_t sleep_until, int64_t spin2_until) {
+    plan_ = {spin_until, sleep_until, spin2_until};
+  }
 
  private:
   // One blocking read into `dst` (at most `n` bytes); 0 with `status` set when none.
@@ -40,6 +48,9 @@ class FrameSocket {
   int fd_;
   int64_t spin_ns_ = 0;
   bool spin_yield_ = false;
+  struct WaitPlan {
+    int64_t spin_until = 0, sleep_until = 0, spin2_until = 0;
+  } plan_;
   std::string buffer_;  // bytes received but not yet returned, from buffer_pos_
   size_t buffer_pos_ = 0, buffer_len_ = 0;
 };

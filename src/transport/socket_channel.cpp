@@ -25,18 +25,9 @@ class SocketChannel final : public EngineChannel {
 
   CallStatus finish(engine::Reply* reply, Deadline limit) override {
     if (send_failed_) return CallStatus::kClosed;
-    if (fixed_spin_ns_ < 0) {
-      // Wait for the reply by yielding the CPU (not sleeping: waking up costs tens of
-      // microseconds here) until a little past the engine's usual round trip, up to 2 ms.
-      int64_t until = started_ns_ + std::min<int64_t>(kMaxSpinNs, usual_ns_ + usual_ns_ / 4);
-      socket_.set_spin(std::max<int64_t>(kMinSpinNs, until - now_ns()), true);
-    }
+    if (fixed_spin_ns_ < 0) plan_wait();
     RecvStatus status = socket_.recv(&in_, std::min(deadline_, limit));
-    if (status == RecvStatus::kOk) {
-      // The usual round trip: a running average that follows changes within a few calls.
-      int64_t took = now_ns() - started_ns_;
-      usual_ns_ = usual_ns_ == 0 ? took : (3 * usual_ns_ + took) / 4;
-    }
+    if (status == RecvStatus::kOk) learn(now_ns() - started_ns_);
     switch (status) {
       case RecvStatus::kClosed:
         return CallStatus::kClosed;
@@ -55,16 +46,52 @@ class SocketChannel final : public EngineChannel {
   std::string describe() const override { return "socket fd " + std::to_string(socket_.fd()); }
 
  private:
+  // Round trips are often of two kinds, short and long (an engine whose camera renders every
+  // other step, say): a running average of each, which follows changes within a few calls.
+  void learn(int64_t took) {
+    auto follow = [](int64_t& avg, int64_t x) { avg = avg == 0 ? x : (3 * avg + x) / 4; };
+    if (short_ns_ == 0 || took <= 2 * short_ns_) {
+      follow(short_ns_, took);
+      longs_in_a_row_ = 0;
+    } else {
+      follow(long_ns_, took);
+      // Only long ones for a while: they are the usual ones now.
+      if (++longs_in_a_row_ >= 8) {
+        short_ns_ = long_ns_;
+        long_ns_ = 0;
+        longs_in_a_row_ = 0;
+      }
+    }
+    if (long_ns_ != 0 && long_ns_ <= 2 * short_ns_) long_ns_ = 0;  // the kinds have merged
+  }
+
+  // Waits for the reply by yielding the CPU (not sleeping: waking up costs tens of
+  // microseconds here) until a little past the usual short round trip. When long ones occur
+  // too, it then sleeps (woken by the reply if it comes) until shortly before the usual long
+  // one, so that the engine (a renderer's threads, say) has the other core meanwhile, and
+  // yields again until a little past it. Then it blocks.
+  void plan_wait() {
+    const int64_t spin1 =
+        started_ns_ + std::clamp<int64_t>(short_ns_ + short_ns_ / 4, kMinSpinNs, kMaxSpinNs);
+    int64_t sleep_until = 0, spin2 = 0;
+    if (long_ns_ > 0) {
+      sleep_until = started_ns_ + long_ns_ - std::max<int64_t>(kWakeEarlyNs, long_ns_ / 8);
+      spin2 = std::min(started_ns_ + long_ns_ + long_ns_ / 4, sleep_until + kMaxSpinNs);
+    }
+    socket_.plan_wait(spin1, sleep_until, spin2);
+  }
+
   static int64_t now_ns() {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(
                std::chrono::steady_clock::now().time_since_epoch())
         .count();
   }
-  static constexpr int64_t kMinSpinNs = 100'000, kMaxSpinNs = 2'000'000;
+  static constexpr int64_t kMinSpinNs = 100'000, kMaxSpinNs = 2'000'000, kWakeEarlyNs = 200'000;
 
   FrameSocket socket_;
   int64_t fixed_spin_ns_ = -1;  // CONVOY_SPIN_US, when set
-  int64_t started_ns_ = 0, usual_ns_ = 0;
+  int64_t started_ns_ = 0, short_ns_ = 0, long_ns_ = 0;
+  int longs_in_a_row_ = 0;
   Deadline deadline_{};
   std::string out_, in_;
   bool send_failed_ = false;
