@@ -109,7 +109,9 @@ class DetectorEngine final : public Engine {
           return;
         }
       }
-      // Images are accepted but not needed; they only give the frame size.
+      // Images are accepted but not needed; they only give the frame size, read once (a
+      // camera keeps its size).
+      if (width_ > 0) return;
       cv::Mat img = detector::image_from_datapack(dp);
       if (!img.empty()) {
         width_ = img.cols;

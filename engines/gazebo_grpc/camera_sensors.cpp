@@ -206,7 +206,9 @@ void CameraSensors::update(double t) {
   bool poses_fresh = false;
   for (auto& cam : cameras_) {
     if (!cam.want_image && !cam.want_depth && !cam.want_boxes) continue;
-    if (cam.rendered && t + 1e-9 < cam.next_update) continue;
+    // Due from half a physics step before its time: engine clocks in whole nanoseconds (a
+    // 1/30 s timestep) fall a little short of the camera's period in doubles.
+    if (cam.rendered && t + 0.5 * physics_.step_size() < cam.next_update) continue;
     if (!poses_fresh) {
       for (const auto& tr : tracked_) {
         render::Pose link = to_pose(physics_.link_pose(tr.link));

@@ -71,8 +71,6 @@ class GazeboEngine final : public Engine {
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
     cameras_ =
         std::make_unique<world::CameraSensors>(desc_, *physics_, config.value("GazeboRNGSeed", 0u));
-    substeps_ = std::max<int64_t>(
-        1, std::llround(static_cast<double>(timestep_ns) * 1e-9 / physics_->step_size()));
 
     std::vector<engine::DataPackId> ids;
     auto add = [&](const std::string& dp_name, const char* type) {
@@ -126,7 +124,12 @@ class GazeboEngine final : public Engine {
 
   int64_t step(int64_t duration_ns) override {
     const double dt = physics_->step_size();
-    int64_t n = std::max<int64_t>(1, std::llround(static_cast<double>(duration_ns) * 1e-9 / dt));
+    // As many physics steps as keep the physics clock within half a step of the engine's,
+    // so that a timestep that is not a multiple of max_step_size (1/30 s, say) does not drift.
+    time_ns_ += duration_ns;
+    const int64_t dt_ns = std::max<int64_t>(1, std::llround(dt * 1e9));
+    const int64_t n = (time_ns_ + dt_ns / 2) / dt_ns - physics_steps_;
+    physics_steps_ += n;
     for (int64_t k = 0; k < n; ++k) {
       for (auto& c : controllers_) {
         auto s = physics_->joint_state(c.joint);
@@ -135,7 +138,6 @@ class GazeboEngine final : public Engine {
       }
       physics_->step();
     }
-    time_ns_ += duration_ns;
     cameras_->update(static_cast<double>(time_ns_) * 1e-9);
     return time_ns_;
   }
@@ -212,8 +214,8 @@ class GazeboEngine final : public Engine {
   std::unordered_map<std::string, size_t> joint_dps_;
   std::unordered_map<std::string, int> link_dps_;
   std::mt19937_64 rng_;
-  int64_t substeps_ = 1;
   int64_t time_ns_ = 0;
+  int64_t physics_steps_ = 0;  // taken since the start
 };
 
 CONVOY_REGISTER_ENGINE("gazebo_grpc", GazeboEngine);

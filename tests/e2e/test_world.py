@@ -99,6 +99,45 @@ class WorldEngine(unittest.TestCase):
         self.assertGreater(last["x"], 0.8)          # ~0.4 m/s for ~3 s
         self.assertAlmostEqual(last["qw"], 1.0, delta=0.01)
 
+    def test_physics_keeps_time_with_any_engine_timestep(self):
+        # A ball falls freely: after the engine's k-th step its speed is g k dt_engine, to
+        # within half a physics step (1 ms), whether the engine step is shorter than the
+        # physics step or no multiple of it (1/30 s).
+        for timestep in (0.0005, 1 / 30):
+            ex = Experiment(self)
+            shutil.copy(os.path.join(HERE, "..", "world", "data", "physics_basics.sdf"),
+                        os.path.join(ex.dir, "world.sdf"))
+            ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                               "GazeboWorldFile": "world.sdf", "EngineTimestep": timestep})
+            ex.engine("probe", textwrap.dedent("""\
+                import json, os
+                from nrp_core.engines.python_json import EngineScript
+                class Script(EngineScript):
+                    def initialize(self):
+                        self._registerDataPack("vz")
+                        self.log = []
+                    def runLoop(self, timestep_ns):
+                        self.log.append(self._getDataPack("vz"))
+                    def shutdown(self):
+                        with open(os.path.join(os.path.dirname(__file__), "vz.json"), "w") as f:
+                            json.dump(self.log, f)
+                """), timestep=timestep)
+            ex.function("tf", textwrap.dedent("""\
+                from nrp_core import *
+                from nrp_core.data.nrp_json import *
+                @EngineDataPack(keyword='ball', id=DataPackIdentifier('ball_link_plugin::body', 'gazebo'))
+                @TransceiverFunction("probe")
+                def tf(ball):
+                    return [JsonDataPack("vz", "probe", float(ball.data.lin_vel[2]))]
+                """))
+            ex.run(0.5)
+            with open(os.path.join(ex.dir, "vz.json")) as f:
+                vz = json.load(f)
+            self.assertGreaterEqual(len(vz), 14, timestep)
+            for k, v in enumerate(vz):
+                self.assertAlmostEqual(v, -9.81 * k * timestep, delta=9.81 * 0.0006,
+                                       msg="step %d of %g s" % (k, timestep))
+
     def test_sdf_models_are_inserted_at_their_init_pose(self):
         ex = Experiment(self)
         data = os.path.join(HERE, "..", "world", "data")
