@@ -69,14 +69,20 @@ class SocketChannel final : public EngineChannel {
   // microseconds here) until a little past the usual short round trip. When long ones occur
   // too, it then sleeps (woken by the reply if it comes) until shortly before the usual long
   // one, so that the engine (a renderer's threads, say) has the other core meanwhile, and
-  // yields again until a little past it. Then it blocks.
+  // yields again until a little past it. Then it blocks. When even the short ones take more
+  // than 2 ms, it sleeps and yields likewise around the short one.
   void plan_wait() {
-    const int64_t spin1 =
-        started_ns_ + std::clamp<int64_t>(short_ns_ + short_ns_ / 4, kMinSpinNs, kMaxSpinNs);
-    int64_t sleep_until = 0, spin2 = 0;
-    if (long_ns_ > 0) {
-      sleep_until = started_ns_ + long_ns_ - std::max<int64_t>(kWakeEarlyNs, long_ns_ / 8);
-      spin2 = std::min(started_ns_ + long_ns_ + long_ns_ / 4, sleep_until + kMaxSpinNs);
+    // Sleeping first (until shortly before `due`), then yielding until a little past it.
+    auto sleep_then_spin = [&](int64_t due, int64_t* sleep_until, int64_t* spin_until) {
+      *sleep_until = started_ns_ + due - std::max<int64_t>(kWakeEarlyNs, due / 8);
+      *spin_until = std::min(started_ns_ + due + due / 4, *sleep_until + kMaxSpinNs);
+    };
+    int64_t spin1 = 0, sleep_until = 0, spin2 = 0;
+    if (short_ns_ > kMaxSpinNs) {  // even the short ones are long
+      sleep_then_spin(short_ns_, &sleep_until, &spin2);
+    } else {
+      spin1 = started_ns_ + std::max<int64_t>(short_ns_ + short_ns_ / 4, kMinSpinNs);
+      if (long_ns_ > 0) sleep_then_spin(long_ns_, &sleep_until, &spin2);
     }
     socket_.plan_wait(spin1, sleep_until, spin2);
   }
