@@ -12,7 +12,10 @@ function(convoy_add_library name)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
 endfunction()
 
-# convoy_use_fast_malloc(target): links jemalloc into a program when it was found.
+# convoy_use_fast_malloc(target): links jemalloc into a program when it was found. For the
+# world engine and the programs that measure it: DART allocates its contact constraints every
+# physics step. Not for programs that run Python: jemalloc halves the speed of NRP-Core's
+# b_image_json benchmark (a list of a million ints per frame).
 function(convoy_use_fast_malloc target)
   if(JEMALLOC_FOUND)
     target_link_libraries(${target} PRIVATE PkgConfig::JEMALLOC)
@@ -28,7 +31,6 @@ function(convoy_add_engine type)
   add_executable(${target} ${ARG_SOURCES})
   target_compile_options(${target} PRIVATE ${CONVOY_WARNINGS})
   target_link_libraries(${target} PRIVATE convoy_engine_main ${ARG_DEPS})
-  convoy_use_fast_malloc(${target})
   if(ARG_SCHEMA)
     configure_file(${ARG_SCHEMA} ${CONVOY_SHARE_DIR}/engines/${type}.schema.json COPYONLY)
   endif()
