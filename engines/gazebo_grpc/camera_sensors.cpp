@@ -230,6 +230,7 @@ void CameraSensors::render(Camera& cam) {
   render::CameraSpec spec{d.width, d.height, d.hfov, d.near_clip, d.far_clip};
   render::Pose pose = to_pose(physics_.link_pose(cam.link) * d.pose);
   renderer_->render(scene_, pose, spec, &cam.frame, cam.want_depth, cam.want_boxes);
+  ++cam.frames;
   cam.has_depth = cam.want_depth;
   cam.has_boxes = cam.want_boxes;
   apply_noise(cam);

@@ -22,6 +22,8 @@ class CameraSensors {
   ~CameraSensors();
 
   size_t count() const { return cameras_.size(); }
+  // How many times camera i has rendered: its datapacks change only when this does.
+  uint64_t frames(size_t i) const { return cameras_[i].frames; }
   const CameraDesc& camera(size_t i) const { return *cameras_[i].desc; }
 
   // Renders the cameras that are due at simulated time `t` (seconds).
@@ -51,6 +53,7 @@ class CameraSensors {
     uint32_t own_model = 0;  // the model carrying the camera: not in its ground truth
     double next_update = 0;
     bool rendered = false;
+    uint64_t frames = 0;
     render::Frame frame;
     int depth_channels = 3;
     std::vector<int16_t> noise;  // mean + stddev * N(0,1) in 0..255 units, a fixed table

@@ -159,6 +159,13 @@ class GazeboEngine final : public Engine {
     c.feed_forward = j.effort();
   }
 
+  bool unchanged(const engine::DataPackId& id) override {
+    auto it = camera_dps_.find(id.name());
+    if (it == camera_dps_.end()) return false;  // joints and links move every step
+    auto sent = sent_frames_.find(id.name());
+    return sent != sent_frames_.end() && sent->second == cameras_->frames(it->second.first);
+  }
+
   void get_datapack(const engine::DataPackId& id, engine::DataPack* out) override {
     if (auto it = camera_dps_.find(id.name()); it != camera_dps_.end()) {
       auto [index, kind] = it->second;
@@ -168,6 +175,7 @@ class GazeboEngine final : public Engine {
         cameras_->depth_datapack(index, out);
       else
         cameras_->boxes_datapack(index, out);
+      sent_frames_[id.name()] = cameras_->frames(index);
       return;
     }
     if (auto it = joint_dps_.find(id.name()); it != joint_dps_.end()) {
@@ -215,7 +223,9 @@ class GazeboEngine final : public Engine {
   std::unordered_map<std::string, int> link_dps_;
   std::mt19937_64 rng_;
   int64_t time_ns_ = 0;
-  int64_t physics_steps_ = 0;  // taken since the start
+  int64_t physics_steps_ = 0;
+  std::unordered_map<std::string, uint64_t>
+      sent_frames_;  // camera datapack -> frame sent  // taken since the start
 };
 
 CONVOY_REGISTER_ENGINE("gazebo_grpc", GazeboEngine);

@@ -33,7 +33,7 @@ class EmptyDataPackError(RuntimeError):
 class DataPack:
     """Base of all datapacks: an identifier and, unless empty, data."""
 
-    __slots__ = ("_id", "_data")
+    __slots__ = ("_id", "_data", "_updated")
     _type = ""
 
     def __init__(self, name, engine_name):
@@ -56,7 +56,9 @@ class DataPack:
         return self._data is None
 
     def isUpdated(self):
-        return self._data is not None
+        # False for a datapack kept from an earlier cycle: its engine did not send it again
+        # (a camera between two frames), as NRP-Core's DataPack.isUpdated().
+        return self._data is not None and getattr(self, "_updated", True)
 
     @property
     def data(self):

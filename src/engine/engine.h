@@ -32,6 +32,10 @@ class Engine {
   virtual void set_datapack(const engine::DataPack& datapack) = 0;
   // Fills `out` with the datapack `id`; leaves its payload unset if there is none.
   virtual void get_datapack(const engine::DataPackId& id, engine::DataPack* out) = 0;
+  // True when datapack `id` has not changed since get_datapack last filled it (a camera
+  // that has not rendered since): a step's reply may then leave it out, and the coordinator
+  // keeps the one it has, as NRP-Core's camera controller returns no datapack between frames.
+  virtual bool unchanged(const engine::DataPackId& id) { return false; }
   virtual void reset() {}
   virtual void shutdown() {}
 };

@@ -47,10 +47,23 @@ void EngineServer::do_step(const engine::StepRequest& request, engine::StepReply
   int64_t t0 = now_ns();
   for (const auto& dp : request.inputs()) engine_.set_datapack(dp);
   reply->set_time_ns(engine_.step(request.duration_ns()));
-  for (const auto& id : request.wanted()) {
+  stale_.clear();
+  auto add = [&](const engine::DataPackId& id) {
     auto* out = reply->add_outputs();
     *out->mutable_id() = id;
     engine_.get_datapack(id, out);
+  };
+  for (const auto& id : request.wanted()) {
+    if (engine_.unchanged(id))
+      stale_.push_back(&id);
+    else
+      add(id);
+  }
+  // Unchanged datapacks are left out: the coordinator keeps the ones it has. Their blobs in
+  // shared memory stay valid only while no later reply carries blobs (the arena's halves
+  // alternate between such replies), so a reply that carries blobs sends them again.
+  if (shm_writer_ && shm_writer_->wrote_blobs()) {
+    for (const auto* id : stale_) add(*id);
   }
   reply->set_compute_ns(now_ns() - t0);
 }
@@ -107,6 +120,7 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     out_arena.attach(shm_out_fd);
     writer = std::make_unique<transport::ShmBlobWriter>(out_arena);
   }
+  shm_writer_ = writer.get();
   if (shm_in_fd >= 0) in_arena.attach(shm_in_fd);
   transport::ShmBlobReader reader(shm_in_fd >= 0 ? &in_arena : nullptr);
   transport::ScopedBlobContext blobs(writer.get(), &reader);

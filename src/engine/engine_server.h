@@ -5,6 +5,7 @@
 #include <string>
 
 #include "engine/engine.h"
+#include "transport/blobs.h"
 
 namespace convoy::engines {
 
@@ -33,6 +34,8 @@ class EngineServer {
   bool initialized_ = false;
   bool shut_down_ = false;
   int64_t spin_us_ = 0;
+  const transport::ShmBlobWriter* shm_writer_ = nullptr;  // serve_socket's, if any
+  std::vector<const engine::DataPackId*> stale_;          // do_step's, reused
 };
 
 // main() of every convoy-engine-<type> binary.

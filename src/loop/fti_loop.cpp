@@ -50,6 +50,9 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
     auto it = pool_.find(key(engine, name));
     return it == pool_.end() ? nullptr : &it->second;
   };
+  source_.updated = [this](const std::string& engine, const std::string& name) {
+    return updated_.count(key(engine, name)) > 0;
+  };
   source_.reader_for = [this](const std::string& engine) -> const transport::BlobReader* {
     auto it = by_name_.find(engine);
     return it == by_name_.end() ? nullptr : it->second->blob_reader();
@@ -83,6 +86,7 @@ void FtiLoop::prime() {
     e->finish(&reply);
     for (auto& dp : *reply.mutable_get_datapacks()->mutable_datapacks()) {
       std::string k = key(e->name(), dp.id().name());
+      updated_.insert(k);
       pool_[k] = std::move(dp);
     }
   }
@@ -93,8 +97,10 @@ void FtiLoop::take_outputs(EngineHandle& e, engine::StepReply* reply) {
   e.time_ns = reply->time_ns();
   e.last_compute_ns = reply->compute_ns();
   for (auto& dp : *reply->mutable_outputs()) {
-    auto& slot = pool_[key(e.name(), dp.id().name())];
+    std::string k = key(e.name(), dp.id().name());
+    auto& slot = pool_[k];
     slot.Swap(&dp);
+    updated_.insert(std::move(k));
   }
 }
 
@@ -183,6 +189,7 @@ void FtiLoop::run(int64_t until_ns) {
               [&](EngineHandle* a, EngineHandle* b) { return a->index < b->index; });
     std::fill(due_mask_.begin(), due_mask_.end(), 0);
     for (auto* e : due) due_mask_[e->index] = 1;
+    if (cycles_ > 0) updated_.clear();  // cycle 0 reads what prime() fetched
     for (auto* e : due) {
       e->last_compute_ns = -1;
       if (!e->busy()) continue;

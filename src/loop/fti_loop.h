@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "loop/engine_handle.h"
@@ -55,6 +56,7 @@ class FtiLoop {
   const std::vector<python::LoadedFunction>& functions_;
   python::InputSource source_;
   std::unordered_map<std::string, engine::DataPack> pool_;  // "engine\0name" -> latest
+  std::unordered_set<std::string> updated_;                 // pool_ keys received this cycle
   std::multimap<int64_t, size_t> queue_;                    // completion time -> engine
   std::vector<engine::DataPack> outputs_;
   std::FILE* csv_ = nullptr;

@@ -72,6 +72,7 @@ py::object FunctionRuntime::input_object(const FunctionInput& in, const InputSou
     transport::ScopedBlobContext blobs(nullptr,
                                        src.reader_for ? src.reader_for(in.engine) : nullptr);
     obj = to_python(*dp);
+    if (src.updated && !src.updated(in.engine, in.datapack)) obj.attr("_updated") = false;
   } else {
     obj = py::module_::import("nrp_core._datapacks").attr("EmptyDataPack")(in.datapack, in.engine);
   }

@@ -34,6 +34,9 @@ struct InputSource {
   // Returns the latest datapack read from an engine, or nullptr if none yet.
   std::function<const engine::DataPack*(const std::string& engine, const std::string& name)>
       engine_datapack;
+  // Whether that datapack came in this loop cycle (NRP-Core's DataPack.isUpdated()); an
+  // engine leaves out of its reply a datapack that has not changed (a camera between frames).
+  std::function<bool(const std::string& engine, const std::string& name)> updated;
   // Reads the blobs of datapacks from `engine`; writes those of datapacks sent to it.
   std::function<const transport::BlobReader*(const std::string& engine)> reader_for;
   std::function<transport::BlobWriter*(const std::string& engine)> writer_for;

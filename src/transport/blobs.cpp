@@ -52,16 +52,17 @@ uint32_t InlineBlobWriter::add(engine::DataPack* dp, std::string_view bytes) {
   return static_cast<uint32_t>(dp->blobs_size() - 1);
 }
 
-void ShmBlobWriter::next_message() {
-  half_ ^= 1;
-  used_ = 0;
-}
-
 uint32_t ShmBlobWriter::add(engine::DataPack* dp, std::string_view bytes) {
   auto* blob = dp->add_blobs();
-  size_t half_size = arena_.size() / 2;
-  size_t aligned = (used_ + 63) & ~size_t{63};
-  if (bytes.size() < kShmBlobThreshold || aligned + bytes.size() > half_size) {
+  const size_t half_size = arena_.size() / 2;
+  const bool big = bytes.size() >= kShmBlobThreshold;
+  if (big && fresh_message_ && bytes.size() <= half_size) {
+    fresh_message_ = false;  // the message's first blob in shared memory: the other half
+    half_ ^= 1;
+    used_ = 0;
+  }
+  const size_t aligned = (used_ + 63) & ~size_t{63};
+  if (!big || fresh_message_ || aligned + bytes.size() > half_size) {
     blob->set_inline_(bytes.data(), bytes.size());  // small, or the arena is full
   } else {
     size_t offset = static_cast<size_t>(half_) * half_size + aligned;

@@ -2,9 +2,11 @@
 //
 // Between the coordinator and an engine it forked, blobs go through two shared-memory
 // arenas (memfd), one written by each side; the messages carry only offsets. Each arena is
-// split in two halves used alternately, message by message, so that the data of the last
-// message stays valid while the next one is written (the coordinator's datapack pool keeps
-// the latest reply of every engine). Remote engines carry blobs inline.
+// split in two halves used alternately by the messages that carry blobs, so that the data of
+// the last such message stays valid while the next one is written (the coordinator's
+// datapack pool keeps the latest datapacks of every engine; an engine leaves an unchanged
+// datapack out of a reply only when the reply carries no blob). Remote engines carry blobs
+// inline.
 #pragma once
 
 #include <cstddef>
@@ -72,14 +74,19 @@ class InlineBlobWriter final : public BlobWriter {
 class ShmBlobWriter final : public BlobWriter {
  public:
   explicit ShmBlobWriter(ShmArena& arena) : arena_(arena) {}
-  // Starts the next message: switches halves and forgets the previous allocations.
-  void next_message();
+  // Starts the next message. Its first blob in shared memory switches halves and forgets the
+  // previous allocations: the halves alternate between messages that carry blobs, so a
+  // blob stays valid until two later messages have carried blobs.
+  void next_message() { fresh_message_ = true; }
+  // Whether the current message has put a blob in shared memory.
+  bool wrote_blobs() const { return !fresh_message_; }
   uint32_t add(engine::DataPack* dp, std::string_view bytes) override;
 
  private:
   ShmArena& arena_;
   int half_ = 1;
   size_t used_ = 0;
+  bool fresh_message_ = true;
 };
 
 class ShmBlobReader final : public BlobReader {

@@ -138,6 +138,45 @@ class WorldEngine(unittest.TestCase):
                 self.assertAlmostEqual(v, -9.81 * k * timestep, delta=9.81 * 0.0006,
                                        msg="step %d of %g s" % (k, timestep))
 
+    def test_camera_datapack_comes_only_with_a_new_frame(self):
+        # A 10 Hz camera read every 0.02 s step: as NRP-Core's camera controller, the engine
+        # sends its datapack only after a new frame; in between, TFs get the last one with
+        # isUpdated() False, intact (its shared memory is not reused meanwhile, even when the
+        # same replies carry another camera's frames).
+        for cameras in (["noisy_camera::cam"], ["noisy_camera::cam", "clean_camera::cam"]):
+            ex = Experiment(self)
+            shutil.copy(os.path.join(HERE, "..", "world", "data", "camera_world.sdf"),
+                        os.path.join(ex.dir, "world.sdf"))
+            ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                               "GazeboWorldFile": "world.sdf", "EngineTimestep": 0.02})
+            decorators = "".join("@EngineDataPack(keyword='c%d', id=DataPackIdentifier(%r, 'gazebo'))\n"
+                                 % (i, c) for i, c in enumerate(cameras))
+            args = ", ".join("c%d" % i for i in range(len(cameras)))
+            ex.function("tf", "import hashlib, json, os\nfrom nrp_core import *\n" + decorators +
+                        "@TransceiverFunction('gazebo')\ndef tf(%s):\n" % args +
+                        "    with open(os.path.join(os.path.dirname(__file__), 'seen.jsonl'), 'a') as f:\n"
+                        "        f.write(json.dumps([[c.isUpdated(), hashlib.md5(c.data.image_data.tobytes())"
+                        ".hexdigest()] for c in (%s,)]) + '\\n')\n" % args +
+                        "    return []\n")
+            ex.run(1.0)
+            with open(os.path.join(ex.dir, "seen.jsonl")) as f:
+                seen = [json.loads(line) for line in f]
+            self.assertGreaterEqual(len(seen), 50)
+            noisy = [s[0] for s in seen]
+            self.assertTrue(noisy[0][0])
+            # Frames at t = 0, 0.1, ..., 1.0, each the same bytes until the next (the noise
+            # makes every frame differ).
+            changes = [i for i in range(1, len(noisy)) if noisy[i][1] != noisy[i - 1][1]]
+            self.assertIn(len(changes) + 1, (10, 11), noisy)
+            self.assertEqual(len({h for _, h in noisy}), len(changes) + 1, noisy)
+            if len(cameras) == 1:
+                for i in range(1, len(noisy)):
+                    self.assertEqual(noisy[i][0], i in changes, (i, noisy))
+            else:
+                # The clean camera renders every step, so every reply carries a frame: the
+                # noisy camera's unchanged one comes again with it.
+                self.assertTrue(all(s[1][0] for s in seen))
+
     def test_sdf_models_are_inserted_at_their_init_pose(self):
         ex = Experiment(self)
         data = os.path.join(HERE, "..", "world", "data")
