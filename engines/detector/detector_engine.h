@@ -123,8 +123,9 @@ class DetectorEngine final : public Engine {
     if (dp.id().name() == "boxes") return;
     cv::Mat img = detector::image_from_datapack(dp);
     if (img.empty()) return;
-    // A camera renders at its update_rate; between two frames the same image comes again
-    // (one per step). Its detections are those already made: detect new images only.
+    // A camera renders at its update_rate; between two frames a TF that does not check
+    // isUpdated() (the report's camera_tf.py) sends the same image again, one per step. Its
+    // detections are those already made: detect new images only.
     if (!img.isContinuous()) img = img.clone();
     const size_t hash = std::hash<std::string_view>{}(
         std::string_view(reinterpret_cast<const char*>(img.data), img.total() * img.elemSize()));
