@@ -18,7 +18,9 @@ class EngineServer {
 
   // Waiting for the next request, yield the CPU in a loop before sleeping (cheaper than a
   // wake-up) when the coordinator usually comes back within `us`: for a little longer than
-  // its usual gap, at most `us`. An engine that usually waits longer sleeps at once.
+  // its usual gap, at most `us`, or at most 50 µs if the engine usually works less than it
+  // waits (it is not the one the loop waits for). An engine that usually waits longer sleeps
+  // at once.
   void set_spin_us(int64_t us) { spin_us_ = us; }
 
   // Serves requests on a connected stream socket until Shutdown or until the peer closes.
