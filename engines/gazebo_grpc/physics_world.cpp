@@ -5,6 +5,7 @@
 #include <functional>
 #include <set>
 #include <stdexcept>
+#include <type_traits>
 
 namespace convoy::world {
 
@@ -184,49 +185,43 @@ void PhysicsWorld::build_model(const ModelDesc& model) {
         made.first->setPositions(dd::FreeJoint::convertToPositions(l.pose));
       }
     } else {
-      if (locked) {  // to the world: welded where it is held
-        dd::WeldJoint::Properties p;
+      // Joint J between the parent body and this link, its properties finished by `finish`.
+      auto joint_of = [&](auto type, auto finish) {
+        using J = typename decltype(type)::type;
+        typename J::Properties p;
         set_frames(p, j->name, parent_world, l.pose, j->pose);
-        p.mT_ParentBodyToJoint = parent_world.inverse() * joint_at;
-        made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
-      } else
+        finish(p);
+        return skel->createJointAndBodyNodePair<J>(parent_bn, p, bp);
+      };
+      auto as_is = [](auto&) {};
+      auto one_axis = [&](auto& p) { p.mAxis = axis.xyz; };
+      if (locked) {  // to the world: welded where it is held
+        made = joint_of(std::type_identity<dd::WeldJoint>{}, [&](auto& p) {
+          p.mT_ParentBodyToJoint = parent_world.inverse() * joint_at;
+        });
+      } else {
         switch (j->type) {
           case JointDesc::kRevolute:
-          case JointDesc::kContinuous: {
-            dd::RevoluteJoint::Properties p;
-            set_frames(p, j->name, parent_world, l.pose, j->pose);
-            p.mAxis = axis.xyz;
-            made = skel->createJointAndBodyNodePair<dd::RevoluteJoint>(parent_bn, p, bp);
+          case JointDesc::kContinuous:
+            made = joint_of(std::type_identity<dd::RevoluteJoint>{}, one_axis);
             break;
-          }
-          case JointDesc::kPrismatic: {
-            dd::PrismaticJoint::Properties p;
-            set_frames(p, j->name, parent_world, l.pose, j->pose);
-            p.mAxis = axis.xyz;
-            made = skel->createJointAndBodyNodePair<dd::PrismaticJoint>(parent_bn, p, bp);
+          case JointDesc::kPrismatic:
+            made = joint_of(std::type_identity<dd::PrismaticJoint>{}, one_axis);
             break;
-          }
-          case JointDesc::kFixed: {
-            dd::WeldJoint::Properties p;
-            set_frames(p, j->name, parent_world, l.pose, j->pose);
-            made = skel->createJointAndBodyNodePair<dd::WeldJoint>(parent_bn, p, bp);
+          case JointDesc::kFixed:
+            made = joint_of(std::type_identity<dd::WeldJoint>{}, as_is);
             break;
-          }
-          case JointDesc::kBall: {
-            dd::BallJoint::Properties p;
-            set_frames(p, j->name, parent_world, l.pose, j->pose);
-            made = skel->createJointAndBodyNodePair<dd::BallJoint>(parent_bn, p, bp);
+          case JointDesc::kBall:
+            made = joint_of(std::type_identity<dd::BallJoint>{}, as_is);
             break;
-          }
-          case JointDesc::kUniversal: {
-            dd::UniversalJoint::Properties p;
-            set_frames(p, j->name, parent_world, l.pose, j->pose);
-            p.mAxis[0] = axis.xyz;
-            p.mAxis[1] = j->axes.size() > 1 ? j->axes[1].xyz : Eigen::Vector3d::UnitY();
-            made = skel->createJointAndBodyNodePair<dd::UniversalJoint>(parent_bn, p, bp);
+          case JointDesc::kUniversal:
+            made = joint_of(std::type_identity<dd::UniversalJoint>{}, [&](auto& p) {
+              p.mAxis[0] = axis.xyz;
+              p.mAxis[1] = j->axes.size() > 1 ? j->axes[1].xyz : Eigen::Vector3d::UnitY();
+            });
             break;
-          }
         }
+      }
       dd::Joint* joint = made.first;
       for (size_t a = 0; a < joint->getNumDofs() && a < j->axes.size(); ++a) {
         const auto& ax = j->axes[a];
