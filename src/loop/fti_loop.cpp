@@ -48,10 +48,11 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
   source_.engine_datapack = [this](const std::string& engine,
                                    const std::string& name) -> const engine::DataPack* {
     auto it = pool_.find(key(engine, name));
-    return it == pool_.end() ? nullptr : &it->second;
+    return it == pool_.end() ? nullptr : &it->second.datapack;
   };
   source_.updated = [this](const std::string& engine, const std::string& name) {
-    return updated_.count(key(engine, name)) > 0;
+    auto it = pool_.find(key(engine, name));
+    return it != pool_.end() && it->second.cycle == cycles_;
   };
   source_.reader_for = [this](const std::string& engine) -> const transport::BlobReader* {
     auto it = by_name_.find(engine);
@@ -85,9 +86,9 @@ void FtiLoop::prime() {
     engine::Reply reply;
     e->finish(&reply);
     for (auto& dp : *reply.mutable_get_datapacks()->mutable_datapacks()) {
-      std::string k = key(e->name(), dp.id().name());
-      updated_.insert(k);
-      pool_[k] = std::move(dp);
+      auto& slot = pool_[key(e->name(), dp.id().name())];
+      slot.datapack.Swap(&dp);
+      slot.cycle = 0;
     }
   }
   for (size_t i = 0; i < engines_.size(); ++i) queue_.emplace(engines_[i]->time_ns, i);
@@ -97,10 +98,9 @@ void FtiLoop::take_outputs(EngineHandle& e, engine::StepReply* reply) {
   e.time_ns = reply->time_ns();
   e.last_compute_ns = reply->compute_ns();
   for (auto& dp : *reply->mutable_outputs()) {
-    std::string k = key(e.name(), dp.id().name());
-    auto& slot = pool_[k];
-    slot.Swap(&dp);
-    updated_.insert(std::move(k));
+    auto& slot = pool_[key(e.name(), dp.id().name())];
+    slot.datapack.Swap(&dp);
+    slot.cycle = cycles_;
   }
 }
 
@@ -189,7 +189,6 @@ void FtiLoop::run(int64_t until_ns) {
               [&](EngineHandle* a, EngineHandle* b) { return a->index < b->index; });
     std::fill(due_mask_.begin(), due_mask_.end(), 0);
     for (auto* e : due) due_mask_[e->index] = 1;
-    if (cycles_ > 0) updated_.clear();  // cycle 0 reads what prime() fetched
     for (auto* e : due) {
       e->last_compute_ns = -1;
       if (!e->busy()) continue;

@@ -12,7 +12,6 @@
 #include <map>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 #include <vector>
 
 #include "loop/engine_handle.h"
@@ -55,9 +54,12 @@ class FtiLoop {
   python::FunctionRuntime& runtime_;
   const std::vector<python::LoadedFunction>& functions_;
   python::InputSource source_;
-  std::unordered_map<std::string, engine::DataPack> pool_;  // "engine\0name" -> latest
-  std::unordered_set<std::string> updated_;                 // pool_ keys received this cycle
-  std::multimap<int64_t, size_t> queue_;                    // completion time -> engine
+  struct Pooled {
+    engine::DataPack datapack;
+    uint64_t cycle = 0;  // the loop cycle it came in (prime(): 0)
+  };
+  std::unordered_map<std::string, Pooled> pool_;  // "engine\0name" -> latest
+  std::multimap<int64_t, size_t> queue_;          // completion time -> engine
   std::vector<engine::DataPack> outputs_;
   std::FILE* csv_ = nullptr;
   int64_t sim_time_ns_ = 0;
