@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "camera_sensors.h"
+#include "datapack/json.h"
 #include "detector.h"
 #include "physics_world.h"
 #include "world_description.h"
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
     const bool truth = backend == "ground_truth";
 
     engine::DataPack image, boxes;
+    datapack::InlineBlobWriter writer;
     double t = 0;
     size_t detections = 0;
     auto one_frame = [&] {
@@ -75,13 +77,17 @@ int main(int argc, char** argv) {
       cameras.update(t);
       std::vector<detector::Detection> dets;
       if (truth) {
-        cameras.boxes_datapack(0, &boxes);
-        const std::string& raw = boxes.json_msgpack();
-        dets = detector::detections_from_boxes(nlohmann::json::from_msgpack(raw.begin(), raw.end()),
-                                               names);
+        boxes.Clear();
+        datapack::Builder out(&boxes, writer);
+        cameras.boxes_datapack(0, out);
+        dets = detector::detections_from_boxes(
+            datapack::read_json(datapack::View(boxes, datapack::inline_blob_reader())), names);
       } else {
-        cameras.image_datapack(0, &image);
-        cv::Mat img = detector::image_from_datapack(image);
+        image.Clear();
+        datapack::Builder out(&image, writer);
+        cameras.image_datapack(0, out);
+        cv::Mat img =
+            detector::image_from_datapack(datapack::View(image, datapack::inline_blob_reader()));
         dets = yolo ? yolo->detect(img) : hog->detect(img);
       }
       detections += dets.size();

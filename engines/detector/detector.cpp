@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
-#include "convoy/datapacks.pb.h"
-#include "transport/blobs.h"
+#include "datapack/camera.h"
+#include "datapack/json.h"
 
 namespace convoy::detector {
 
@@ -299,110 +299,119 @@ std::vector<Detection> detections_from_boxes(const nlohmann::json& j,
 
 namespace {
 
-cv::Mat make_image(int height, int width, size_t bytes, const uint8_t* data,
-                   const std::string& what) {
-  if (height <= 0 || width <= 0) return {};
-  size_t pixels = static_cast<size_t>(height) * width;
-  if (bytes == 0) return {};
-  if (bytes % pixels != 0)
-    throw std::runtime_error(what + ": " + std::to_string(bytes) + " bytes for a " +
+// An image of `bytes` bytes of pixels: wrapped in place (no copy) for 1 or 3 bytes a pixel,
+// converted for 4. Empty for a zero size.
+cv::Mat wrap_image(int height, int width, std::string_view bytes, const std::string& what) {
+  if (height <= 0 || width <= 0 || bytes.empty()) return {};
+  const size_t pixels = static_cast<size_t>(height) * width;
+  if (bytes.size() % pixels != 0)
+    throw std::runtime_error(what + ": " + std::to_string(bytes.size()) + " bytes for a " +
                              std::to_string(width) + "x" + std::to_string(height) + " image");
-  size_t depth = bytes / pixels;
-  cv::Mat out;
-  if (depth == 1 || depth == 3) {
-    out = cv::Mat(height, width, depth == 1 ? CV_8UC1 : CV_8UC3);
-    std::memcpy(out.data, data, bytes);
-  } else if (depth == 4) {
-    cv::Mat rgba(height, width, CV_8UC4, const_cast<uint8_t*>(data));
-    cv::cvtColor(rgba, out, cv::COLOR_RGBA2RGB);
-  } else {
-    throw std::runtime_error(what + ": unsupported image depth " + std::to_string(depth));
+  const size_t depth = bytes.size() / pixels;
+  auto* data = reinterpret_cast<uint8_t*>(const_cast<char*>(bytes.data()));
+  if (depth == 1 || depth == 3) return cv::Mat(height, width, depth == 1 ? CV_8UC1 : CV_8UC3, data);
+  if (depth == 4) {
+    cv::Mat out;
+    cv::cvtColor(cv::Mat(height, width, CV_8UC4, data), out, cv::COLOR_RGBA2RGB);
+    return out;
   }
-  return out;
+  throw std::runtime_error(what + ": unsupported image depth " + std::to_string(depth));
 }
 
-cv::Mat image_from_json(const engine::DataPack& dp) {
-  const std::string& raw = dp.json_msgpack();
-  nlohmann::json j = nlohmann::json::from_msgpack(raw.begin(), raw.end());
-  const std::string what = "datapack '" + dp.id().name() + "'";
+cv::Mat image_from_json(const datapack::View& dp) {
+  const nlohmann::json j = datapack::read_json(dp);
+  const std::string what = dp.describe();
   if (!j.is_object() || !j.contains("current_image_frame"))
     throw std::runtime_error(what + ": needs c_imageHeight, c_imageWidth, current_image_frame");
   int h = j.value("c_imageHeight", 0);
   int w = j.value("c_imageWidth", 0);
   const auto& frame = j["current_image_frame"];
   if (frame.is_array()) {
-    std::vector<uint8_t> bytes;
+    std::string bytes;
     bytes.reserve(frame.size());
-    for (const auto& v : frame) bytes.push_back(static_cast<uint8_t>(v.get<int>()));
-    return make_image(h, w, bytes.size(), bytes.data(), what);
+    for (const auto& v : frame) bytes.push_back(static_cast<char>(v.get<int>()));
+    return wrap_image(h, w, bytes, what).clone();
   }
   if (!frame.is_binary())
     throw std::runtime_error(what + ": current_image_frame must be a list or a numpy array");
-  const auto& bin = frame.get_binary();
-  if (!bin.has_subtype() || (bin.subtype() != 1 && bin.subtype() != 2))
-    throw std::runtime_error(what + ": current_image_frame is not a numpy array");
-  const uint8_t* b = bin.data();
-  const uint8_t* e = b + bin.size();
-  auto bad = [&] { return std::runtime_error(what + ": bad numpy array header"); };
-  if (e - b < 2) throw bad();
-  size_t dlen = *b++;
-  if (static_cast<size_t>(e - b) < dlen + 1) throw bad();
-  std::string dtype(reinterpret_cast<const char*>(b), dlen);
-  b += dlen;
-  size_t ndim = *b++;
-  if (static_cast<size_t>(e - b) < ndim * 8) throw bad();
-  std::vector<uint64_t> shape(ndim);
-  for (size_t i = 0; i < ndim; ++i) {
-    uint64_t d = 0;
-    for (int k = 7; k >= 0; --k) d = (d << 8) | b[k];
-    shape[i] = d;
-    b += 8;
-  }
-  if (dtype != "|u1" && dtype != "<u1" && dtype != "u1" && dtype != "B")
-    throw std::runtime_error(what + ": current_image_frame dtype '" + dtype +
+  const datapack::NdarrayRef array = datapack::read_ndarray(dp, frame);
+  if (!datapack::is_uint8(array.header.dtype))
+    throw std::runtime_error(what + ": current_image_frame dtype '" + array.header.dtype +
                              "' is not supported (needs uint8)");
-  std::string_view data(reinterpret_cast<const char*>(b), static_cast<size_t>(e - b));
-  if (bin.subtype() == 2) {
-    if (data.size() != 4) throw bad();
-    uint32_t index = (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3];
-    data = transport::current_blob_reader().get(dp, index);
+  if (array.header.shape.size() >= 2 && (h <= 0 || w <= 0)) {
+    h = static_cast<int>(array.header.shape[0]);
+    w = static_cast<int>(array.header.shape[1]);
   }
-  if (ndim >= 2 && (h <= 0 || w <= 0)) {
-    h = static_cast<int>(shape[0]);
-    w = static_cast<int>(shape[1]);
-  }
-  return make_image(h, w, data.size(), reinterpret_cast<const uint8_t*>(data.data()), what);
-}
-
-cv::Mat image_from_proto(const engine::DataPack& dp) {
-  const std::string what = "datapack '" + dp.id().name() + "'";
-  if (dp.proto().type_name() != "convoy.data.Camera")
-    throw std::runtime_error(what + ": protobuf type '" + dp.proto().type_name() +
-                             "' is not convoy.data.Camera");
-  data::Camera cam;
-  if (!cam.ParseFromString(dp.proto().data()))
-    throw std::runtime_error(what + ": cannot parse convoy.data.Camera");
-  std::string_view bytes = cam.image_data();
-  if (cam.image_blob() > 0) bytes = transport::current_blob_reader().get(dp, cam.image_blob() - 1);
-  size_t expected = static_cast<size_t>(cam.image_height()) * cam.image_width() * cam.image_depth();
-  if (cam.image_depth() != 0 && bytes.size() != expected)
-    throw std::runtime_error(what + ": " + std::to_string(bytes.size()) + " bytes, expected " +
-                             std::to_string(expected));
-  return make_image(static_cast<int>(cam.image_height()), static_cast<int>(cam.image_width()),
-                    bytes.size(), reinterpret_cast<const uint8_t*>(bytes.data()), what);
+  cv::Mat img = wrap_image(h, w, array.data, what);
+  // Inline array bytes live in `j`, which goes now; a blob's stay.
+  return frame.get_binary().subtype() == datapack::kNdarrayExtType ? img.clone() : img;
 }
 
 }  // namespace
 
-cv::Mat image_from_datapack(const engine::DataPack& dp) {
-  switch (dp.payload_case()) {
-    case engine::DataPack::kProto:
-      return image_from_proto(dp);
-    case engine::DataPack::kJsonMsgpack:
-      return image_from_json(dp);
-    default:
-      return {};
+cv::Mat image_from_datapack(const datapack::View& dp) {
+  if (dp.is_proto()) {
+    const datapack::CameraImage img = datapack::read_camera(dp);
+    cv::Mat mat = wrap_image(static_cast<int>(img.height), static_cast<int>(img.width), img.pixels,
+                             dp.describe());
+    return img.owned.empty() ? mat : mat.clone();  // a small frame's pixels live in `img`
   }
+  if (dp.is_json()) return image_from_json(dp);
+  return {};
+}
+
+std::vector<Detection> GroundTruthPassthrough::detect(const cv::Mat&, const nlohmann::json& boxes) {
+  std::vector<Detection> dets = detections_from_boxes(boxes, names_);
+  sort_by_confidence(&dets);
+  return dets;
+}
+
+namespace {
+using BackendFactory = std::unique_ptr<Backend> (*)(const nlohmann::json& config,
+                                                    std::vector<std::string> names);
+const std::map<std::string, BackendFactory>& backends() {
+  static const std::map<std::string, BackendFactory> table = {
+      {"ground_truth",
+       [](const nlohmann::json&, std::vector<std::string> names) -> std::unique_ptr<Backend> {
+         return std::make_unique<GroundTruthPassthrough>(std::move(names));
+       }},
+      {"yolo",
+       [](const nlohmann::json& config,
+          std::vector<std::string> names) -> std::unique_ptr<Backend> {
+         YoloOptions o;
+         o.model_path = config.value("ModelPath", std::string());
+         o.class_names = std::move(names);
+         o.input_size = config.value("InputSize", 640);
+         o.conf_threshold = config.value("ConfidenceThreshold", 0.25f);
+         o.nms_threshold = config.value("NmsThreshold", 0.45f);
+         o.version = parse_yolo_version(config.value("YoloVersion", std::string("auto")));
+         return std::make_unique<YoloDetector>(std::move(o));
+       }},
+      {"hog",
+       [](const nlohmann::json&, std::vector<std::string>) -> std::unique_ptr<Backend> {
+         return std::make_unique<HogDetector>();
+       }},
+  };
+  return table;
+}
+}  // namespace
+
+std::vector<std::string> backend_names() {
+  std::vector<std::string> out;
+  for (const auto& [name, f] : backends()) out.push_back(name);
+  return out;
+}
+
+std::unique_ptr<Backend> make_backend(const nlohmann::json& config) {
+  const std::string name = config.value("Backend", std::string("ground_truth"));
+  auto it = backends().find(name);
+  if (it == backends().end()) {
+    std::string known;
+    for (const auto& n : backend_names()) known += (known.empty() ? "\"" : ", \"") + n + "\"";
+    throw std::runtime_error("Backend '" + name + "': must be one of " + known);
+  }
+  const std::string names_file = config.value("ClassNamesFile", std::string());
+  return it->second(config, names_file.empty() ? coco_class_names() : read_class_names(names_file));
 }
 
 nlohmann::json detections_json(const std::vector<Detection>& dets) {

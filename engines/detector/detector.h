@@ -4,6 +4,7 @@
 // detector_engine.cpp.
 #pragma once
 
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/dnn.hpp>
@@ -11,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "convoy/engine.pb.h"
+#include "datapack/datapack.h"
 
 namespace convoy::detector {
 
@@ -67,12 +68,34 @@ struct YoloOptions {
   YoloVersion version = YoloVersion::kAuto;
 };
 
-class YoloDetector {
+// What a detector backend detects from.
+enum class BackendInput { kImage, kGroundTruth };
+
+// A detector backend: a camera image (or, for the ground-truth passthrough, the camera's
+// ground-truth boxes) in, detections out.
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual BackendInput input() const { return BackendInput::kImage; }
+  // `image` for kImage backends; `boxes` (the ::boxes datapack's JSON) for kGroundTruth.
+  virtual std::vector<Detection> detect(const cv::Mat& image, const nlohmann::json& boxes) = 0;
+};
+
+// The backend named by the engine's config ("Backend", default "ground_truth"), built from
+// the config's other keys. Throws naming the key on a bad value.
+std::unique_ptr<Backend> make_backend(const nlohmann::json& config);
+// The backend names make_backend knows.
+std::vector<std::string> backend_names();
+
+class YoloDetector final : public Backend {
  public:
   // Throws "ModelPath '<path>': cannot read ONNX model: ..." on failure.
   explicit YoloDetector(YoloOptions options);
   // `image`: RGB (CV_8UC3) or grey (CV_8UC1).
   std::vector<Detection> detect(const cv::Mat& image);
+  std::vector<Detection> detect(const cv::Mat& image, const nlohmann::json&) override {
+    return detect(image);
+  }
   const YoloOptions& options() const { return options_; }
 
  private:
@@ -80,10 +103,13 @@ class YoloDetector {
   cv::dnn::Net net_;
 };
 
-class HogDetector {
+class HogDetector final : public Backend {
  public:
   HogDetector();
   std::vector<Detection> detect(const cv::Mat& image);
+  std::vector<Detection> detect(const cv::Mat& image, const nlohmann::json&) override {
+    return detect(image);
+  }
 
  private:
   cv::HOGDescriptor hog_;
@@ -94,10 +120,23 @@ class HogDetector {
 std::vector<Detection> detections_from_boxes(const nlohmann::json& boxes,
                                              const std::vector<std::string>& names);
 
+// Not a detector: passes the camera's ground-truth boxes through, labelled as ground truth.
+class GroundTruthPassthrough final : public Backend {
+ public:
+  explicit GroundTruthPassthrough(std::vector<std::string> names) : names_(std::move(names)) {}
+  BackendInput input() const override { return BackendInput::kGroundTruth; }
+  std::vector<Detection> detect(const cv::Mat&, const nlohmann::json& boxes) override;
+
+ private:
+  std::vector<std::string> names_;
+};
+
 // The RGB (or grey) image of a camera datapack: a convoy.data.Camera protobuf, or a JSON
 // datapack {c_imageHeight, c_imageWidth, current_image_frame}. Returns an empty Mat when
 // the datapack holds no image (empty payload, zero size). Throws on malformed data.
-cv::Mat image_from_datapack(const engine::DataPack& dp);
+// A frame in a blob is wrapped in place, without a copy: the Mat is valid as long as the
+// datapack's blobs are (for an engine: until the end of the step that follows).
+cv::Mat image_from_datapack(const datapack::View& dp);
 
 // The detections datapack body.
 nlohmann::json detections_json(const std::vector<Detection>& dets);

@@ -26,6 +26,9 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "convoy/datapacks.pb.h"
+#include "datapack/json.h"
+#include "datapack/registry.h"
 #include "detector.h"
 #include "engine/engine.h"
 
@@ -36,37 +39,19 @@ class DetectorEngine final : public Engine {
   std::vector<engine::DataPackId> initialize(const std::string& name, const nlohmann::json& config,
                                              int64_t timestep_ns) override {
     name_ = name;
-    backend_ = config.value("Backend", std::string("ground_truth"));
-    std::string names_file = config.value("ClassNamesFile", std::string());
-    names_ =
-        names_file.empty() ? detector::coco_class_names() : detector::read_class_names(names_file);
-    if (backend_ == "yolo") {
-      detector::YoloOptions o;
-      o.model_path = config.value("ModelPath", std::string());
-      o.class_names = names_;
-      o.input_size = config.value("InputSize", 640);
-      o.conf_threshold = config.value("ConfidenceThreshold", 0.25f);
-      o.nms_threshold = config.value("NmsThreshold", 0.45f);
-      o.version = detector::parse_yolo_version(config.value("YoloVersion", std::string("auto")));
-      yolo_ = std::make_unique<detector::YoloDetector>(std::move(o));
-    } else if (backend_ == "hog") {
-      hog_ = std::make_unique<detector::HogDetector>();
-    } else if (backend_ != "ground_truth") {
-      throw std::runtime_error("Backend '" + backend_ +
-                               "': must be \"yolo\", \"hog\" or \"ground_truth\"");
-    }
+    backend_ = detector::make_backend(config);
     std::vector<engine::DataPackId> ids;
-    auto add = [&](const char* dp_name, const char* type) {
+    auto add = [&](const char* dp_name, std::string_view type) {
       engine::DataPackId id;
       id.set_name(dp_name);
       id.set_engine_name(name);
-      id.set_type(type);
+      id.set_type(std::string(type));
       ids.push_back(id);
     };
-    add("detections", "json");
-    add("camera_img", "json");
-    add("camera", "convoy.data.Camera");
-    add("boxes", "json");  // used by the ground_truth backend, ignored by the others
+    add("detections", datapack::kJsonType);
+    add("camera_img", datapack::kJsonType);
+    add("camera", datapack::type_name<data::Camera>());
+    add("boxes", datapack::kJsonType);  // used by the ground-truth passthrough only
     return ids;
   }
 
@@ -75,17 +60,16 @@ class DetectorEngine final : public Engine {
     if (!pending_) return time_ns_;
     pending_ = false;
     auto t0 = std::chrono::steady_clock::now();
-    std::vector<detector::Detection> dets;
-    if (backend_ == "ground_truth") {
-      dets = detector::detections_from_boxes(pending_boxes_, names_);
-      detector::sort_by_confidence(&dets);
+    if (backend_->input() == detector::BackendInput::kGroundTruth) {
       width_ = pending_boxes_.value("width", width_);
       height_ = pending_boxes_.value("height", height_);
     } else {
       width_ = pending_image_.cols;
       height_ = pending_image_.rows;
-      dets = yolo_ ? yolo_->detect(pending_image_) : hog_->detect(pending_image_);
     }
+    std::vector<detector::Detection> dets = backend_->detect(pending_image_, pending_boxes_);
+    // The image may point into the request's shared memory, valid during this step only.
+    pending_image_ = cv::Mat();
     auto t1 = std::chrono::steady_clock::now();
     ++frame_;
     result_ = {{"frame", frame_},
@@ -97,12 +81,11 @@ class DetectorEngine final : public Engine {
     return time_ns_;
   }
 
-  void set_datapack(const engine::DataPack& dp) override {
-    if (dp.payload_case() == engine::DataPack::PAYLOAD_NOT_SET) return;
-    if (backend_ == "ground_truth") {
-      if (dp.payload_case() == engine::DataPack::kJsonMsgpack) {
-        const std::string& raw = dp.json_msgpack();
-        nlohmann::json j = nlohmann::json::from_msgpack(raw.begin(), raw.end());
+  void set_datapack(const datapack::View& dp) override {
+    if (dp.empty()) return;
+    if (backend_->input() == detector::BackendInput::kGroundTruth) {
+      if (dp.is_json() && dp.id().name() == "boxes") {
+        nlohmann::json j = datapack::read_json(dp);
         if (j.is_object() && j.contains("boxes")) {
           pending_boxes_ = std::move(j);
           pending_ = true;
@@ -121,6 +104,7 @@ class DetectorEngine final : public Engine {
     }
     // Ground truth sent to an image backend (one config for every backend) is not needed.
     if (dp.id().name() == "boxes") return;
+    // In place: the image is read from the request's shared memory during the next step.
     cv::Mat img = detector::image_from_datapack(dp);
     if (img.empty()) return;
     // A camera renders at its update_rate; between two frames a TF that does not check
@@ -136,30 +120,23 @@ class DetectorEngine final : public Engine {
     pending_ = true;
   }
 
-  void get_datapack(const engine::DataPackId& id, engine::DataPack* out) override {
-    if (id.name() != "detections") {
-      throw std::runtime_error("engine '" + name_ + "' has no datapack '" + id.name() +
-                               "' (it provides \"detections\")");
-    }
-    out->mutable_id()->set_type("json");
-    if (result_.is_null()) return;
-    std::vector<uint8_t> bytes = nlohmann::json::to_msgpack(result_);
-    out->set_json_msgpack(std::string(bytes.begin(), bytes.end()));
+  void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
+    // Only "detections" has a value; other ids come back empty, as for every engine.
+    if (id.name() != "detections" || result_.is_null()) return;
+    datapack::write_json(out, result_);
   }
 
   void reset() override {
     time_ns_ = 0;
     frame_ = 0;
     pending_ = false;
+    pending_image_ = cv::Mat();
     result_ = nullptr;
   }
 
  private:
   std::string name_;
-  std::string backend_;
-  std::vector<std::string> names_;
-  std::unique_ptr<detector::YoloDetector> yolo_;
-  std::unique_ptr<detector::HogDetector> hog_;
+  std::unique_ptr<detector::Backend> backend_;
   int64_t time_ns_ = 0;
   int64_t frame_ = 0;
   bool pending_ = false;

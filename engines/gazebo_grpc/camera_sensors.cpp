@@ -5,9 +5,10 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "convoy/datapacks.pb.h"
+#include "datapack/camera.h"
+#include "datapack/json.h"
 #include "render/mesh_loader.h"
-#include "transport/blobs.h"
+#include "render/readback.h"
 
 namespace convoy::world {
 
@@ -30,22 +31,6 @@ render::Material to_material(const Material& m) {
   return out;
 }
 
-// A JSON datapack whose "<key>" holds a float32 image as a numpy blob (msgpack ext type 2).
-void numpy_blob(nlohmann::json* j, const char* key, const std::vector<float>& values, int h, int w,
-                engine::DataPack* out) {
-  std::string_view bytes(reinterpret_cast<const char*>(values.data()), values.size() * 4);
-  uint32_t index = transport::current_blob_writer().add(out, bytes);
-  std::vector<uint8_t> header;
-  const std::string dtype = "<f4";
-  header.push_back(static_cast<uint8_t>(dtype.size()));
-  header.insert(header.end(), dtype.begin(), dtype.end());
-  header.push_back(2);
-  for (uint64_t d : {static_cast<uint64_t>(h), static_cast<uint64_t>(w)})
-    for (int b = 0; b < 8; ++b) header.push_back(static_cast<uint8_t>(d >> (8 * b)));
-  for (int b = 3; b >= 0; --b) header.push_back(static_cast<uint8_t>(index >> (8 * b)));
-  (*j)[key] = nlohmann::json::binary(header, 2);
-}
-
 }  // namespace
 
 std::string CameraSensors::class_of(const std::string& model_name) {
@@ -64,6 +49,7 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
       for (const auto& cam : link.cameras) {
         Camera c;
         c.desc = &cam;
+        c.frame.keep_rgba = true;  // converted (with noise) straight into the datapack
         c.link = physics.link_index(link.name);
         cameras_.push_back(std::move(c));
       }
@@ -233,7 +219,7 @@ void CameraSensors::render(Camera& cam) {
   ++cam.frames;
   cam.has_depth = cam.want_depth;
   cam.has_boxes = cam.want_boxes;
-  apply_noise(cam);
+  draw_noise(cam);
   cam.rendered = true;
 }
 
@@ -243,67 +229,70 @@ void CameraSensors::first_render(Camera& cam) {
   cam.next_update = rate > 0 ? now_ + 1.0 / rate : now_;
 }
 
-void CameraSensors::apply_noise(Camera& cam) {
+void CameraSensors::draw_noise(Camera& cam) {
   // Gazebo: each channel value (0..1) gets mean + stddev * N(0, 1), clamped to [0, 1]. The
   // normal samples come from the camera's fixed table, read from a random place each
   // frame: deterministic for a seed, and a loop the compiler vectorises.
-  if (cam.noise.empty()) return;
-  const size_t n = cam.frame.rgb.size();
-  if (cam.noise.size() < n + 1) return;
+  const size_t n = static_cast<size_t>(cam.frame.width) * cam.frame.height * 3;
+  cam.noise_at = nullptr;
+  if (cam.noise.empty() || cam.noise.size() < n + 1) return;
   const size_t starts = cam.noise.size() - n;
-  uint8_t* px = cam.frame.rgb.data();
-  const int16_t* noise = cam.noise.data() + static_cast<size_t>(rng_() % starts);
-  for (size_t i = 0; i < n; ++i) {
-    int v = px[i] + noise[i];
-    px[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
+  cam.noise_at = cam.noise.data() + static_cast<size_t>(rng_() % starts);
+}
+
+void CameraSensors::convert(const Camera& cam, std::span<uint8_t> dst) const {
+  // The one copy of a frame in this process: the read-back RGBA, with the noise, into the
+  // datapack (in the outgoing shared memory for a large frame).
+  const size_t pixels = static_cast<size_t>(cam.frame.width) * cam.frame.height;
+  const uint8_t* src = cam.frame.rgba.data();
+  const int16_t* noise = cam.noise_at;
+  datapack::count_copy(dst.size());
+  auto noisy = [&](size_t p, int c) {
+    const int v = src[4 * p + c] + noise[3 * p + c];
+    return static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
+  };
+  if (cam.depth_channels == 1) {
+    for (size_t p = 0; p < pixels; ++p) {
+      int r = src[4 * p], g = src[4 * p + 1], b = src[4 * p + 2];
+      if (noise) r = noisy(p, 0), g = noisy(p, 1), b = noisy(p, 2);
+      dst[p] = static_cast<uint8_t>((299 * r + 587 * g + 114 * b + 500) / 1000);
+    }
+  } else if (!noise) {
+    render::rgba_to_rgb(src, dst.data(), pixels);
+  } else {
+    uint8_t* out = dst.data();
+    for (size_t p = 0; p < pixels; ++p)
+      for (int c = 0; c < 3; ++c) out[3 * p + c] = noisy(p, c);
   }
 }
 
-void CameraSensors::image_datapack(size_t i, engine::DataPack* out) {
+void CameraSensors::image_datapack(size_t i, datapack::Builder& out) {
   Camera& cam = cameras_[i];
   cam.want_image = true;
   if (!cam.rendered) first_render(cam);
-  data::Camera c;
-  c.set_image_width(static_cast<uint32_t>(cam.frame.width));
-  c.set_image_height(static_cast<uint32_t>(cam.frame.height));
-  c.set_image_depth(static_cast<uint32_t>(cam.depth_channels));
-  std::string_view bytes(reinterpret_cast<const char*>(cam.frame.rgb.data()), cam.frame.rgb.size());
-  std::vector<uint8_t> gray;
-  if (cam.depth_channels == 1) {
-    gray.resize(cam.frame.rgb.size() / 3);
-    for (size_t p = 0; p < gray.size(); ++p) {
-      const uint8_t* px = &cam.frame.rgb[3 * p];
-      gray[p] = static_cast<uint8_t>((299 * px[0] + 587 * px[1] + 114 * px[2] + 500) / 1000);
-    }
-    bytes = std::string_view(reinterpret_cast<const char*>(gray.data()), gray.size());
-  }
-  if (bytes.size() >= transport::kShmBlobThreshold) {
-    c.set_image_blob(transport::current_blob_writer().add(out, bytes) + 1);
-  } else {
-    c.set_image_data(bytes.data(), bytes.size());
-  }
-  out->mutable_id()->set_type("convoy.data.Camera");
-  out->mutable_proto()->set_type_name("convoy.data.Camera");
-  c.SerializeToString(out->mutable_proto()->mutable_data());
+  datapack::write_camera(out, static_cast<uint32_t>(cam.frame.height),
+                         static_cast<uint32_t>(cam.frame.width),
+                         static_cast<uint32_t>(cam.depth_channels),
+                         [&](std::span<uint8_t> dst) { convert(cam, dst); });
 }
 
-void CameraSensors::depth_datapack(size_t i, engine::DataPack* out) {
+void CameraSensors::depth_datapack(size_t i, datapack::Builder& out) {
   Camera& cam = cameras_[i];
   cam.want_depth = true;
   if (!cam.rendered)
     first_render(cam);
   else if (!cam.has_depth)
     render(cam);  // (noise redrawn: a new sample of the same view)
-  nlohmann::json j;
-  j["width"] = cam.frame.width;
-  j["height"] = cam.frame.height;
-  numpy_blob(&j, "depth", cam.frame.depth, cam.frame.height, cam.frame.width, out);
-  out->mutable_id()->set_type("json");
-  std::vector<uint8_t> bytes = nlohmann::json::to_msgpack(j);
-  out->set_json_msgpack(std::string(bytes.begin(), bytes.end()));
+  const uint64_t shape[2] = {static_cast<uint64_t>(cam.frame.height),
+                             static_cast<uint64_t>(cam.frame.width)};
+  const std::string_view bytes(reinterpret_cast<const char*>(cam.frame.depth.data()),
+                               cam.frame.depth.size() * sizeof(float));
+  datapack::write_json(out, {{"width", cam.frame.width},
+                             {"height", cam.frame.height},
+                             {"depth", datapack::ndarray_json(out, "<f4", shape, bytes)}});
 }
 
-void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
+void CameraSensors::boxes_datapack(size_t i, datapack::Builder& out) {
   Camera& cam = cameras_[i];
   cam.want_boxes = true;
   if (!cam.rendered)
@@ -322,10 +311,8 @@ void CameraSensors::boxes_datapack(size_t i, engine::DataPack* out) {
                      {"y_max", b.y_max},
                      {"pixels", b.pixel_count}});
   }
-  nlohmann::json j = {{"width", cam.frame.width}, {"height", cam.frame.height}, {"boxes", boxes}};
-  out->mutable_id()->set_type("json");
-  std::vector<uint8_t> bytes = nlohmann::json::to_msgpack(j);
-  out->set_json_msgpack(std::string(bytes.begin(), bytes.end()));
+  datapack::write_json(
+      out, {{"width", cam.frame.width}, {"height", cam.frame.height}, {"boxes", boxes}});
 }
 
 }  // namespace convoy::world

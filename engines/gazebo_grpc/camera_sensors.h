@@ -5,10 +5,11 @@
 
 #include <memory>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
-#include "convoy/engine.pb.h"
+#include "datapack/datapack.h"
 #include "physics_world.h"
 #include "render/renderer.h"
 #include "world_description.h"
@@ -33,14 +34,14 @@ class CameraSensors {
   // once they have been asked for: a world whose cameras nobody reads costs no rendering.
 
   // The latest frame as a convoy.data.Camera datapack.
-  void image_datapack(size_t i, engine::DataPack* out);
+  void image_datapack(size_t i, datapack::Builder& out);
   // The latest depth image (metres, float32, H x W) as a JSON datapack
   // {"width", "height", "depth": ndarray}.
-  void depth_datapack(size_t i, engine::DataPack* out);
+  void depth_datapack(size_t i, datapack::Builder& out);
   // The latest ground truth as a JSON datapack: {"boxes": [{"model", "class", "instance",
   // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}: every visible model but the ground
   // and the camera's own.
-  void boxes_datapack(size_t i, engine::DataPack* out);
+  void boxes_datapack(size_t i, datapack::Builder& out);
 
   // The object class of a model: its <convoy:class> element if any, else its name without
   // a trailing number ("pedestrian_3" -> "pedestrian").
@@ -56,7 +57,8 @@ class CameraSensors {
     uint64_t frames = 0;
     render::Frame frame;
     int depth_channels = 3;
-    std::vector<int16_t> noise;  // mean + stddev * N(0,1) in 0..255 units, a fixed table
+    std::vector<int16_t> noise;         // mean + stddev * N(0,1) in 0..255 units, a fixed table
+    const int16_t* noise_at = nullptr;  // the current frame's samples (null: no noise)
     bool want_image = false, want_depth = false, want_boxes = false;  // asked for once:
                                                                       // rendered from then on
     bool has_depth = false, has_boxes = false;                        // the current frame has them
@@ -69,7 +71,9 @@ class CameraSensors {
   void build_scene(const WorldDesc& desc);
   void render(Camera& cam);
   void first_render(Camera& cam);  // on the first request: render now, schedule the next
-  void apply_noise(Camera& cam);
+  void draw_noise(Camera& cam);
+  // The frame's pixels (RGB or grey, with its noise) into `dst`.
+  void convert(const Camera& cam, std::span<uint8_t> dst) const;
 
   const PhysicsWorld& physics_;
   std::unique_ptr<render::Renderer> renderer_;

@@ -20,6 +20,8 @@
 
 #include "camera_sensors.h"
 #include "convoy/datapacks.pb.h"
+#include "datapack/proto.h"
+#include "datapack/registry.h"
 #include "engine/engine.h"
 #include "joint_pid.h"
 #include "physics_world.h"
@@ -73,7 +75,7 @@ class GazeboEngine final : public Engine {
         std::make_unique<world::CameraSensors>(desc_, *physics_, config.value("GazeboRNGSeed", 0u));
 
     std::vector<engine::DataPackId> ids;
-    auto add = [&](const std::string& dp_name, const char* type) {
+    auto add = [&](const std::string& dp_name, const std::string& type) {
       engine::DataPackId id;
       id.set_name(dp_name);
       id.set_engine_name(name);
@@ -91,7 +93,7 @@ class GazeboEngine final : public Engine {
           std::string short_name = pid.joint.substr(model.name.size() + 2);
           for (const std::string& n : {plugin + "::" + short_name, pid.joint}) {
             joint_dps_[n] = controllers_.size() - 1;
-            add(n, "convoy.data.Joint");
+            add(n, datapack::type_name<data::Joint>());
           }
         }
       }
@@ -100,7 +102,7 @@ class GazeboEngine final : public Engine {
           int index = physics_->link_index(link.name);
           for (const std::string& n : {plugin + "::" + link.short_name, link.name}) {
             link_dps_[n] = index;
-            add(n, "convoy.data.Link");
+            add(n, datapack::type_name<data::Link>());
           }
         }
       }
@@ -113,7 +115,7 @@ class GazeboEngine final : public Engine {
         camera_dps_[base] = {c, kImage};
         camera_dps_[base + "::depth"] = {c, kDepth};
         camera_dps_[base + "::boxes"] = {c, kBoxes};
-        add(base, "convoy.data.Camera");
+        add(base, datapack::type_name<data::Camera>());
         add(base + "::depth", "json");
         add(base + "::boxes", "json");
       }
@@ -142,18 +144,15 @@ class GazeboEngine final : public Engine {
     return time_ns_;
   }
 
-  void set_datapack(const engine::DataPack& dp) override {
+  void set_datapack(const datapack::View& dp) override {
     auto it = joint_dps_.find(dp.id().name());
     if (it == joint_dps_.end()) {
       throw std::runtime_error("engine '" + name_ + "' has no writable datapack '" +
                                dp.id().name() + "' (joint datapacks are <joint plugin>::<joint>)");
     }
-    if (dp.payload_case() != engine::DataPack::kProto ||
-        dp.proto().type_name() != "convoy.data.Joint") {
+    if (dp.proto_type() != datapack::type_name<data::Joint>())
       throw std::runtime_error("datapack '" + dp.id().name() + "' must be a GazeboJointDataPack");
-    }
-    data::Joint j;
-    j.ParseFromString(dp.proto().data());
+    const auto j = datapack::read_proto<data::Joint>(dp);
     auto& c = controllers_[it->second];
     c.target = c.velocity ? j.velocity() : j.position();
     c.feed_forward = j.effort();
@@ -166,7 +165,7 @@ class GazeboEngine final : public Engine {
     return sent != sent_frames_.end() && sent->second == cameras_->frames(it->second.first);
   }
 
-  void get_datapack(const engine::DataPackId& id, engine::DataPack* out) override {
+  void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
     if (auto it = camera_dps_.find(id.name()); it != camera_dps_.end()) {
       auto [index, kind] = it->second;
       if (kind == kImage)
@@ -185,9 +184,7 @@ class GazeboEngine final : public Engine {
       j.set_position(static_cast<float>(s.position));
       j.set_velocity(static_cast<float>(s.velocity));
       j.set_effort(static_cast<float>(s.effort));
-      out->mutable_id()->set_type("convoy.data.Joint");
-      out->mutable_proto()->set_type_name("convoy.data.Joint");
-      j.SerializeToString(out->mutable_proto()->mutable_data());
+      datapack::write_proto(out, j);
       return;
     }
     if (auto it = link_dps_.find(id.name()); it != link_dps_.end()) {
@@ -198,9 +195,7 @@ class GazeboEngine final : public Engine {
         l.add_rotation(static_cast<float>(v));
       for (int k = 0; k < 3; ++k) l.add_linear_velocity(static_cast<float>(s.linear_velocity[k]));
       for (int k = 0; k < 3; ++k) l.add_angular_velocity(static_cast<float>(s.angular_velocity[k]));
-      out->mutable_id()->set_type("convoy.data.Link");
-      out->mutable_proto()->set_type_name("convoy.data.Link");
-      l.SerializeToString(out->mutable_proto()->mutable_data());
+      datapack::write_proto(out, l);
     }
   }
 

@@ -58,7 +58,7 @@ class PythonJsonEngine final : public Engine {
     }
   }
 
-  void set_datapack(const engine::DataPack& dp) override {
+  void set_datapack(const datapack::View& dp) override {
     py::dict datapacks = script_.attr("_datapacks");
     py::str key(dp.id().name());
     if (!datapacks.contains(key)) {
@@ -73,7 +73,7 @@ class PythonJsonEngine final : public Engine {
     }
   }
 
-  void get_datapack(const engine::DataPackId& id, engine::DataPack* out) override {
+  void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
     py::dict datapacks = script_.attr("_datapacks");
     py::str key(id.name());
     if (!datapacks.contains(key)) return;  // unknown id: empty datapack

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "convoy/engine.pb.h"
+#include "datapack/datapack.h"
 
 namespace convoy::engines {
 
@@ -28,10 +29,14 @@ class Engine {
                                                      int64_t timestep_ns) = 0;
   // Advances by `duration_ns`; returns the engine's time afterwards.
   virtual int64_t step(int64_t duration_ns) = 0;
-  // Accepts a datapack sent by a transceiver function.
-  virtual void set_datapack(const engine::DataPack& datapack) = 0;
-  // Fills `out` with the datapack `id`; leaves its payload unset if there is none.
-  virtual void get_datapack(const engine::DataPackId& id, engine::DataPack* out) = 0;
+  // Accepts a datapack sent by a transceiver function. Its blobs are read in place
+  // (datapack/datapack.h): they stay valid until the end of the step that follows; an engine
+  // that keeps them longer copies them.
+  virtual void set_datapack(const datapack::View& datapack) = 0;
+  // Fills `out` (whose id is set) with the datapack `id` through the codecs of src/datapack.
+  // Leaves its payload unset (the empty datapack) for an id it does not know, or that has no
+  // value yet.
+  virtual void get_datapack(const engine::DataPackId& id, datapack::Builder& out) = 0;
   // True when datapack `id` has not changed since get_datapack last filled it (a camera
   // that has not rendered since): a step's reply may then leave it out, and the coordinator
   // keeps the one it has, as NRP-Core's camera controller returns no datapack between frames.

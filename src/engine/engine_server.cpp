@@ -43,16 +43,22 @@ std::vector<std::string> registered_engine_types() {
   return out;
 }
 
+void EngineServer::get(const engine::DataPackId& id, engine::DataPack* out) {
+  *out->mutable_id() = id;
+  datapack::Builder builder(out, *blob_writer_);
+  engine_.get_datapack(id, builder);
+}
+
+void EngineServer::put(const engine::DataPack& dp) {
+  engine_.set_datapack(datapack::View(dp, *blob_reader_));
+}
+
 void EngineServer::do_step(const engine::StepRequest& request, engine::StepReply* reply) {
   int64_t t0 = now_ns();
-  for (const auto& dp : request.inputs()) engine_.set_datapack(dp);
+  for (const auto& dp : request.inputs()) put(dp);
   reply->set_time_ns(engine_.step(request.duration_ns()));
   stale_.clear();
-  auto add = [&](const engine::DataPackId& id) {
-    auto* out = reply->add_outputs();
-    *out->mutable_id() = id;
-    engine_.get_datapack(id, out);
-  };
+  auto add = [&](const engine::DataPackId& id) { get(id, reply->add_outputs()); };
   for (const auto& id : request.wanted()) {
     if (engine_.unchanged(id))
       stale_.push_back(&id);
@@ -83,14 +89,11 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
         do_step(request.step(), reply->mutable_step());
         break;
       case engine::Request::kGetDatapacks:
-        for (const auto& id : request.get_datapacks().ids()) {
-          auto* out = reply->mutable_get_datapacks()->add_datapacks();
-          *out->mutable_id() = id;
-          engine_.get_datapack(id, out);
-        }
+        for (const auto& id : request.get_datapacks().ids())
+          get(id, reply->mutable_get_datapacks()->add_datapacks());
         break;
       case engine::Request::kSetDatapacks:
-        for (const auto& dp : request.set_datapacks().datapacks()) engine_.set_datapack(dp);
+        for (const auto& dp : request.set_datapacks().datapacks()) put(dp);
         reply->mutable_done();
         break;
       case engine::Request::kReset:
@@ -121,9 +124,10 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     writer = std::make_unique<transport::ShmBlobWriter>(out_arena);
   }
   shm_writer_ = writer.get();
+  if (writer) blob_writer_ = writer.get();
   if (shm_in_fd >= 0) in_arena.attach(shm_in_fd);
   transport::ShmBlobReader reader(shm_in_fd >= 0 ? &in_arena : nullptr);
-  transport::ScopedBlobContext blobs(writer.get(), &reader);
+  blob_reader_ = &reader;
   std::string in, out;
   engine::Request request;
   engine::Reply reply;
@@ -159,6 +163,9 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     if (!socket.send(out) || !more) break;
     follow(usual_work_ns, now_ns() - received);
   }
+  blob_writer_ = &inline_writer_;
+  blob_reader_ = &datapack::inline_blob_reader();
+  shm_writer_ = nullptr;
   // The coordinator went away without a Shutdown: still let the engine clean up.
   if (initialized_ && !shut_down_) {
     shut_down_ = true;
@@ -346,6 +353,10 @@ int engine_main(int argc, char** argv) {
     std::fprintf(stderr, "engine server error: %s\n", e.what());
     return 1;
   }
+  const auto& copies = datapack::large_copies();
+  std::fprintf(stderr, "frame-sized copies: %llu (%.1f MB)\n",
+               static_cast<unsigned long long>(copies.copies.load()),
+               static_cast<double>(copies.bytes.load()) / 1e6);
   return 0;
 }
 

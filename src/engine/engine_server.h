@@ -36,8 +36,15 @@ class EngineServer {
   bool initialized_ = false;
   bool shut_down_ = false;
   int64_t spin_us_ = 0;
+  void get(const engine::DataPackId& id, engine::DataPack* out);
+  void put(const engine::DataPack& dp);
   const transport::ShmBlobWriter* shm_writer_ = nullptr;  // serve_socket's, if any
-  std::vector<const engine::DataPackId*> stale_;          // do_step's, reused
+  // The blobs of requests are read with blob_reader_, those of replies written with
+  // blob_writer_: inline unless serve_socket has shared-memory arenas.
+  datapack::InlineBlobWriter inline_writer_;
+  datapack::BlobWriter* blob_writer_ = &inline_writer_;
+  const datapack::BlobReader* blob_reader_ = &datapack::inline_blob_reader();
+  std::vector<const engine::DataPackId*> stale_;  // do_step's, reused
 };
 
 // main() of every convoy-engine-<type> binary.

@@ -21,7 +21,7 @@ void EngineHandle::create_arenas(size_t bytes_each) {
   shm_writer_ = std::make_unique<transport::ShmBlobWriter>(in_arena_);
 }
 
-transport::BlobWriter* EngineHandle::blob_writer() {
+datapack::BlobWriter* EngineHandle::blob_writer() {
   if (shm_writer_) return shm_writer_.get();
   return &inline_writer_;
 }

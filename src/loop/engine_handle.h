@@ -30,8 +30,8 @@ class EngineHandle {
   int out_arena_fd() const { return out_arena_.fd(); }
   int in_arena_fd() const { return in_arena_.fd(); }
   // Reads blobs of this engine's replies; writes blobs of datapacks sent to it.
-  const transport::BlobReader* blob_reader() const { return &reader_; }
-  transport::BlobWriter* blob_writer();
+  const datapack::BlobReader* blob_reader() const { return &reader_; }
+  datapack::BlobWriter* blob_writer();
   bool connected() const { return channel_ != nullptr; }
   bool busy() const { return busy_; }
 
@@ -65,7 +65,7 @@ class EngineHandle {
   transport::ShmArena out_arena_, in_arena_;
   transport::ShmBlobReader reader_{&out_arena_};
   std::unique_ptr<transport::ShmBlobWriter> shm_writer_;
-  transport::InlineBlobWriter inline_writer_;
+  datapack::InlineBlobWriter inline_writer_;
   bool busy_ = false;
   std::string what_;
   double timeout_s_ = 0;

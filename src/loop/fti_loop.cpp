@@ -54,11 +54,11 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& ru
     auto it = pool_.find(key(engine, name));
     return it != pool_.end() && it->second.cycle == cycles_;
   };
-  source_.reader_for = [this](const std::string& engine) -> const transport::BlobReader* {
+  source_.reader_for = [this](const std::string& engine) -> const datapack::BlobReader* {
     auto it = by_name_.find(engine);
     return it == by_name_.end() ? nullptr : it->second->blob_reader();
   };
-  source_.writer_for = [this](const std::string& engine) -> transport::BlobWriter* {
+  source_.writer_for = [this](const std::string& engine) -> datapack::BlobWriter* {
     auto it = by_name_.find(engine);
     return it == by_name_.end() ? nullptr : it->second->blob_writer();
   };

@@ -1,20 +1,40 @@
 #include "python/datapack_convert.h"
 
+#include <pybind11/embed.h>
 #include <pybind11/numpy.h>
 
 #include <cstring>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "convoy/datapacks.pb.h"
+#include "datapack/camera.h"
+#include "datapack/json.h"
+#include "datapack/proto.h"
+#include "datapack/registry.h"
 #include "python/msgpack_codec.h"
-#include "transport/blobs.h"
+
+// What Python sees of the datapack registry (nrp_core.data.nrp_protobuf builds its classes
+// from it).
+PYBIND11_EMBEDDED_MODULE(_convoy_datapack, m) {
+  using convoy::datapack::Registry;
+  m.def("types", [] {
+    pybind11::dict out;
+    for (const auto* t : Registry::global().all()) out[pybind11::str(t->python_class)] = t->name;
+    return out;
+  });
+  m.def("python_class",
+        [](const std::string& type) { return Registry::global().add_by_name(type).python_class; });
+  m.def("file_descriptor_set", [](const std::string& type) {
+    return pybind11::bytes(Registry::global().file_descriptor_set(type));
+  });
+}
 
 namespace convoy::python {
 namespace {
 
-constexpr const char* kCamera = "convoy.data.Camera";
-constexpr const char* kJoint = "convoy.data.Joint";
-constexpr const char* kLink = "convoy.data.Link";
+using datapack::Builder;
+using datapack::View;
 
 struct JsonClasses {
   py::object json, empty, base;
@@ -34,10 +54,6 @@ const py::module_& proto_module() {
   return *m;
 }
 
-bool type_is(py::handle obj, const char* name) {
-  return std::strcmp(Py_TYPE(obj.ptr())->tp_name, name) == 0;
-}
-
 py::object uint8_array(std::string_view bytes, bool in_shm, ImageAccess access) {
   static py::object* frombuffer_fn =
       new py::object(py::module_::import("numpy").attr("frombuffer"));
@@ -49,6 +65,7 @@ py::object uint8_array(std::string_view bytes, bool in_shm, ImageAccess access) 
   }
   // A private copy, which numpy then wraps without copying again.
   py::bytearray owned(bytes.data(), bytes.size());
+  datapack::count_copy(bytes.size());
   return frombuffer(owned, "uint8");
 }
 
@@ -71,159 +88,187 @@ py::array_t<float> float_array(const google::protobuf::RepeatedField<float>& val
   return arr;
 }
 
-py::object proto_data(const engine::DataPack& dp, ImageAccess access) {
-  const auto& p = dp.proto();
-  const std::string& type = p.type_name();
-  const py::module_& m = proto_module();
-  if (type == kCamera) {
-    data::Camera c;
-    if (!c.ParseFromString(p.data())) throw std::runtime_error("corrupt camera datapack");
-    py::object image;
-    if (c.image_blob() > 0) {
-      bool in_shm = false;
-      auto bytes = transport::current_blob_reader().get(dp, c.image_blob() - 1, &in_shm);
-      image = uint8_array(bytes, in_shm, access);
-    } else {
-      image = uint8_array(c.image_data(), false, access);
-    }
-    return m.attr("CameraData")(c.image_height(), c.image_width(), c.image_depth(), image);
-  }
-  if (type == kJoint) {
-    data::Joint j;
-    if (!j.ParseFromString(p.data())) throw std::runtime_error("corrupt joint datapack");
-    return m.attr("JointData")(j.position(), j.velocity(), j.effort());
-  }
-  if (type == kLink) {
-    data::Link l;
-    if (!l.ParseFromString(p.data())) throw std::runtime_error("corrupt link datapack");
-    py::array_t<float> rot = float_array(l.rotation(), 4);
-    if (l.rotation_size() == 0) rot.mutable_data()[3] = 1.0f;
-    return m.attr("LinkData")(float_array(l.position(), 3), rot,
-                              float_array(l.linear_velocity(), 3),
-                              float_array(l.angular_velocity(), 3));
-  }
-  throw std::runtime_error("datapack '" + dp.id().name() + "' of engine '" + dp.id().engine_name() +
-                           "' holds protobuf type " + type + ", which has no Python class");
+// The standard messages have converters of their own, with numpy fields and the report's
+// attribute names (nrp_core.data.nrp_protobuf's CameraData, JointData, LinkData).
+py::object camera_to_python(const View& in, ImageAccess access) {
+  const datapack::CameraImage img = datapack::read_camera(in);
+  return proto_module().attr("CameraData")(img.height, img.width, img.depth,
+                                           uint8_array(img.pixels, img.in_shm, access));
 }
 
-const char* proto_class(const std::string& type) {
-  if (type == kCamera) return "GazeboCameraDataPack";
-  if (type == kJoint) return "GazeboJointDataPack";
-  if (type == kLink) return "GazeboLinkDataPack";
+void camera_from_python(py::handle data, Builder& out) {
+  py::buffer_info info = py::buffer(data.attr("image_data")).request();
+  std::string_view bytes(static_cast<const char*>(info.ptr),
+                         static_cast<size_t>(info.size * info.itemsize));
+  datapack::write_camera(out, data.attr("image_height").cast<uint32_t>(),
+                         data.attr("image_width").cast<uint32_t>(),
+                         data.attr("image_depth").cast<uint32_t>(), bytes);
+}
+
+py::object joint_to_python(const View& in, ImageAccess) {
+  const auto j = datapack::read_proto<data::Joint>(in);
+  return proto_module().attr("JointData")(j.position(), j.velocity(), j.effort());
+}
+
+void joint_from_python(py::handle data, Builder& out) {
+  data::Joint j;
+  j.set_position(data.attr("position").cast<float>());
+  j.set_velocity(data.attr("velocity").cast<float>());
+  j.set_effort(data.attr("effort").cast<float>());
+  datapack::write_proto(out, j);
+}
+
+py::object link_to_python(const View& in, ImageAccess) {
+  const auto l = datapack::read_proto<data::Link>(in);
+  py::array_t<float> rot = float_array(l.rotation(), 4);
+  if (l.rotation_size() == 0) rot.mutable_data()[3] = 1.0f;
+  return proto_module().attr("LinkData")(float_array(l.position(), 3), rot,
+                                         float_array(l.linear_velocity(), 3),
+                                         float_array(l.angular_velocity(), 3));
+}
+
+void link_from_python(py::handle data, Builder& out) {
+  data::Link l;
+  for (float v : float_vector(data.attr("pos"), 3, "link position")) l.add_position(v);
+  for (float v : float_vector(data.attr("rot"), 4, "link rotation")) l.add_rotation(v);
+  for (float v : float_vector(data.attr("lin_vel"), 3, "link linear velocity"))
+    l.add_linear_velocity(v);
+  for (float v : float_vector(data.attr("ang_vel"), 3, "link angular velocity"))
+    l.add_angular_velocity(v);
+  datapack::write_proto(out, l);
+}
+
+struct Converter {
+  const char* data_class;  // tp_name of the Python data object
+  py::object (*to_data)(const View&, ImageAccess);
+  void (*from_data)(py::handle, Builder&);
+};
+
+const std::unordered_map<std::string, Converter>& converters() {
+  static const auto* table = new std::unordered_map<std::string, Converter>{
+      {datapack::type_name<data::Camera>(), {"CameraData", camera_to_python, camera_from_python}},
+      {datapack::type_name<data::Joint>(), {"JointData", joint_to_python, joint_from_python}},
+      {datapack::type_name<data::Link>(), {"LinkData", link_to_python, link_from_python}},
+  };
+  return *table;
+}
+
+const Converter* converter_for_data(py::handle data) {
+  const char* tp = Py_TYPE(data.ptr())->tp_name;
+  for (const auto& [type, c] : converters())
+    if (std::strcmp(tp, c.data_class) == 0) return &c;
   return nullptr;
 }
 
-// Encodes a CameraData / JointData / LinkData; false if `data` is none of them.
-bool encode_proto(py::handle data, engine::DataPack* out) {
-  auto* payload = out->mutable_proto();
-  if (type_is(data, "CameraData")) {
-    data::Camera c;
-    c.set_image_height(data.attr("image_height").cast<uint32_t>());
-    c.set_image_width(data.attr("image_width").cast<uint32_t>());
-    c.set_image_depth(data.attr("image_depth").cast<uint32_t>());
-    py::object image = data.attr("image_data");
-    py::buffer_info info = py::buffer(image).request();
-    std::string_view bytes(static_cast<const char*>(info.ptr),
-                           static_cast<size_t>(info.size * info.itemsize));
-    if (bytes.size() >= transport::kShmBlobThreshold) {
-      c.set_image_blob(transport::current_blob_writer().add(out, bytes) + 1);
-    } else {
-      c.set_image_data(bytes.data(), bytes.size());
-    }
-    payload->set_type_name(kCamera);
-    c.SerializeToString(payload->mutable_data());
-  } else if (type_is(data, "JointData")) {
-    data::Joint j;
-    j.set_position(data.attr("position").cast<float>());
-    j.set_velocity(data.attr("velocity").cast<float>());
-    j.set_effort(data.attr("effort").cast<float>());
-    payload->set_type_name(kJoint);
-    j.SerializeToString(payload->mutable_data());
-  } else if (type_is(data, "LinkData")) {
-    data::Link l;
-    for (float v : float_vector(data.attr("pos"), 3, "link position")) l.add_position(v);
-    for (float v : float_vector(data.attr("rot"), 4, "link rotation")) l.add_rotation(v);
-    for (float v : float_vector(data.attr("lin_vel"), 3, "link linear velocity"))
-      l.add_linear_velocity(v);
-    for (float v : float_vector(data.attr("ang_vel"), 3, "link angular velocity"))
-      l.add_angular_velocity(v);
-    payload->set_type_name(kLink);
-    l.SerializeToString(payload->mutable_data());
-  } else {
-    out->clear_payload();
-    return false;
+// Every other registered message: a class of nrp_core.data.nrp_protobuf whose data is a
+// Python protobuf message (built from the registry by _datapack_class).
+const py::object& generic_class(const std::string& type) {
+  static auto* classes = new std::unordered_map<std::string, py::object>;
+  auto it = classes->find(type);
+  if (it == classes->end())
+    it = classes->emplace(type, proto_module().attr("_datapack_class")(type)).first;
+  return it->second;
+}
+
+py::object proto_data(const View& in, ImageAccess access) {
+  const std::string& type = in.proto_type();
+  if (auto it = converters().find(type); it != converters().end())
+    return it->second.to_data(in, access);
+  try {
+    const std::string& bytes = in.message().proto().data();
+    return generic_class(type).attr("_message").attr("FromString")(py::bytes(bytes));
+  } catch (py::error_already_set& e) {
+    throw std::runtime_error(in.describe() + " holds protobuf type " + type +
+                             ", which Python cannot decode: " + e.what());
   }
-  out->mutable_id()->set_type(payload->type_name());
+}
+
+// A Python protobuf message (it has a DESCRIPTOR): its full name names a registered type.
+bool encode_generic(py::handle data, Builder& out) {
+  if (!PyObject_HasAttrString(reinterpret_cast<PyObject*>(Py_TYPE(data.ptr())), "DESCRIPTOR") ||
+      !py::hasattr(data, "SerializeToString"))
+    return false;
+  const std::string type = data.attr("DESCRIPTOR").attr("full_name").cast<std::string>();
+  datapack::Registry::global().add_by_name(type);
+  auto* dp = out.message();
+  dp->mutable_id()->set_type(type);
+  auto* payload = dp->mutable_proto();
+  payload->set_type_name(type);
+  payload->set_data(data.attr("SerializeToString")().cast<std::string>());
   return true;
 }
 
 }  // namespace
 
-py::object decode_json(const std::string& msgpack, const engine::DataPack* owner) {
+py::object decode_json(const std::string& msgpack, const View* owner) {
   PyObject* v = msgpack_decode(msgpack, owner);
   if (!v) throw py::error_already_set();
   return py::reinterpret_steal<py::object>(v);
 }
 
-void encode_json(py::handle value, std::string* out, engine::DataPack* owner) {
+void encode_json(py::handle value, std::string* out, Builder* owner) {
   if (!msgpack_encode(value.ptr(), out, owner)) throw py::error_already_set();
 }
 
-py::object data_to_python(const engine::DataPack& dp, ImageAccess images) {
-  switch (dp.payload_case()) {
-    case engine::DataPack::kJsonMsgpack:
-      return decode_json(dp.json_msgpack(), &dp);
-    case engine::DataPack::kProto:
-      return proto_data(dp, images);
-    default:
-      return py::none();
-  }
+py::object data_to_python(const View& in, ImageAccess images) {
+  if (in.is_json()) return decode_json(in.message().json_msgpack(), &in);
+  if (in.is_proto()) return proto_data(in, images);
+  return py::none();
 }
 
-py::object to_python(const engine::DataPack& dp, ImageAccess images) {
-  const auto& id = dp.id();
-  switch (dp.payload_case()) {
-    case engine::DataPack::kJsonMsgpack:
-      return json_classes().json(id.name(), id.engine_name(), data_to_python(dp, images));
-    case engine::DataPack::kProto: {
-      const char* cls = proto_class(dp.proto().type_name());
-      py::object data = proto_data(dp, images);
-      py::object obj = proto_module().attr(cls)(id.name(), id.engine_name());
-      obj.attr("_data") = data;
-      return obj;
-    }
-    default:
-      return json_classes().empty(id.name(), id.engine_name(), id.type());
+py::object to_python(const View& in, ImageAccess images) {
+  const auto& id = in.id();
+  if (in.is_json())
+    return json_classes().json(id.name(), id.engine_name(), data_to_python(in, images));
+  if (in.is_proto()) {
+    const std::string& type = in.proto_type();
+    py::object data = proto_data(in, images);
+    py::object cls;
+    if (const auto* t = datapack::Registry::global().find(type); t && converters().count(type))
+      cls = proto_module().attr(t->python_class.c_str());
+    else
+      cls = generic_class(type);
+    py::object obj = cls(id.name(), id.engine_name());
+    obj.attr("_data") = data;
+    return obj;
   }
+  return json_classes().empty(id.name(), id.engine_name(), id.type());
 }
 
-void data_from_python(py::handle data, engine::DataPack* out) {
+void data_from_python(py::handle data, Builder& out) {
   if (data.is_none()) {
-    out->clear_payload();
+    out.clear();
     return;
   }
   try {
-    if (!PyDict_Check(data.ptr()) && encode_proto(data, out)) return;
-    out->mutable_id()->set_type("json");
-    std::string* bytes = out->mutable_json_msgpack();
+    if (!PyDict_Check(data.ptr())) {
+      if (const Converter* c = converter_for_data(data)) {
+        c->from_data(data, out);
+        return;
+      }
+      if (encode_generic(data, out)) return;
+    }
+    auto* dp = out.message();
+    dp->mutable_id()->set_type(std::string(datapack::kJsonType));
+    std::string* bytes = dp->mutable_json_msgpack();
     bytes->clear();
-    encode_json(data, bytes, out);
+    encode_json(data, bytes, &out);
   } catch (py::error_already_set& e) {
-    throw std::runtime_error("datapack '" + out->id().name() + "' for engine '" +
-                             out->id().engine_name() + "': " + e.what());
+    throw std::runtime_error(out.describe() + ": " + e.what());
   } catch (const py::cast_error& e) {
-    throw std::runtime_error("datapack '" + out->id().name() + "' for engine '" +
-                             out->id().engine_name() + "': wrong field type (" + e.what() + ")");
+    throw std::runtime_error(out.describe() + ": wrong field type (" + e.what() + ")");
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(out.describe() + ": " + e.what());
   }
 }
 
-void from_python(py::handle obj, engine::DataPack* out) {
+void from_python(py::handle obj, Builder& out) {
   if (!py::isinstance(obj, json_classes().base)) {
     throw std::runtime_error("returned a " + std::string(Py_TYPE(obj.ptr())->tp_name) +
                              " where a datapack (e.g. JsonDataPack) was expected");
   }
   py::object id = obj.attr("_id");
-  auto* pid = out->mutable_id();
+  auto* pid = out.message()->mutable_id();
   pid->set_name(id.attr("dataPackName").cast<std::string>());
   pid->set_engine_name(id.attr("engineName").cast<std::string>());
   data_from_python(obj.attr("_data"), out);

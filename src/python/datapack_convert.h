@@ -1,38 +1,41 @@
-// Datapacks between their wire form (engine::DataPack) and nrp_core's Python classes.
+// Datapacks between their wire form and nrp_core's Python classes.
 //
-// JSON data <-> Python values (dicts, lists, numpy arrays); the standard protobuf messages
-// (convoy.data.Camera / Joint / Link) <-> GazeboCameraDataPack / GazeboJointDataPack /
-// GazeboLinkDataPack. Blobs are read and written through the thread's current blob
-// reader / writer (transport/blobs.h).
+// JSON data <-> Python values (dicts, lists, numpy arrays). Protobuf data <-> the Python class
+// of its registered type (datapack/registry.h): the standard messages convoy.data.Camera /
+// Joint / Link become GazeboCameraDataPack / GazeboJointDataPack / GazeboLinkDataPack with
+// numpy fields (a camera image is a view on the received frame); any other registered message
+// becomes a datapack class of nrp_core.data.nrp_protobuf whose data is a message of Debian's
+// Python protobuf, built from the registry's descriptors. Blobs are read and written through
+// the View / Builder given.
 #pragma once
 
 #include <pybind11/pybind11.h>
 
 #include <string>
 
-#include "convoy/engine.pb.h"
+#include "datapack/datapack.h"
 
 namespace convoy::python {
 
 namespace py = pybind11;
 
 // JSON data (MessagePack bytes) <-> Python value. Throw py::error_already_set on error.
-py::object decode_json(const std::string& msgpack, const engine::DataPack* owner = nullptr);
-void encode_json(py::handle value, std::string* out, engine::DataPack* owner = nullptr);
+py::object decode_json(const std::string& msgpack, const datapack::View* owner = nullptr);
+void encode_json(py::handle value, std::string* out, datapack::Builder* owner = nullptr);
 
 // How a camera image reaches Python: a read-only view on the received bytes (zero copy,
 // valid while the sender keeps them: the coordinator's functions during one cycle) or a copy
 // (an engine, which keeps its datapacks across steps).
 enum class ImageAccess { kView, kCopy };
 
-// engine::DataPack -> JsonDataPack / Gazebo*DataPack, or EmptyDataPack without a payload.
-py::object to_python(const engine::DataPack& datapack, ImageAccess images = ImageAccess::kView);
-// Only the data: a dict (JSON), a CameraData / JointData / LinkData, or None if empty.
-py::object data_to_python(const engine::DataPack& datapack, ImageAccess images);
+// A datapack -> JsonDataPack / a protobuf datapack class, or EmptyDataPack without a payload.
+py::object to_python(const datapack::View& datapack, ImageAccess images = ImageAccess::kView);
+// Only the data: a JSON value, the protobuf data object, or None if empty.
+py::object data_to_python(const datapack::View& datapack, ImageAccess images);
 
-// A Python datapack object -> engine::DataPack. Throws std::runtime_error naming the problem.
-void from_python(py::handle datapack, engine::DataPack* out);
-// Data only (a JSON value or a CameraData / JointData / LinkData) into `out`, whose id is set.
-void data_from_python(py::handle data, engine::DataPack* out);
+// A Python datapack object -> `out` (id included). Throws std::runtime_error naming the problem.
+void from_python(py::handle datapack, datapack::Builder& out);
+// Data only (a JSON value or a protobuf data object) into `out`, whose id is set.
+void data_from_python(py::handle data, datapack::Builder& out);
 
 }  // namespace convoy::python

@@ -69,9 +69,8 @@ py::object FunctionRuntime::input_object(const FunctionInput& in, const InputSou
   const engine::DataPack* dp = src.engine_datapack(in.engine, in.datapack);
   py::object obj;
   if (dp) {
-    transport::ScopedBlobContext blobs(nullptr,
-                                       src.reader_for ? src.reader_for(in.engine) : nullptr);
-    obj = to_python(*dp);
+    const datapack::BlobReader* reader = src.reader_for ? src.reader_for(in.engine) : nullptr;
+    obj = to_python(datapack::View(*dp, reader ? *reader : datapack::inline_blob_reader()));
     if (src.updated && !src.updated(in.engine, in.datapack)) obj.attr("_updated") = false;
   } else {
     obj = py::module_::import("nrp_core._datapacks").attr("EmptyDataPack")(in.datapack, in.engine);
@@ -104,12 +103,12 @@ void FunctionRuntime::run_transceiver(const LoadedFunction& fn, const InputSourc
   for (auto item : result) {
     outputs->emplace_back();
     try {
-      transport::BlobWriter* writer = nullptr;
+      datapack::BlobWriter* writer = nullptr;
       if (src.writer_for && py::hasattr(item, "_id")) {
         writer = src.writer_for(item.attr("_id").attr("engineName").cast<std::string>());
       }
-      transport::ScopedBlobContext blobs(writer, nullptr);
-      from_python(item, &outputs->back());
+      datapack::Builder out(&outputs->back(), writer ? *writer : inline_writer_);
+      from_python(item, out);
     } catch (py::error_already_set& e) {
       throw FunctionError(fn.label() + ": " + format_exception(e));
     } catch (const std::exception& e) {

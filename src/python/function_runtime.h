@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "convoy/engine.pb.h"
+#include "datapack/blobs.h"
 #include "python/interpreter.h"
-#include "transport/blobs.h"
 
 namespace convoy::python {
 
@@ -38,8 +38,8 @@ struct InputSource {
   // engine leaves out of its reply a datapack that has not changed (a camera between frames).
   std::function<bool(const std::string& engine, const std::string& name)> updated;
   // Reads the blobs of datapacks from `engine`; writes those of datapacks sent to it.
-  std::function<const transport::BlobReader*(const std::string& engine)> reader_for;
-  std::function<transport::BlobWriter*(const std::string& engine)> writer_for;
+  std::function<const datapack::BlobReader*(const std::string& engine)> reader_for;
+  std::function<datapack::BlobWriter*(const std::string& engine)> writer_for;
 };
 
 class FunctionRuntime {
@@ -63,8 +63,9 @@ class FunctionRuntime {
   py::object input_object(const FunctionInput& in, const InputSource& src,
                           const LoadedFunction& fn);
   bool by_reference_;
-  py::dict preprocessed_;  // "engine\0name" -> latest datapack object from a PF
-  py::dict shared_;        // by-reference inputs of this cycle
+  py::dict preprocessed_;                     // "engine\0name" -> latest datapack object from a PF
+  py::dict shared_;                           // by-reference inputs of this cycle
+  datapack::InlineBlobWriter inline_writer_;  // for datapacks to engines without a writer
 };
 
 }  // namespace convoy::python

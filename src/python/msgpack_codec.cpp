@@ -3,7 +3,7 @@
 #include <cstring>
 #include <vector>
 
-#include "transport/blobs.h"
+#include "datapack/ndarray.h"
 
 namespace convoy::python {
 namespace {
@@ -71,7 +71,7 @@ void put_int(std::string* out, long long v) {
 
 bool is_ndarray(PyObject* obj) { return std::strcmp(Py_TYPE(obj)->tp_name, "numpy.ndarray") == 0; }
 
-bool encode_ndarray(PyObject* obj, std::string* out, engine::DataPack* owner) {
+bool encode_ndarray(PyObject* obj, std::string* out, datapack::Builder* owner) {
   Py_buffer view;
   // C-contiguous view; non-contiguous arrays are copied by numpy into one.
   PyObject* contig = nullptr;
@@ -95,26 +95,22 @@ bool encode_ndarray(PyObject* obj, std::string* out, engine::DataPack* owner) {
   Py_ssize_t dlen = 0;
   const char* dstr = PyUnicode_AsUTF8AndSize(descr, &dlen);
   std::string header;
-  header.push_back(static_cast<char>(dlen));
-  header.append(dstr, dlen);
-  header.push_back(static_cast<char>(view.ndim));
-  for (int i = 0; i < view.ndim; ++i) {
-    uint64_t d = static_cast<uint64_t>(view.shape[i]);
-    for (int b = 0; b < 8; ++b) header.push_back(static_cast<char>((d >> (8 * b)) & 0xff));
-  }
-  if (owner && static_cast<size_t>(view.len) >= transport::kShmBlobThreshold) {
-    uint32_t index = transport::current_blob_writer().add(
-        owner, std::string_view(static_cast<const char*>(view.buf), static_cast<size_t>(view.len)));
+  std::vector<uint64_t> shape(view.shape, view.shape + view.ndim);
+  datapack::append_ndarray_header(&header, std::string_view(dstr, static_cast<size_t>(dlen)),
+                                  shape);
+  if (owner && static_cast<size_t>(view.len) >= datapack::kLargeBlobBytes) {
+    uint32_t index = owner->add_blob(
+        std::string_view(static_cast<const char*>(view.buf), static_cast<size_t>(view.len)));
     out->push_back('\xc9');
     put_be(out, header.size() + 4, 4);
-    out->push_back(static_cast<char>(kNdarrayBlobExtType));
+    out->push_back(static_cast<char>(datapack::kNdarrayBlobExtType));
     out->append(header);
-    put_be(out, index, 4);
+    datapack::append_blob_index(out, index);
   } else {
     size_t total = header.size() + static_cast<size_t>(view.len);
     out->push_back('\xc9');
     put_be(out, total, 4);
-    out->push_back(static_cast<char>(kNdarrayExtType));
+    out->push_back(static_cast<char>(datapack::kNdarrayExtType));
     out->append(header);
     out->append(static_cast<const char*>(view.buf), static_cast<size_t>(view.len));
   }
@@ -124,7 +120,7 @@ bool encode_ndarray(PyObject* obj, std::string* out, engine::DataPack* owner) {
   return true;
 }
 
-bool encode(PyObject* obj, std::string* out, engine::DataPack* owner, int depth) {
+bool encode(PyObject* obj, std::string* out, datapack::Builder* owner, int depth) {
   if (depth > 200) {
     PyErr_SetString(PyExc_ValueError, "datapack data nested too deeply (cycle?)");
     return false;
@@ -211,7 +207,7 @@ bool encode(PyObject* obj, std::string* out, engine::DataPack* owner, int depth)
 
 class Decoder {
  public:
-  Decoder(std::string_view b, const engine::DataPack* owner)
+  Decoder(std::string_view b, const datapack::View* owner)
       : p_(reinterpret_cast<const uint8_t*>(b.data())), end_(p_ + b.size()), owner_(owner) {}
 
   PyObject* value() {
@@ -375,8 +371,8 @@ class Decoder {
     int8_t type = static_cast<int8_t>(*p_++);
     const uint8_t* body = p_;
     p_ += n;
-    if (type == kNdarrayExtType || type == kNdarrayBlobExtType) {
-      return ndarray(body, n, type == kNdarrayBlobExtType);
+    if (type == datapack::kNdarrayExtType || type == datapack::kNdarrayBlobExtType) {
+      return ndarray(body, n, type == datapack::kNdarrayBlobExtType);
     }
     return PyBytes_FromStringAndSize(reinterpret_cast<const char*>(body), n);
   }
@@ -384,26 +380,26 @@ class Decoder {
 
   const uint8_t* p_;
   const uint8_t* end_;
-  const engine::DataPack* owner_;
+  const datapack::View* owner_;
   bool ok_ = true;
 };
 
 PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
-  const uint8_t* e = b + n;
-  if (n < 2) return fail("bad ndarray header");
-  size_t dlen = *b++;
-  if (static_cast<size_t>(e - b) < dlen + 1) return fail("bad ndarray header");
-  std::string dtype(reinterpret_cast<const char*>(b), dlen);
-  b += dlen;
-  size_t ndim = *b++;
-  if (static_cast<size_t>(e - b) < ndim * 8) return fail("bad ndarray header");
-  PyObject* shape = PyTuple_New(static_cast<Py_ssize_t>(ndim));
-  for (size_t i = 0; i < ndim; ++i) {
-    uint64_t d = 0;
-    for (int k = 7; k >= 0; --k) d = (d << 8) | b[k];
-    b += 8;
-    PyTuple_SET_ITEM(shape, static_cast<Py_ssize_t>(i), PyLong_FromUnsignedLongLong(d));
+  datapack::NdarrayHeader header;
+  std::string_view data;
+  try {
+    data = datapack::parse_ndarray_header({reinterpret_cast<const char*>(b), n}, &header);
+    if (in_blob) {
+      if (!owner_) return fail("array blob reference without its datapack");
+      data = owner_->blob(datapack::parse_blob_index(data));
+    }
+  } catch (const std::exception& ex) {
+    return fail(ex.what());
   }
+  PyObject* shape = PyTuple_New(static_cast<Py_ssize_t>(header.shape.size()));
+  for (size_t i = 0; i < header.shape.size(); ++i)
+    PyTuple_SET_ITEM(shape, static_cast<Py_ssize_t>(i),
+                     PyLong_FromUnsignedLongLong(header.shape[i]));
   static PyObject* numpy_empty = nullptr;
   if (!numpy_empty) {
     PyObject* np = PyImport_ImportModule("numpy");
@@ -414,7 +410,7 @@ PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
     numpy_empty = PyObject_GetAttrString(np, "empty");
     Py_DECREF(np);
   }
-  PyObject* arr = PyObject_CallFunction(numpy_empty, "Os", shape, dtype.c_str());
+  PyObject* arr = PyObject_CallFunction(numpy_empty, "Os", shape, header.dtype.c_str());
   Py_DECREF(shape);
   if (!arr) return fail("bad ndarray dtype");
   Py_buffer view;
@@ -422,40 +418,24 @@ PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
     Py_DECREF(arr);
     return fail("ndarray buffer");
   }
-  std::string_view data(reinterpret_cast<const char*>(b), static_cast<size_t>(e - b));
-  if (in_blob) {
-    if (data.size() != 4 || !owner_) {
-      PyBuffer_Release(&view);
-      Py_DECREF(arr);
-      return fail("array blob reference without its datapack");
-    }
-    uint32_t index = (uint32_t{b[0]} << 24) | (uint32_t{b[1]} << 16) | (uint32_t{b[2]} << 8) | b[3];
-    try {
-      data = transport::current_blob_reader().get(*owner_, index);
-    } catch (const std::exception& ex) {
-      PyBuffer_Release(&view);
-      Py_DECREF(arr);
-      PyErr_SetString(PyExc_ValueError, ex.what());
-      return fail(ex.what());
-    }
-  }
   if (static_cast<size_t>(view.len) != data.size()) {
     PyBuffer_Release(&view);
     Py_DECREF(arr);
     return fail("ndarray size does not match its shape");
   }
   std::memcpy(view.buf, data.data(), data.size());
+  datapack::count_copy(data.size());
   PyBuffer_Release(&view);
   return arr;
 }
 
 }  // namespace
 
-bool msgpack_encode(PyObject* obj, std::string* out, engine::DataPack* blob_owner) {
+bool msgpack_encode(PyObject* obj, std::string* out, datapack::Builder* blob_owner) {
   return encode(obj, out, blob_owner, 0);
 }
 
-PyObject* msgpack_decode(std::string_view bytes, const engine::DataPack* blob_owner) {
+PyObject* msgpack_decode(std::string_view bytes, const datapack::View* blob_owner) {
   Decoder d(bytes, blob_owner);
   PyObject* v = d.value();
   if (v && !d.at_end()) {

@@ -350,11 +350,16 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   const size_t pixels = static_cast<size_t>(w) * h;
   out->width = w;
   out->height = h;
-  s.rgba.resize(pixels * 4);
+  std::vector<uint8_t>& rgba = out->keep_rgba ? out->rgba : s.rgba;
+  rgba.resize(pixels * 4);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, s.rgba.data());
-  out->rgb.resize(pixels * 3);
-  rgba_to_rgb(s.rgba.data(), out->rgb.data(), pixels);
+  glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  if (out->keep_rgba) {
+    out->rgb.clear();
+  } else {
+    out->rgb.resize(pixels * 3);
+    rgba_to_rgb(rgba.data(), out->rgb.data(), pixels);
+  }
   if (want_depth) {
     out->depth.resize(pixels);
     glReadBuffer(GL_COLOR_ATTACHMENT1);

@@ -55,6 +55,11 @@ struct BoundingBox {
 struct Frame {
   int width = 0, height = 0;
   std::vector<uint8_t> rgb;  // height x width x 3, row 0 = top of the image
+  // Set by the caller: leave the colour as read back, in `rgba` (height x width x 4, alpha
+  // 255), and `rgb` empty. A caller that converts the pixels anyway (the world engine's
+  // cameras, straight into the outgoing shared memory) saves a copy of the frame.
+  bool keep_rgba = false;
+  std::vector<uint8_t> rgba;
   // height x width distances in metres along the optical axis (camera +X), row 0 = top;
   // +infinity where nothing lies within the clip range. Empty unless asked for.
   std::vector<float> depth;

@@ -33,67 +33,28 @@ void ShmArena::attach(int fd) {
   base_ = static_cast<char*>(p);
 }
 
-std::string_view BlobReader::get(const engine::DataPack& dp, uint32_t index, bool* in_shm) const {
-  if (in_shm) *in_shm = false;
-  if (index >= static_cast<uint32_t>(dp.blobs_size())) return {};
-  const auto& b = dp.blobs(static_cast<int>(index));
-  if (!b.in_shm()) return b.inline_();
-  const char* base = shm_base();
-  if (!base || b.shm_offset() + b.size() > shm_size()) {
-    throw std::runtime_error("datapack '" + dp.id().name() +
-                             "' refers to shared memory this process cannot read");
-  }
-  if (in_shm) *in_shm = true;
-  return {base + b.shm_offset(), b.size()};
-}
-
-uint32_t InlineBlobWriter::add(engine::DataPack* dp, std::string_view bytes) {
-  dp->add_blobs()->set_inline_(bytes.data(), bytes.size());
-  return static_cast<uint32_t>(dp->blobs_size() - 1);
-}
-
-uint32_t ShmBlobWriter::add(engine::DataPack* dp, std::string_view bytes) {
+std::span<uint8_t> ShmBlobWriter::reserve(engine::DataPack* dp, size_t size, uint32_t* index) {
   auto* blob = dp->add_blobs();
+  *index = static_cast<uint32_t>(dp->blobs_size() - 1);
   const size_t half_size = arena_.size() / 2;
-  const bool big = bytes.size() >= kShmBlobThreshold;
-  if (big && fresh_message_ && bytes.size() <= half_size) {
+  const bool big = size >= kShmBlobThreshold;
+  if (big && fresh_message_ && size <= half_size) {
     fresh_message_ = false;  // the message's first blob in shared memory: the other half
     half_ ^= 1;
     used_ = 0;
   }
   const size_t aligned = (used_ + 63) & ~size_t{63};
-  if (!big || fresh_message_ || aligned + bytes.size() > half_size) {
-    blob->set_inline_(bytes.data(), bytes.size());  // small, or the arena is full
-  } else {
-    size_t offset = static_cast<size_t>(half_) * half_size + aligned;
-    std::memcpy(arena_.data() + offset, bytes.data(), bytes.size());
-    used_ = aligned + bytes.size();
-    blob->set_in_shm(true);
-    blob->set_shm_offset(offset);
-    blob->set_size(bytes.size());
+  if (!big || fresh_message_ || aligned + size > half_size) {
+    std::string* bytes = blob->mutable_inline_();  // small, or the arena is full
+    bytes->resize(size);
+    return {reinterpret_cast<uint8_t*>(bytes->data()), size};
   }
-  return static_cast<uint32_t>(dp->blobs_size() - 1);
-}
-
-namespace {
-InlineBlobWriter default_writer;
-BlobReader default_reader;
-thread_local BlobWriter* tls_writer = &default_writer;
-thread_local const BlobReader* tls_reader = &default_reader;
-}  // namespace
-
-BlobWriter& current_blob_writer() { return *tls_writer; }
-const BlobReader& current_blob_reader() { return *tls_reader; }
-
-ScopedBlobContext::ScopedBlobContext(BlobWriter* writer, const BlobReader* reader)
-    : prev_writer_(tls_writer), prev_reader_(tls_reader) {
-  if (writer) tls_writer = writer;
-  if (reader) tls_reader = reader;
-}
-
-ScopedBlobContext::~ScopedBlobContext() {
-  tls_writer = prev_writer_;
-  tls_reader = prev_reader_;
+  const size_t offset = static_cast<size_t>(half_) * half_size + aligned;
+  used_ = aligned + size;
+  blob->set_in_shm(true);
+  blob->set_shm_offset(offset);
+  blob->set_size(size);
+  return {reinterpret_cast<uint8_t*>(arena_.data() + offset), size};
 }
 
 }  // namespace convoy::transport

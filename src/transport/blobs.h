@@ -1,4 +1,4 @@
-// Large byte payloads of datapacks (engine::Blob): where they are written and read.
+// Shared-memory blobs (datapack/blobs.h) between the coordinator and the engines it forks.
 //
 // Between the coordinator and an engine it forked, blobs go through two shared-memory
 // arenas (memfd), one written by each side; the messages carry only offsets. Each arena is
@@ -15,11 +15,11 @@
 #include <string_view>
 
 #include "convoy/engine.pb.h"
+#include "datapack/blobs.h"
 
 namespace convoy::transport {
 
-// Blobs at least this large go to shared memory; smaller ones stay inline.
-constexpr size_t kShmBlobThreshold = 32 * 1024;
+constexpr size_t kShmBlobThreshold = datapack::kLargeBlobBytes;
 
 // A shared-memory region mapped in this process.
 class ShmArena {
@@ -43,35 +43,8 @@ class ShmArena {
   size_t size_ = 0;
 };
 
-// Writes blobs into a datapack.
-class BlobWriter {
- public:
-  virtual ~BlobWriter() = default;
-  // Appends a blob holding `bytes` to `dp`; returns its index.
-  virtual uint32_t add(engine::DataPack* dp, std::string_view bytes) = 0;
-};
-
-// Reads a datapack's blobs.
-class BlobReader {
- public:
-  virtual ~BlobReader() = default;
-  // The bytes of blob `index` of `dp`; empty view if there is no such blob. `in_shm` tells
-  // whether they live in shared memory (valid until the sender's next-but-one message).
-  virtual std::string_view get(const engine::DataPack& dp, uint32_t index,
-                               bool* in_shm = nullptr) const;
-
- protected:
-  virtual const char* shm_base() const { return nullptr; }
-  virtual size_t shm_size() const { return 0; }
-};
-
-class InlineBlobWriter final : public BlobWriter {
- public:
-  uint32_t add(engine::DataPack* dp, std::string_view bytes) override;
-};
-
 // Writes blobs at or above kShmBlobThreshold into an arena, alternating halves.
-class ShmBlobWriter final : public BlobWriter {
+class ShmBlobWriter final : public datapack::BlobWriter {
  public:
   explicit ShmBlobWriter(ShmArena& arena) : arena_(arena) {}
   // Starts the next message. Its first blob in shared memory switches halves and forgets the
@@ -80,7 +53,7 @@ class ShmBlobWriter final : public BlobWriter {
   void next_message() { fresh_message_ = true; }
   // Whether the current message has put a blob in shared memory.
   bool wrote_blobs() const { return !fresh_message_; }
-  uint32_t add(engine::DataPack* dp, std::string_view bytes) override;
+  std::span<uint8_t> reserve(engine::DataPack* dp, size_t size, uint32_t* index) override;
 
  private:
   ShmArena& arena_;
@@ -89,7 +62,7 @@ class ShmBlobWriter final : public BlobWriter {
   bool fresh_message_ = true;
 };
 
-class ShmBlobReader final : public BlobReader {
+class ShmBlobReader final : public datapack::BlobReader {
  public:
   explicit ShmBlobReader(const ShmArena* arena) : arena_(arena) {}
 
@@ -99,21 +72,6 @@ class ShmBlobReader final : public BlobReader {
 
  private:
   const ShmArena* arena_;
-};
-
-// The reader and writer in force on this thread: set by whoever handles a message, used by
-// the datapack codecs (msgpack ext type 2, the camera's image_blob).
-BlobWriter& current_blob_writer();
-const BlobReader& current_blob_reader();
-
-class ScopedBlobContext {
- public:
-  ScopedBlobContext(BlobWriter* writer, const BlobReader* reader);
-  ~ScopedBlobContext();
-
- private:
-  BlobWriter* prev_writer_;
-  const BlobReader* prev_reader_;
 };
 
 }  // namespace convoy::transport

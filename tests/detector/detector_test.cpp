@@ -12,8 +12,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "convoy/datapacks.pb.h"
+#include "datapack/blobs.h"
 #include "detector_engine.h"
-#include "transport/blobs.h"
 
 namespace convoy::detector {
 namespace {
@@ -180,6 +180,9 @@ std::string bytes_of(const cv::Mat& m) {
   return std::string(reinterpret_cast<const char*>(m.data), m.total() * m.elemSize());
 }
 
+// A datapack as an engine receives it, with inline blobs.
+datapack::View in(const engine::DataPack& dp) { return {dp, datapack::inline_blob_reader()}; }
+
 bool same(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
 }
@@ -192,7 +195,7 @@ engine::DataPack camera_proto(const cv::Mat& img, bool as_blob) {
   cam.set_image_width(img.cols);
   cam.set_image_depth(img.channels());
   if (as_blob) {
-    transport::InlineBlobWriter w;
+    datapack::InlineBlobWriter w;
     cam.set_image_blob(w.add(&dp, bytes_of(img)) + 1);
   } else {
     cam.set_image_data(bytes_of(img));
@@ -225,7 +228,7 @@ engine::DataPack camera_json(const cv::Mat& img, int frame_kind) {
     b.insert(b.end(), raw.begin(), raw.end());
     j["current_image_frame"] = nlohmann::json::binary(b, 1);
   } else {
-    transport::InlineBlobWriter w;
+    datapack::InlineBlobWriter w;
     uint32_t index = w.add(&dp, raw);
     auto b = ndarray_header(img);
     for (int k = 3; k >= 0; --k) b.push_back(static_cast<uint8_t>(index >> (8 * k)));
@@ -238,18 +241,18 @@ engine::DataPack camera_json(const cv::Mat& img, int frame_kind) {
 
 TEST(ImageFromDatapack, CameraProto) {
   cv::Mat img = test_image(30, 40);
-  EXPECT_TRUE(same(image_from_datapack(camera_proto(img, false)), img));
-  EXPECT_TRUE(same(image_from_datapack(camera_proto(img, true)), img));
+  EXPECT_TRUE(same(image_from_datapack(in(camera_proto(img, false))), img));
+  EXPECT_TRUE(same(image_from_datapack(in(camera_proto(img, true))), img));
   cv::Mat grey(5, 6, CV_8UC1, cv::Scalar(9));
-  EXPECT_TRUE(same(image_from_datapack(camera_proto(grey, false)), grey));
-  EXPECT_TRUE(image_from_datapack(engine::DataPack()).empty());
+  EXPECT_TRUE(same(image_from_datapack(in(camera_proto(grey, false))), grey));
+  EXPECT_TRUE(image_from_datapack(in(engine::DataPack())).empty());
 }
 
 TEST(ImageFromDatapack, JsonListAndNumpy) {
   cv::Mat img = test_image(12, 16);
   for (int kind : {0, 1, 2}) {
     SCOPED_TRACE(kind);
-    EXPECT_TRUE(same(image_from_datapack(camera_json(img, kind)), img));
+    EXPECT_TRUE(same(image_from_datapack(in(camera_json(img, kind))), img));
   }
 }
 
@@ -260,7 +263,7 @@ TEST(ImageFromDatapack, BadSize) {
   j["c_imageWidth"] = 17;
   auto m = nlohmann::json::to_msgpack(j);
   dp.set_json_msgpack(std::string(m.begin(), m.end()));
-  EXPECT_THROW(image_from_datapack(dp), std::runtime_error);
+  EXPECT_THROW(image_from_datapack(in(dp)), std::runtime_error);
 }
 
 // --- the ONNX models of make_models.py ---------------------------------------------------
@@ -362,7 +365,10 @@ nlohmann::json detections_of(engines::DetectorEngine& e) {
   engine::DataPackId id;
   id.set_name("detections");
   engine::DataPack dp;
-  e.get_datapack(id, &dp);
+  *dp.mutable_id() = id;
+  datapack::InlineBlobWriter blobs;
+  datapack::Builder out(&dp, blobs);
+  e.get_datapack(id, out);
   if (dp.payload_case() != engine::DataPack::kJsonMsgpack) return nullptr;
   EXPECT_EQ(dp.id().type(), "json");
   return nlohmann::json::from_msgpack(dp.json_msgpack());
@@ -380,7 +386,9 @@ TEST_F(OnnxModels, EngineYoloRunsOncePerNewImage) {
   EXPECT_TRUE(detections_of(e).is_null());  // nothing yet
   e.step(10'000'000);
   EXPECT_TRUE(detections_of(e).is_null());
-  e.set_datapack(camera_json(test_image(480, 640), 2));
+  const engine::DataPack input1 = camera_json(test_image(480, 640), 2);
+
+  e.set_datapack(in(input1));
   e.step(10'000'000);
   nlohmann::json j = detections_of(e);
   ASSERT_TRUE(j.is_object());
@@ -397,15 +405,21 @@ TEST_F(OnnxModels, EngineYoloRunsOncePerNewImage) {
   e.step(10'000'000);  // no new image: same detections
   EXPECT_EQ(detections_of(e)["frame"], 1);
   EXPECT_EQ(detections_of(e)["time_ns"], 20'000'000);
-  e.set_datapack(camera_json(test_image(480, 640), 2));  // the same image again
+  const engine::DataPack input2 = camera_json(test_image(480, 640), 2);  // the same image again
+
+  e.set_datapack(in(input2));
   e.step(10'000'000);
   EXPECT_EQ(detections_of(e)["frame"], 1);  // not detected again
   cv::Mat changed = test_image(480, 640);
   changed.at<cv::Vec3b>(479, 639)[0] ^= 1;  // one pixel differs: a new image
-  e.set_datapack(camera_json(changed, 2));
+  const engine::DataPack input3 = camera_json(changed, 2);
+
+  e.set_datapack(in(input3));
   e.step(10'000'000);
   EXPECT_EQ(detections_of(e)["frame"], 2);
-  e.set_datapack(camera_proto(test_image(240, 320), true));
+  const engine::DataPack input4 = camera_proto(test_image(240, 320), true);
+
+  e.set_datapack(in(input4));
   e.step(10'000'000);
   j = detections_of(e);
   EXPECT_EQ(j["frame"], 3);
@@ -439,7 +453,7 @@ TEST(Engine, GroundTruthPassthrough) {
   dp.mutable_id()->set_name("boxes");
   auto m = nlohmann::json::to_msgpack(boxes);
   dp.set_json_msgpack(std::string(m.begin(), m.end()));
-  e.set_datapack(dp);
+  e.set_datapack(in(dp));
   e.step(1000);
   nlohmann::json j = detections_of(e);
   ASSERT_TRUE(j.is_object());
@@ -475,7 +489,9 @@ TEST(Engine, HogOnSyntheticImage) {
   // A dark upright figure: HOG may or may not fire; the engine must run and report.
   cv::rectangle(img, cv::Rect(140, 60, 40, 120), cv::Scalar(20, 20, 20), cv::FILLED);
   cv::circle(img, cv::Point(160, 45), 15, cv::Scalar(20, 20, 20), cv::FILLED);
-  e.set_datapack(camera_json(img, 1));
+  const engine::DataPack input5 = camera_json(img, 1);
+
+  e.set_datapack(in(input5));
   e.step(1000);
   nlohmann::json j = detections_of(e);
   ASSERT_TRUE(j.is_object());

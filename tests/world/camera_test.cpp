@@ -7,7 +7,7 @@
 
 #include "camera_sensors.h"
 #include "convoy/datapacks.pb.h"
-#include "transport/blobs.h"
+#include "datapack/blobs.h"
 
 namespace convoy::world {
 namespace {
@@ -19,14 +19,17 @@ struct Image {
   std::string bytes;
 };
 
+datapack::InlineBlobWriter blob_writer;
+
 Image image_of(CameraSensors& cams, size_t i) {
   engine::DataPack dp;
-  cams.image_datapack(i, &dp);
+  datapack::Builder out(&dp, blob_writer);
+  cams.image_datapack(i, out);
   data::Camera c;
   EXPECT_TRUE(c.ParseFromString(dp.proto().data()));
-  std::string bytes =
-      c.image_blob() ? std::string(transport::current_blob_reader().get(dp, c.image_blob() - 1))
-                     : c.image_data();
+  std::string bytes = c.image_blob()
+                          ? std::string(datapack::inline_blob_reader().get(dp, c.image_blob() - 1))
+                          : c.image_data();
   return {static_cast<int>(c.image_width()), static_cast<int>(c.image_height()),
           static_cast<int>(c.image_depth()), bytes};
 }
@@ -118,7 +121,8 @@ TEST_F(CameraTest, CubeLandsWhereThePinholeModelPutsIt) {
   EXPECT_NEAR(ry_max, y_max, 1);
 
   engine::DataPack dp;
-  cams_->boxes_datapack(i, &dp);
+  datapack::Builder out(&dp, blob_writer);
+  cams_->boxes_datapack(i, out);
   auto j = nlohmann::json::from_msgpack(dp.json_msgpack());
   ASSERT_EQ(j["boxes"].size(), 1u) << j.dump();
   const auto& b = j["boxes"][0];
@@ -133,12 +137,13 @@ TEST_F(CameraTest, CubeLandsWhereThePinholeModelPutsIt) {
 TEST_F(CameraTest, DepthImageGivesTheDistanceToTheCube) {
   size_t i = index_of("clean_camera");
   engine::DataPack dp;
-  cams_->depth_datapack(i, &dp);
+  datapack::Builder out(&dp, blob_writer);
+  cams_->depth_datapack(i, out);
   auto j = nlohmann::json::from_msgpack(dp.json_msgpack());
   EXPECT_EQ(j["width"], 320);
   ASSERT_TRUE(j["depth"].is_binary());
   ASSERT_EQ(dp.blobs_size(), 1);
-  std::string_view bytes = transport::current_blob_reader().get(dp, 0);
+  std::string_view bytes = datapack::inline_blob_reader().get(dp, 0);
   ASSERT_EQ(bytes.size(), 320u * 240 * 4);
   float centre;
   std::memcpy(&centre, bytes.data() + 4 * (120 * 320 + 160), 4);

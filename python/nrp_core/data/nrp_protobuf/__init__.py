@@ -8,6 +8,10 @@ The data objects answer to the report's attribute names and to NRP-Core 1.4's:
       ang_vel/angular_velocity (numpy float32)
 A camera image received in a transceiver function is a read-only view on the engine's
 frame (no copy): copy it (image_data.copy()) to change it or keep it beyond the call.
+
+Every other protobuf message registered in Convoy's datapack registry (src/datapack) has a
+datapack class here too, made on first use: `<Package><Message>DataPack` by NRP-Core's rule
+(or the name given at registration), whose .data is a message of Debian's Python protobuf.
 """
 import numpy as np
 
@@ -99,5 +103,70 @@ class GazeboLinkDataPack(DataPack):
         self._data = LinkData()
 
 
+class ProtobufDataPack(DataPack):
+    """A datapack of a registered protobuf message: .data is the message (mutable in place)."""
+
+    __slots__ = ()
+    _message = None  # the message class, set on each subclass
+
+    def __init__(self, name, engine_name):
+        DataPack.__init__(self, name, engine_name)
+        self._data = self._message()
+
+
+_classes = {}  # type name -> datapack class
+
+
+def _registry():
+    try:
+        import _convoy_datapack  # provided by the Convoy program running this Python
+    except ImportError:
+        return None
+    return _convoy_datapack
+
+
+def _message_class(type_name):
+    """The Python protobuf class of a registered message, built from Convoy's descriptors."""
+    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+    pool = descriptor_pool.Default()
+    try:
+        descriptor = pool.FindMessageTypeByName(type_name)
+    except KeyError:
+        files = descriptor_pb2.FileDescriptorSet.FromString(
+            _registry().file_descriptor_set(type_name))
+        for f in files.file:  # dependencies first
+            try:
+                pool.FindFileByName(f.name)
+            except KeyError:
+                pool.Add(f)
+        descriptor = pool.FindMessageTypeByName(type_name)
+    get_class = getattr(message_factory, "GetMessageClass", None)
+    if get_class is not None:
+        return get_class(descriptor)
+    return message_factory.MessageFactory(pool).GetPrototype(descriptor)
+
+
+def _datapack_class(type_name):
+    cls = _classes.get(type_name)
+    if cls is None:
+        registry = _registry()
+        if registry is None:
+            raise RuntimeError("protobuf datapack type %r: no Convoy datapack registry in this "
+                               "Python" % type_name)
+        cls = type(registry.python_class(type_name), (ProtobufDataPack,),
+                   {"__slots__": (), "_type": type_name, "_message": _message_class(type_name)})
+        _classes[type_name] = cls
+    return cls
+
+
+def __getattr__(name):
+    # `from nrp_core.data.nrp_protobuf import RoadUserDataPack`: any registered type's class.
+    registry = _registry()
+    type_name = registry.types().get(name) if registry is not None else None
+    if type_name is None:
+        raise AttributeError("module %r has no attribute %r" % (__name__, name))
+    return _datapack_class(type_name)
+
+
 __all__ = ["GazeboCameraDataPack", "GazeboJointDataPack", "GazeboLinkDataPack", "CameraData",
-           "JointData", "LinkData", "DataPackIdentifier"]
+           "JointData", "LinkData", "DataPackIdentifier", "ProtobufDataPack"]

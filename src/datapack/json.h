@@ -1,0 +1,34 @@
+// JSON datapacks: a JSON value as MessagePack (DataPack.json_msgpack), with numpy arrays as
+// MessagePack ext values (ndarray.h) whose large bytes sit in blobs. This is the C++ codec;
+// Python values go through python/msgpack_codec.h, which writes the same bytes.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string_view>
+
+#include "datapack/datapack.h"
+#include "datapack/ndarray.h"
+
+namespace convoy::datapack {
+
+void write_json(Builder& out, const nlohmann::json& value);
+// Throws std::runtime_error naming the datapack unless it holds a JSON value.
+nlohmann::json read_json(const View& in);
+
+// A numpy array as a JSON value (nlohmann binary with the ext type as subtype): its bytes
+// inline when small, else in a blob of `out`.
+nlohmann::json ndarray_json(Builder& out, std::string_view dtype, std::span<const uint64_t> shape,
+                            std::string_view bytes);
+
+// An array inside a JSON value read with read_json. `data` points into `value` (inline
+// bytes) or into the blob (see View for how long that stays valid).
+struct NdarrayRef {
+  NdarrayHeader header;
+  std::string_view data;
+  bool in_shm = false;
+};
+// Throws std::runtime_error unless `value` is a numpy array whose bytes match its shape.
+NdarrayRef read_ndarray(const View& in, const nlohmann::json& value);
+
+}  // namespace convoy::datapack

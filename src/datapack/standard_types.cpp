@@ -1,0 +1,14 @@
+// The protobuf datapack types every Convoy program knows. One line per type.
+#include "convoy/datapacks.pb.h"
+#include "datapack/registry.h"
+
+namespace convoy::datapack {
+
+void register_standard_types(Registry& r) {
+  // The report's tables 3.1-3.3, under NRP-Core's Python class names.
+  r.add<data::Camera>("GazeboCameraDataPack");
+  r.add<data::Joint>("GazeboJointDataPack");
+  r.add<data::Link>("GazeboLinkDataPack");
+}
+
+}  // namespace convoy::datapack
