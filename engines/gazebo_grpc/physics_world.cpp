@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <dart/collision/bullet/BulletCollisionDetector.hpp>
-#include <functional>
 #include <set>
 #include <stdexcept>
-#include <type_traits>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
 
 namespace convoy::world {
 
@@ -57,6 +59,307 @@ Eigen::AlignedBox3d transformed(const Eigen::AlignedBox3d& box, const Eigen::Iso
   return out;
 }
 
+// --- One model's skeleton ---------------------------------------------------------------
+
+// Static scenery that nothing can touch (no collision) and that carries no sensor is for the
+// cameras only: DART's per-skeleton cost would buy nothing.
+bool needs_physics(const ModelDesc& model) {
+  if (model.links.empty()) return false;
+  if (!model.is_static) return true;
+  bool needed = false;
+  for (const auto& l : model.links) needed |= !l.collisions.empty() || !l.cameras.empty();
+  return needed;
+}
+
+// A model's links and joints, indexed for the walk from its root links down its joints.
+struct LinkTree {
+  std::unordered_map<std::string, const LinkDesc*> links;                   // by name
+  std::unordered_map<std::string, std::vector<const JointDesc*>> children;  // by parent
+  std::set<std::string> has_parent;
+  std::unordered_map<std::string, const JointDesc*> to_world;  // child link -> joint to world
+};
+
+LinkTree index_links(const ModelDesc& model) {
+  LinkTree tree;
+  for (const auto& l : model.links) tree.links[l.name] = &l;
+  for (const auto& j : model.joints) {
+    if (!tree.links.count(j.child)) {
+      throw std::runtime_error("joint '" + j.name + "': unknown child link '" + j.child + "'");
+    }
+    if (j.parent == "world") {
+      tree.to_world[j.child] = &j;
+    } else {
+      if (!tree.links.count(j.parent)) {
+        throw std::runtime_error("joint '" + j.name + "': unknown parent link '" + j.parent + "'");
+      }
+      tree.children[j.parent].push_back(&j);
+    }
+    tree.has_parent.insert(j.child);
+  }
+  return tree;
+}
+
+// A revolute or prismatic joint whose limits are equal cannot move: Gazebo holds it at the
+// limit.
+bool is_locked(const JointDesc& j) {
+  return (j.type == JointDesc::kRevolute || j.type == JointDesc::kPrismatic) && !j.axes.empty() &&
+         j.axes[0].lower == j.axes[0].upper;
+}
+
+// A fixed or locked joint holds its child rigidly to its parent.
+bool is_rigid(const JointDesc& j) { return j.type == JointDesc::kFixed || is_locked(j); }
+
+// Where joint `j` holds its child's side, in the world as the SDF places the links: the joint
+// frame, turned or moved to the limit if the joint is locked.
+Eigen::Isometry3d held_pose(const JointDesc& j) {
+  Eigen::Isometry3d at = j.pose;
+  if (!is_locked(j)) return at;
+  const AxisDesc& axis = j.axes[0];
+  if (j.type == JointDesc::kRevolute)
+    at.rotate(Eigen::AngleAxisd(axis.lower, axis.xyz.normalized()));
+  else
+    at.translate(axis.lower * axis.xyz.normalized());
+  return at;
+}
+
+dd::BodyNode::Properties body_props(const LinkDesc& l) {
+  dd::BodyNode::Properties bp;
+  bp.mName = l.name;
+  bp.mInertia = dd::Inertia(l.mass, l.com, l.inertia);
+  bp.mGravityMode = l.gravity;
+  return bp;
+}
+
+// Adds the mass of link `l`, whose frame is `offset` in the body's frame, to body `bn`.
+void add_inertia(dd::BodyNode* bn, const LinkDesc& l, const Eigen::Isometry3d& offset) {
+  const dd::Inertia& host = bn->getInertia();
+  const double m1 = host.getMass(), m2 = l.mass, m = m1 + m2;
+  const Eigen::Vector3d c1 = host.getLocalCOM(), c2 = offset * l.com;
+  const Eigen::Vector3d c = m > 0 ? Eigen::Vector3d((m1 * c1 + m2 * c2) / m) : c1;
+  auto about_c = [&](double mass, const Eigen::Vector3d& at) -> Eigen::Matrix3d {
+    const Eigen::Vector3d d = at - c;  // parallel axis theorem
+    return mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  };
+  const Eigen::Matrix3d moment = host.getMoment() + about_c(m1, c1) +
+                                 offset.linear() * l.inertia * offset.linear().transpose() +
+                                 about_c(m2, c2);
+  bn->setInertia(dd::Inertia(m, c, moment));
+}
+
+// A joint of DART type J, named after SDF joint `j`, from body `parent` (nullptr: the world),
+// whose frame is `parent_world` in the world, to a new body for link `l`; `finish` completes
+// the joint's properties.
+template <typename J, typename Finish>
+std::pair<dd::Joint*, dd::BodyNode*> create_joint(dd::Skeleton& skel, dd::BodyNode* parent,
+                                                  const Eigen::Isometry3d& parent_world,
+                                                  const LinkDesc& l, const JointDesc& j,
+                                                  Finish finish) {
+  typename J::Properties p;
+  set_frames(p, j.name, parent_world, l.pose, j.pose);
+  finish(p);
+  return skel.createJointAndBodyNodePair<J>(parent, p, body_props(l));
+}
+
+// Gives each axis of `joint` the SDF joint's limits, damping, friction and effort limit.
+void set_axis_dynamics(dd::Joint* joint, const JointDesc& j) {
+  for (size_t a = 0; a < joint->getNumDofs() && a < j.axes.size(); ++a) {
+    const auto& ax = j.axes[a];
+    bool limited = j.type != JointDesc::kContinuous && ax.lower < ax.upper && ax.lower > -1e15 &&
+                   ax.upper < 1e15;
+    if (limited) {
+      joint->setPositionLowerLimit(a, ax.lower);
+      joint->setPositionUpperLimit(a, ax.upper);
+      joint->setLimitEnforcement(true);
+    }
+    joint->setDampingCoefficient(a, ax.damping);
+    joint->setCoulombFriction(a, ax.friction);
+    if (ax.effort > 0) {
+      joint->setForceLowerLimit(a, -ax.effort);
+      joint->setForceUpperLimit(a, ax.effort);
+    }
+  }
+}
+
+// A model's skeleton, and where its links and movable joints ended up.
+struct BuiltModel {
+  struct Link {
+    std::string name;
+    dd::BodyNode* body;
+    Eigen::Isometry3d offset;  // the link's frame in the body's frame
+  };
+  struct Joint {
+    std::string name;
+    dd::Joint* joint;
+  };
+  dd::SkeletonPtr skeleton;
+  std::vector<Link> links;    // in the order built
+  std::vector<Joint> joints;  // those with a degree of freedom, in the order built
+};
+
+// Builds a model's skeleton, walking from each root link down the joints: a body per link,
+// except that a link held rigidly to its parent joins the parent's body.
+class SkeletonBuilder {
+ public:
+  explicit SkeletonBuilder(const ModelDesc& model) : model_(model), tree_(index_links(model)) {
+    out_.skeleton = dd::Skeleton::create(model.name);
+  }
+
+  BuiltModel build() && {
+    for (const auto& l : model_.links) {
+      auto tw = tree_.to_world.find(l.name);
+      if (tw != tree_.to_world.end()) {
+        attach(nullptr, Eigen::Isometry3d::Identity(), l, tw->second);  // jointed to the world
+      } else if (!tree_.has_parent.count(l.name)) {
+        attach(nullptr, Eigen::Isometry3d::Identity(), l, nullptr);  // a free or welded root
+      }
+    }
+    if (model_.is_static) out_.skeleton->setMobile(false);  // DART then skips its dynamics
+    return std::move(out_);
+  }
+
+ private:
+  // Builds link `l` and the links below it. `j` joins it to body `parent`, whose frame is
+  // `parent_world` in the world as the SDF places the links (nullptr and the identity: the
+  // world); no `j`: `l` is a root link.
+  void attach(dd::BodyNode* parent, const Eigen::Isometry3d& parent_world, const LinkDesc& l,
+              const JointDesc* j) {
+    if (j && parent && is_rigid(*j)) {
+      fuse(parent, parent_world, l, *j);
+      return;
+    }
+    dd::BodyNode* body = j ? add_jointed_body(parent, parent_world, l, *j) : add_root_body(l);
+    add_shapes(body, l, Eigen::Isometry3d::Identity());
+    attach_children(l, body, l.pose);
+  }
+
+  // Builds the links below link `l`, which is part of `body`, whose frame is `body_world` in
+  // the world as the SDF places the links.
+  void attach_children(const LinkDesc& l, dd::BodyNode* body, const Eigen::Isometry3d& body_world) {
+    auto it = tree_.children.find(l.name);
+    if (it == tree_.children.end()) return;
+    for (const JointDesc* j : it->second) attach(body, body_world, *tree_.links.at(j->child), j);
+  }
+
+  // Link `l`, held rigidly by joint `j`, becomes part of its parent's body: its mass and shapes
+  // join that body, which DART steps faster than two bodies welded together.
+  void fuse(dd::BodyNode* parent, const Eigen::Isometry3d& parent_world, const LinkDesc& l,
+            const JointDesc& j) {
+    const Eigen::Isometry3d offset =
+        parent_world.inverse() * held_pose(j) * j.pose.inverse() * l.pose;
+    add_inertia(parent, l, offset);
+    add_shapes(parent, l, offset);
+    attach_children(l, parent, l.pose * offset.inverse());
+  }
+
+  // The body of root link `l`: welded to the world in a static model, on a free joint
+  // otherwise.
+  dd::BodyNode* add_root_body(const LinkDesc& l) {
+    const std::string name = model_.name + "::__root__" + l.short_name;
+    if (model_.is_static) {
+      dd::WeldJoint::Properties p;
+      set_frames(p, name, Eigen::Isometry3d::Identity(), l.pose, l.pose);
+      return out_.skeleton->createJointAndBodyNodePair<dd::WeldJoint>(nullptr, p, body_props(l))
+          .second;
+    }
+    dd::FreeJoint::Properties p;
+    p.mName = name;
+    auto [joint, body] =
+        out_.skeleton->createJointAndBodyNodePair<dd::FreeJoint>(nullptr, p, body_props(l));
+    joint->setPositions(dd::FreeJoint::convertToPositions(l.pose));
+    return body;
+  }
+
+  // The body of link `l`, hanging from `parent` by joint `j` with the SDF's axis dynamics.
+  dd::BodyNode* add_jointed_body(dd::BodyNode* parent, const Eigen::Isometry3d& parent_world,
+                                 const LinkDesc& l, const JointDesc& j) {
+    auto [joint, body] = create_typed_joint(parent, parent_world, l, j);
+    set_axis_dynamics(joint, j);
+    if (joint->getNumDofs() > 0) out_.joints.push_back({j.name, joint});
+    return body;
+  }
+
+  // The DART joint for SDF joint `j`, and the new body for link `l`.
+  std::pair<dd::Joint*, dd::BodyNode*> create_typed_joint(dd::BodyNode* parent,
+                                                          const Eigen::Isometry3d& parent_world,
+                                                          const LinkDesc& l, const JointDesc& j) {
+    dd::Skeleton& skel = *out_.skeleton;
+    const AxisDesc axis = j.axes.empty() ? AxisDesc{} : j.axes[0];
+    auto as_is = [](auto&) {};
+    auto one_axis = [&](auto& p) { p.mAxis = axis.xyz; };
+    if (is_locked(j)) {  // to the world (see attach): welded where it is held
+      return create_joint<dd::WeldJoint>(skel, parent, parent_world, l, j, [&](auto& p) {
+        p.mT_ParentBodyToJoint = parent_world.inverse() * held_pose(j);
+      });
+    }
+    switch (j.type) {
+      case JointDesc::kRevolute:
+      case JointDesc::kContinuous:
+        return create_joint<dd::RevoluteJoint>(skel, parent, parent_world, l, j, one_axis);
+      case JointDesc::kPrismatic:
+        return create_joint<dd::PrismaticJoint>(skel, parent, parent_world, l, j, one_axis);
+      case JointDesc::kFixed:
+        return create_joint<dd::WeldJoint>(skel, parent, parent_world, l, j, as_is);
+      case JointDesc::kBall:
+        return create_joint<dd::BallJoint>(skel, parent, parent_world, l, j, as_is);
+      case JointDesc::kUniversal:
+        return create_joint<dd::UniversalJoint>(skel, parent, parent_world, l, j, [&](auto& p) {
+          p.mAxis[0] = axis.xyz;
+          p.mAxis[1] = j.axes.size() > 1 ? j.axes[1].xyz : Eigen::Vector3d::UnitY();
+        });
+    }
+    throw std::logic_error("joint '" + j.name + "': unknown joint type");
+  }
+
+  // Gives body `bn` the collision shapes of link `l`, whose frame is `offset` in the body's
+  // frame, and records the link as that body and offset.
+  void add_shapes(dd::BodyNode* bn, const LinkDesc& l, const Eigen::Isometry3d& offset) {
+    for (const auto& c : l.collisions) {
+      Eigen::Isometry3d shape_offset = c.pose;
+      auto shape = make_shape(c.shape, &shape_offset);
+      auto* node = bn->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(
+          shape, l.name + "::" + c.name);
+      node->setRelativeTransform(offset * shape_offset);
+      node->getDynamicsAspect()->setFrictionCoeff(c.mu);
+    }
+    out_.links.push_back({l.name, bn, offset});
+  }
+
+  const ModelDesc& model_;
+  const LinkTree tree_;
+  BuiltModel out_;
+};
+
+// --- Static scenery and moving bodies ---------------------------------------------------
+
+// Static scenery: a static model with collisions and no infinite plane.
+bool is_scenery(const ModelDesc& model) {
+  bool has_plane = false, has_collision = false;
+  for (const auto& l : model.links) {
+    for (const auto& c : l.collisions) has_plane |= c.shape.kind == Shape::kPlane;
+    has_collision |= !l.collisions.empty();
+  }
+  return model.is_static && has_collision && !has_plane;
+}
+
+// The box holding the collision shapes of body `bn`, in the body's frame.
+Eigen::AlignedBox3d collision_box(dd::BodyNode* bn) {
+  Eigen::AlignedBox3d box;
+  for (const dd::ShapeNode* node : bn->getShapeNodesWith<dd::CollisionAspect>()) {
+    const auto& bb = node->getShape()->getBoundingBox();
+    box.extend(
+        transformed(Eigen::AlignedBox3d(bb.getMin(), bb.getMax()), node->getRelativeTransform()));
+  }
+  return box;
+}
+
+// The distance from the origin to the farthest corner of `box`.
+double farthest_corner(const Eigen::AlignedBox3d& box) {
+  double radius = 0;
+  for (int c = 0; c < 8; ++c)
+    radius = std::max(radius, box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)).norm());
+  return radius;
+}
+
 }  // namespace
 
 PhysicsWorld::PhysicsWorld(const WorldDesc& desc) {
@@ -70,224 +373,42 @@ PhysicsWorld::PhysicsWorld(const WorldDesc& desc) {
 }
 
 void PhysicsWorld::build_model(const ModelDesc& model) {
-  if (model.links.empty()) return;
-  // Static scenery that nothing can touch (no collision) and that carries no sensor is for
-  // the cameras only: DART's per-skeleton cost would buy nothing.
-  if (model.is_static) {
-    bool needed = false;
-    for (const auto& l : model.links) needed |= !l.collisions.empty() || !l.cameras.empty();
-    if (!needed) return;
-  }
-  auto skel = dd::Skeleton::create(model.name);
-  std::unordered_map<std::string, const LinkDesc*> links;
-  for (const auto& l : model.links) links[l.name] = &l;
-  std::unordered_map<std::string, std::vector<const JointDesc*>> children;  // by parent
-  std::set<std::string> has_parent;
-  std::unordered_map<std::string, const JointDesc*> to_world;  // child link -> joint to world
-  for (const auto& j : model.joints) {
-    if (!links.count(j.child)) {
-      throw std::runtime_error("joint '" + j.name + "': unknown child link '" + j.child + "'");
-    }
-    if (j.parent == "world") {
-      to_world[j.child] = &j;
-    } else {
-      if (!links.count(j.parent)) {
-        throw std::runtime_error("joint '" + j.name + "': unknown parent link '" + j.parent + "'");
-      }
-      children[j.parent].push_back(&j);
-    }
-    has_parent.insert(j.child);
-  }
+  if (!needs_physics(model)) return;
+  BuiltModel built = SkeletonBuilder(model).build();
+  for (const auto& l : built.links) add_link(l.name, l.body, l.offset);
+  for (const auto& j : built.joints) add_joint(j.name, j.joint);
+  add_skeleton(built.skeleton, model);
+}
 
-  auto body_props = [](const LinkDesc& l) {
-    dd::BodyNode::Properties bp;
-    bp.mName = l.name;
-    bp.mInertia = dd::Inertia(l.mass, l.com, l.inertia);
-    bp.mGravityMode = l.gravity;
-    return bp;
-  };
-  // Gives body `bn` the collision shapes of link `l`, whose frame is `link_offset` in the
-  // body's frame, and registers the link as that body and offset.
-  auto add_shapes = [&](dd::BodyNode* bn, const LinkDesc& l, const Eigen::Isometry3d& link_offset) {
-    for (const auto& c : l.collisions) {
-      Eigen::Isometry3d offset = c.pose;
-      auto shape = make_shape(c.shape, &offset);
-      auto* node = bn->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(
-          shape, l.name + "::" + c.name);
-      node->setRelativeTransform(link_offset * offset);
-      node->getDynamicsAspect()->setFrictionCoeff(c.mu);
-    }
-    links_.push_back({bn, link_offset, link_offset.isApprox(Eigen::Isometry3d::Identity(), 0)});
-    link_names_.push_back(l.name);
-    link_by_name_[l.name] = static_cast<int>(links_.size() - 1);
-  };
-  // Adds the mass of link `l`, whose frame is `offset` in the body's frame, to body `bn`.
-  auto add_inertia = [](dd::BodyNode* bn, const LinkDesc& l, const Eigen::Isometry3d& offset) {
-    const dd::Inertia& host = bn->getInertia();
-    const double m1 = host.getMass(), m2 = l.mass, m = m1 + m2;
-    const Eigen::Vector3d c1 = host.getLocalCOM(), c2 = offset * l.com;
-    const Eigen::Vector3d c = m > 0 ? Eigen::Vector3d((m1 * c1 + m2 * c2) / m) : c1;
-    auto about_c = [&](double mass, const Eigen::Vector3d& at) -> Eigen::Matrix3d {
-      const Eigen::Vector3d d = at - c;  // parallel axis theorem
-      return mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
-    };
-    const Eigen::Matrix3d moment = host.getMoment() + about_c(m1, c1) +
-                                   offset.linear() * l.inertia * offset.linear().transpose() +
-                                   about_c(m2, c2);
-    bn->setInertia(dd::Inertia(m, c, moment));
-  };
+void PhysicsWorld::add_link(const std::string& name, dd::BodyNode* body,
+                            const Eigen::Isometry3d& offset) {
+  links_.push_back({body, offset, offset.isApprox(Eigen::Isometry3d::Identity(), 0)});
+  link_names_.push_back(name);
+  link_by_name_[name] = static_cast<int>(links_.size() - 1);
+}
 
-  // Builds the subtree hanging from `parent_bn` through joint `j` (nullptr: a root link).
-  // `parent_world` is where the parent body's frame is in the world as the SDF places the
-  // links (the identity for the world).
-  std::function<void(dd::BodyNode*, const Eigen::Isometry3d&, const LinkDesc&, const JointDesc*)>
-      attach;
-  attach = [&](dd::BodyNode* parent_bn, const Eigen::Isometry3d& parent_world, const LinkDesc& l,
-               const JointDesc* j) {
-    auto attach_children = [&](dd::BodyNode* bn, const Eigen::Isometry3d& bn_world) {
-      auto it = children.find(l.name);
-      if (it == children.end()) return;
-      for (const JointDesc* cj : it->second) attach(bn, bn_world, *links.at(cj->child), cj);
-    };
-    // A revolute or prismatic joint whose limits are equal cannot move (Gazebo holds it at
-    // the limit). Such a joint, or a fixed one, between two links makes them one rigid body:
-    // the child's mass and shapes join the parent's body, which DART steps faster than two
-    // bodies welded together.
-    const AxisDesc axis = (!j || j->axes.empty()) ? AxisDesc{} : j->axes[0];
-    const bool locked = j &&
-                        (j->type == JointDesc::kRevolute || j->type == JointDesc::kPrismatic) &&
-                        !j->axes.empty() && axis.lower == axis.upper;
-    Eigen::Isometry3d joint_at = j ? j->pose : Eigen::Isometry3d::Identity();  // held there
-    if (locked && j->type == JointDesc::kRevolute)
-      joint_at.rotate(Eigen::AngleAxisd(axis.lower, axis.xyz.normalized()));
-    else if (locked)
-      joint_at.translate(axis.lower * axis.xyz.normalized());
-    if (j && parent_bn && (locked || j->type == JointDesc::kFixed)) {
-      const Eigen::Isometry3d offset =
-          parent_world.inverse() * joint_at * j->pose.inverse() * l.pose;
-      add_inertia(parent_bn, l, offset);
-      add_shapes(parent_bn, l, offset);
-      attach_children(parent_bn, l.pose * offset.inverse());
-      return;
-    }
-    std::pair<dd::Joint*, dd::BodyNode*> made;
-    auto bp = body_props(l);
-    if (!j) {
-      if (model.is_static) {
-        dd::WeldJoint::Properties p;
-        set_frames(p, model.name + "::__root__" + l.short_name, Eigen::Isometry3d::Identity(),
-                   l.pose, l.pose);
-        made = skel->createJointAndBodyNodePair<dd::WeldJoint>(nullptr, p, bp);
-      } else {
-        dd::FreeJoint::Properties p;
-        p.mName = model.name + "::__root__" + l.short_name;
-        made = skel->createJointAndBodyNodePair<dd::FreeJoint>(nullptr, p, bp);
-        made.first->setPositions(dd::FreeJoint::convertToPositions(l.pose));
-      }
-    } else {
-      // Joint J between the parent body and this link, its properties finished by `finish`.
-      auto joint_of = [&](auto type, auto finish) {
-        using J = typename decltype(type)::type;
-        typename J::Properties p;
-        set_frames(p, j->name, parent_world, l.pose, j->pose);
-        finish(p);
-        return skel->createJointAndBodyNodePair<J>(parent_bn, p, bp);
-      };
-      auto as_is = [](auto&) {};
-      auto one_axis = [&](auto& p) { p.mAxis = axis.xyz; };
-      if (locked) {  // to the world: welded where it is held
-        made = joint_of(std::type_identity<dd::WeldJoint>{}, [&](auto& p) {
-          p.mT_ParentBodyToJoint = parent_world.inverse() * joint_at;
-        });
-      } else {
-        switch (j->type) {
-          case JointDesc::kRevolute:
-          case JointDesc::kContinuous:
-            made = joint_of(std::type_identity<dd::RevoluteJoint>{}, one_axis);
-            break;
-          case JointDesc::kPrismatic:
-            made = joint_of(std::type_identity<dd::PrismaticJoint>{}, one_axis);
-            break;
-          case JointDesc::kFixed:
-            made = joint_of(std::type_identity<dd::WeldJoint>{}, as_is);
-            break;
-          case JointDesc::kBall:
-            made = joint_of(std::type_identity<dd::BallJoint>{}, as_is);
-            break;
-          case JointDesc::kUniversal:
-            made = joint_of(std::type_identity<dd::UniversalJoint>{}, [&](auto& p) {
-              p.mAxis[0] = axis.xyz;
-              p.mAxis[1] = j->axes.size() > 1 ? j->axes[1].xyz : Eigen::Vector3d::UnitY();
-            });
-            break;
-        }
-      }
-      dd::Joint* joint = made.first;
-      for (size_t a = 0; a < joint->getNumDofs() && a < j->axes.size(); ++a) {
-        const auto& ax = j->axes[a];
-        bool limited = j->type != JointDesc::kContinuous && ax.lower < ax.upper &&
-                       ax.lower > -1e15 && ax.upper < 1e15;
-        if (limited) {
-          joint->setPositionLowerLimit(a, ax.lower);
-          joint->setPositionUpperLimit(a, ax.upper);
-          joint->setLimitEnforcement(true);
-        }
-        joint->setDampingCoefficient(a, ax.damping);
-        joint->setCoulombFriction(a, ax.friction);
-        if (ax.effort > 0) {
-          joint->setForceLowerLimit(a, -ax.effort);
-          joint->setForceUpperLimit(a, ax.effort);
-        }
-      }
-      if (joint->getNumDofs() > 0) {
-        joints_.push_back({j->name, joint, 0});
-        joint_by_name_[j->name] = static_cast<int>(joints_.size() - 1);
-      }
-    }
-    add_shapes(made.second, l, Eigen::Isometry3d::Identity());
-    attach_children(made.second, l.pose);
-  };
+void PhysicsWorld::add_joint(const std::string& name, dd::Joint* joint) {
+  joints_.push_back({name, joint, 0});
+  joint_by_name_[name] = static_cast<int>(joints_.size() - 1);
+}
 
-  for (const auto& l : model.links) {
-    auto tw = to_world.find(l.name);
-    if (tw != to_world.end()) {
-      attach(nullptr, Eigen::Isometry3d::Identity(), l, tw->second);  // jointed to the world
-    } else if (!has_parent.count(l.name)) {
-      attach(nullptr, Eigen::Isometry3d::Identity(), l, nullptr);  // a free or welded root
-    }
-  }
-  if (model.is_static) skel->setMobile(false);  // DART then skips its dynamics
-
-  // Static scenery (static, with collisions, no infinite plane) stays out of the DART world:
-  // it has no dynamics, and DART would still visit it every step. gate_scenery() enters it
-  // into collision detection while a moving body is near.
-  bool has_plane = false, has_collision = false;
-  for (const auto& l : model.links) {
-    for (const auto& c : l.collisions) has_plane |= c.shape.kind == Shape::kPlane;
-    has_collision |= !l.collisions.empty();
-  }
-  const bool scenery = model.is_static && has_collision && !has_plane;
+void PhysicsWorld::add_skeleton(const dd::SkeletonPtr& skel, const ModelDesc& model) {
+  // Static scenery stays out of the DART world: it has no dynamics, and DART would still visit
+  // it every step. gate_scenery() enters it into collision detection while a moving body is
+  // near.
+  const bool scenery = is_scenery(model);
   if (scenery)
     scenery_.push_back({skel, {}, false});
   else
     world_->addSkeleton(skel);
   for (size_t b = 0; b < skel->getNumBodyNodes(); ++b) {
     dd::BodyNode* bn = skel->getBodyNode(b);
-    Eigen::AlignedBox3d box;  // in the body frame
-    for (const dd::ShapeNode* node : bn->getShapeNodesWith<dd::CollisionAspect>()) {
-      const auto& bb = node->getShape()->getBoundingBox();
-      box.extend(
-          transformed(Eigen::AlignedBox3d(bb.getMin(), bb.getMax()), node->getRelativeTransform()));
-    }
+    const Eigen::AlignedBox3d box = collision_box(bn);
     if (box.isEmpty()) continue;
     if (scenery) {
       scenery_.back().box.extend(transformed(box, bn->getWorldTransform()));
     } else if (!model.is_static) {
-      double radius = 0;  // the farthest corner from the body's origin
-      for (int c = 0; c < 8; ++c)
-        radius =
-            std::max(radius, box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(c)).norm());
-      moving_.push_back({bn, radius});
+      moving_.push_back({bn, farthest_corner(box)});
     }
   }
 }

@@ -57,7 +57,17 @@ class PhysicsWorld {
     dart::dynamics::Joint* joint = nullptr;
     double effort = 0;
   };
+  // Builds a model's skeleton (none for a static model with neither collisions nor cameras)
+  // and registers its links and movable joints.
   void build_model(const ModelDesc& model);
+  // Registers a link under its scoped name: part of `body`, its frame `offset` in the body's.
+  void add_link(const std::string& name, dart::dynamics::BodyNode* body,
+                const Eigen::Isometry3d& offset);
+  // Registers a joint with a degree of freedom under its scoped name.
+  void add_joint(const std::string& name, dart::dynamics::Joint* joint);
+  // Puts a model's skeleton into the DART world, or among the static scenery, and notes its
+  // moving bodies for gate_scenery().
+  void add_skeleton(const dart::dynamics::SkeletonPtr& skel, const ModelDesc& model);
   // Static scenery far from every moving body is left out of collision detection (see
   // step()); this re-decides which scenery takes part, from the moving bodies' state.
   void gate_scenery();
