@@ -8,10 +8,10 @@
 #include <ctime>
 #include <fstream>
 #include <memory>
-#include <optional>
 #include <set>
 #include <sstream>
 
+#include "app/engine_set.h"
 #include "app/run_log.h"
 #include "config/simulation_config.h"
 #include "core/clock.h"
@@ -19,7 +19,7 @@
 #include "core/interrupt.h"
 #include "loop/fti_loop.h"
 #include "python/function_runtime.h"
-#include "transport/frame_socket.h"
+#include "python/interpreter.h"
 
 namespace convoy::app {
 
@@ -68,7 +68,7 @@ fs::path make_run_dir(const RunOptions& options, const std::string& sim_name) {
 }
 
 // Checks that every function names engines that exist, and PF inputs are their own engine's.
-void check_functions(const std::vector<python::LoadedFunction>& functions,
+void check_functions(const std::vector<loop::LoadedFunction>& functions,
                      const config::SimulationConfig& cfg) {
   std::set<std::string> engines;
   std::string list;
@@ -97,76 +97,45 @@ void check_functions(const std::vector<python::LoadedFunction>& functions,
   }
 }
 
-// Engines whose next request usually comes within this time wait for it by yielding the CPU
-// rather than sleeping (EngineServer::set_spin_us): the slowest engine of a lock-step loop
-// then starts its next step without a wake-up; the others, which wait longer, sleep.
-int engine_spin_us() {
-  if (const char* s = std::getenv("CONVOY_ENGINE_SPIN_US")) return std::atoi(s);
-  return 300;
+// How a run ended: its exit code and, unless it went well, why.
+struct Outcome {
+  int code = kExitOk;
+  std::string error;
+};
+
+std::string interrupted_text() {
+  return "interrupted by signal " + std::to_string(interrupt_signal().load());
 }
 
-// Each local engine gets two arenas of this size (virtual: pages are used once written).
-size_t shm_arena_bytes() {
-  if (const char* s = std::getenv("CONVOY_SHM_MB")) return std::strtoull(s, nullptr, 10) << 20;
-  return size_t{512} << 20;
-}
-
-void launch_engine(loop::EngineHandle& handle, const config::SimulationConfig& cfg) {
-  const auto& ec = handle.config();
-  if (ec.launch_type == "EmptyLaunchCommand") {
-    if (ec.server_address.empty()) {
-      throw UserError(cfg.file.string() + ": " + ec.pointer +
-                      "/ServerAddress: EmptyLaunchCommand needs the address of the running "
-                      "engine");
-    }
-    auto channel = transport::make_grpc_channel(ec.server_address, deadline_after(10.0));
-    if (!channel) {
-      throw EngineError(ec.name, "engine '" + ec.name + "': nothing answers at ServerAddress " +
-                                     ec.server_address + " (EmptyLaunchCommand)");
-    }
-    handle.attach(std::move(channel), launch::ChildProcess());
-    return;
-  }
-  int fds[2];
-  transport::make_socket_pair(fds);
-  launch::LaunchSpec spec;
-  spec.program = ec.proc_cmd.empty() ? "convoy-engine-" + ec.type : ec.proc_cmd;
-  spec.args = ec.proc_start_params;
-  spec.args.insert(spec.args.end(),
-                   {"--convoy-fd", "3", "--convoy-spin-us", std::to_string(engine_spin_us())});
-  spec.pass_fds = {fds[1]};
-  if (size_t bytes = shm_arena_bytes(); bytes > 0) {  // CONVOY_SHM_MB=0: blobs inline
-    handle.create_arenas(bytes);
-    spec.args.insert(spec.args.end(), {"--convoy-shm-out", "4", "--convoy-shm-in", "5"});
-    spec.pass_fds.push_back(handle.out_arena_fd());
-    spec.pass_fds.push_back(handle.in_arena_fd());
-  }
-  spec.env = ec.env_params;
-  spec.env.push_back("CONVOY_RUN_DIR=" + handle.log_file().parent_path().parent_path().string());
-  spec.env.push_back("CONVOY_BIN_DIR=" + bin_dir().string());
-  spec.env.push_back("CONVOY_SHARE_DIR=" + share_dir().string());
-  spec.log_file = handle.log_file();
-  spec.working_dir = cfg.dir;
-  spec.search_dirs = {bin_dir()};
-
-  launch::ChildProcess child;
+// The exit code of a run that a step ended by throwing `thrown`.
+Outcome outcome_of(std::exception_ptr thrown) {
   try {
-    child = launch::launch(spec);
+    std::rethrow_exception(thrown);
+  } catch (const UserError& e) {
+    return {kExitUserError, e.what()};
+  } catch (const EngineError& e) {
+    // Ctrl-C while waiting for an engine: the engine did nothing wrong.
+    if (interrupted()) return {kExitInterrupted, interrupted_text()};
+    return {kExitEngineError, e.what()};
+  } catch (const FunctionError& e) {
+    return {kExitFunctionError, e.what()};
   } catch (const std::exception& e) {
-    close(fds[0]);
-    close(fds[1]);
-    throw UserError(cfg.file.string() + ": " + ec.pointer + ": engine '" + ec.name +
-                    "': " + e.what());
+    return {kExitInternal, e.what()};
   }
-  close(fds[1]);
-  handle.attach(transport::make_socket_channel(fds[0]), child);
 }
+
+// What the loop did, kept after it and the functions it ran are gone.
+struct LoopFigures {
+  bool ran = false;  // the loop was set up
+  uint64_t cycles = 0;
+  int64_t sim_time_ns = 0;
+  double wall_s = 0;  // from prime() on: start-up and shutdown not counted
+};
 
 // summary.json: what an engine or function of the run wrote there (a JSON object, e.g. an
 // experiment's own figures), with the coordinator's fields on top.
 void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
-                   const loop::FtiLoop* loop, double wall_s, double loop_wall_s, int exit_code,
-                   const std::string& error) {
+                   const LoopFigures& loop, double wall_s, const Outcome& outcome) {
   nlohmann::json j = nlohmann::json::object();
   if (std::ifstream in(file); in) {
     j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
@@ -174,168 +143,149 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   }
   j["simulation"] = cfg.name;
   j["config"] = cfg.file.string();
-  j["exit_code"] = exit_code;
-  j["error"] = error;
+  j["exit_code"] = outcome.code;
+  j["error"] = outcome.error;
   j["wall_s"] = wall_s;
-  j["cycles"] = loop ? loop->cycles() : 0;
-  const double sim_s = loop ? static_cast<double>(loop->sim_time_ns()) * 1e-9 : 0.0;
+  j["cycles"] = loop.cycles;
+  const double sim_s = static_cast<double>(loop.sim_time_ns) * 1e-9;
   j["sim_time_s"] = sim_s;
   // The loop alone, without start-up and shutdown: simulated over wall-clock time.
-  j["loop_wall_s"] = loop_wall_s;
-  j["real_time_factor"] = loop_wall_s > 0 ? sim_s / loop_wall_s : 0.0;
+  j["loop_wall_s"] = loop.wall_s;
+  j["real_time_factor"] = loop.wall_s > 0 ? sim_s / loop.wall_s : 0.0;
   std::ofstream(file) << j.dump(2) << "\n";
 }
 
-}  // namespace
-
-int run_simulation(const RunOptions& options) {
-  install_signal_handlers();
-  RunLog log;
-  log.quiet = options.quiet;
-
-  config::SimulationConfig cfg;
+// The config and the run folder. Returns kExitOk, or the exit code once it has
+// logged why the run cannot start.
+int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, fs::path* run_dir) {
   try {
-    cfg = config::load_simulation_config(fs::absolute(options.config_file), options.overrides,
-                                         share_dir());
+    *cfg = config::load_simulation_config(fs::absolute(options.config_file), options.overrides,
+                                          share_dir());
   } catch (const config::ConfigError& e) {
     log.error(e.what());
     return kExitUserError;
   }
-  fs::path run_dir;
   try {
-    run_dir = make_run_dir(options, cfg.name);
+    *run_dir = make_run_dir(options, cfg->name);
   } catch (const std::exception& e) {
     log.error(std::string("cannot create the run folder: ") + e.what());
     return kExitUserError;
   }
-  log.open(run_dir / "logs" / "coordinator.log");
-  log.info("run folder: " + run_dir.string());
-  for (const auto& w : cfg.warnings) log.info("warning: " + w);
-  std::ofstream(run_dir / "config.json") << cfg.json.dump(2) << "\n";
+  log.open(*run_dir / "logs" / "coordinator.log");
+  log.info("run folder: " + run_dir->string());
+  for (const auto& w : cfg->warnings) log.info("warning: " + w);
+  std::ofstream(*run_dir / "config.json") << cfg->json.dump(2) << "\n";
   std::error_code stale;
-  fs::remove(run_dir / "summary.json", stale);  // a reused folder's; the run writes its own
-  if (cfg.loop != "FTILoop")
-    log.info("warning: SimulationLoop " + cfg.loop + " is not available yet; running FTILoop");
-  if (cfg.datapack_processor != "tf")
-    log.info("warning: DataPackProcessor " + cfg.datapack_processor +
+  fs::remove(*run_dir / "summary.json", stale);  // a reused folder's; the run writes its own
+  if (cfg->loop != "FTILoop")
+    log.info("warning: SimulationLoop " + cfg->loop + " is not available yet; running FTILoop");
+  if (cfg->datapack_processor != "tf")
+    log.info("warning: DataPackProcessor " + cfg->datapack_processor +
              " is not available yet; running tf");
   for (const char* key :
        {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph"}) {
-    if (cfg.json.contains(key) && !cfg.json[key].empty()) {
+    if (cfg->json.contains(key) && !cfg->json[key].empty()) {
       log.info(std::string("warning: ") + key + " is not supported yet; ignored");
     }
   }
+  return kExitOk;
+}
 
-  std::vector<std::unique_ptr<loop::EngineHandle>> engines;
-  std::unique_ptr<loop::FtiLoop> fti;
-  double loop_wall = 0;
-  std::optional<SteadyClock::time_point> loop_start;
-  std::FILE* csv = nullptr;
-  auto t0 = SteadyClock::now();
-  int code = kExitOk;
-  std::string error;
-  {
-    python::Interpreter interpreter;
-    python::FunctionRuntime runtime(cfg.argument_passing == "reference");
-    std::vector<python::LoadedFunction> functions;
-    try {
-      for (const auto& f : cfg.functions) {
-        if (!f.active) continue;
-        interpreter.add_path(f.file.parent_path());
-        for (auto& fn : runtime.load(f.name, f.file)) functions.push_back(std::move(fn));
-      }
-      check_functions(functions, cfg);
-
-      for (const auto& ec : cfg.engines) {
-        engines.push_back(
-            std::make_unique<loop::EngineHandle>(ec, run_dir / "logs" / (ec.name + ".log")));
-        engines.back()->index = engines.size() - 1;
-      }
-      for (auto& e : engines) launch_engine(*e, cfg);
-      log.info("started " + std::to_string(engines.size()) + " engines");
-
-      for (auto& e : engines) {
-        engine::Request request;
-        auto* init = request.mutable_initialize();
-        init->set_engine_name(e->name());
-        init->set_config_json(e->config().json.dump());
-        init->set_timestep_ns(e->config().timestep_ns);
-        double timeout =
-            e->config().command_timeout_s > 0 ? std::max(e->config().command_timeout_s, 60.0) : 0;
-        e->start(request, "Initialize", timeout);
-      }
-      for (auto& e : engines) {
-        engine::Reply reply;
-        e->finish(&reply);
-      }
-      log.info("engines initialized in " +
-               std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) +
-               " s");
-
-      std::vector<loop::EngineHandle*> handles;
-      for (auto& e : engines) handles.push_back(e.get());
-      fti = std::make_unique<loop::FtiLoop>(handles, runtime, functions);
-      csv = std::fopen((run_dir / "steps.csv").c_str(), "w");
-      if (csv) std::setvbuf(csv, nullptr, _IOFBF, 1 << 20);
-      fti->set_step_log(csv);
-      if (!options.quiet) {
-        auto start = SteadyClock::now();
-        fti->set_progress(5.0, [&log, start, timeout = cfg.timeout_ns](int64_t sim_ns) {
-          double wall = std::chrono::duration<double>(SteadyClock::now() - start).count();
-          std::ostringstream s;
-          s.precision(1);
-          s << std::fixed << "progress: simulated " << sim_ns * 1e-9 << " s";
-          if (timeout > 0) s << " of " << timeout * 1e-9 << " s";
-          s << " (" << sim_ns * 1e-9 / wall << "x real time)";
-          log.info(s.str());
-        });
-      }
-      loop_start = SteadyClock::now();
-      fti->prime();
-      fti->run(cfg.timeout_ns);
-      if (interrupted()) {
-        code = kExitInterrupted;
-        error = "interrupted by signal " + std::to_string(interrupt_signal().load());
-      }
-    } catch (const UserError& e) {
-      code = kExitUserError;
-      error = e.what();
-    } catch (const EngineError& e) {
-      code = interrupted() ? kExitInterrupted : kExitEngineError;
-      error = interrupted() ? "interrupted by signal " + std::to_string(interrupt_signal().load())
-                            : e.what();
-    } catch (const FunctionError& e) {
-      code = kExitFunctionError;
-      error = e.what();
-    } catch (const std::exception& e) {
-      code = kExitInternal;
-      error = e.what();
-    }
-    if (loop_start)
-      loop_wall = std::chrono::duration<double>(SteadyClock::now() - *loop_start).count();
-    if (code == kExitInterrupted) {
-      log.info(error + ": shutting the engines down (Ctrl-C again to kill them)");
-      interrupt_signal().store(0);
-    } else if (code != kExitOk) {
-      log.error(error);
-    }
-    // Shut everything down, whatever happened.
-    for (auto& e : engines) {
-      std::string err = e->shutdown(code == kExitOk ? 10.0 : 3.0);
-      if (!err.empty()) {
-        log.error(err + "\n--- " + e->log_file().string() + " (last lines) ---\n" + e->log_tail());
-        if (code == kExitOk) code = kExitEngineError;
-        if (error.empty()) error = err;
-      }
-    }
-    if (csv) std::fclose(csv);
+// The active functions, before any engine starts (a broken file costs no start-up).
+std::vector<loop::LoadedFunction> load_functions(const config::SimulationConfig& cfg,
+                                                 python::Interpreter& interpreter,
+                                                 python::FunctionRuntime& runtime) {
+  std::vector<loop::LoadedFunction> functions;
+  for (const auto& f : cfg.functions) {
+    if (!f.active) continue;
+    interpreter.add_path(f.file.parent_path());
+    for (auto& fn : runtime.load(f.name, f.file)) functions.push_back(std::move(fn));
   }
-  double wall = std::chrono::duration<double>(SteadyClock::now() - t0).count();
-  write_summary(run_dir / "summary.json", cfg, fti.get(), wall, loop_wall, code, error);
-  if (fti) {
+  check_functions(functions, cfg);
+  return functions;
+}
+
+// The loop, until SimulationTimeout or an interrupt. Fills `figures` however it ends.
+void run_loop(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet, RunLog& log,
+              EngineSet& engines, loop::FunctionRunner& runner,
+              const std::vector<loop::LoadedFunction>& functions, LoopFigures* figures) {
+  loop::FtiLoop fti(engines.handles(), runner, functions);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> csv(
+      std::fopen((run_dir / "steps.csv").c_str(), "w"), &std::fclose);
+  if (csv) std::setvbuf(csv.get(), nullptr, _IOFBF, 1 << 20);
+  fti.set_step_log(csv.get());
+  if (!quiet) {
+    auto start = SteadyClock::now();
+    fti.set_progress(5.0, [&log, start, timeout = cfg.timeout_ns](int64_t sim_ns) {
+      double wall = std::chrono::duration<double>(SteadyClock::now() - start).count();
+      std::ostringstream s;
+      s.precision(1);
+      s << std::fixed << "progress: simulated " << sim_ns * 1e-9 << " s";
+      if (timeout > 0) s << " of " << timeout * 1e-9 << " s";
+      s << " (" << sim_ns * 1e-9 / wall << "x real time)";
+      log.info(s.str());
+    });
+  }
+  figures->ran = true;
+  const auto start = SteadyClock::now();
+  auto record = [&] {
+    figures->cycles = fti.cycles();
+    figures->sim_time_ns = fti.sim_time_ns();
+    figures->wall_s = std::chrono::duration<double>(SteadyClock::now() - start).count();
+  };
+  try {
+    fti.prime();
+    fti.run(cfg.timeout_ns);
+  } catch (...) {
+    record();
+    throw;
+  }
+  record();
+}
+
+// The run proper, with the interpreter up: load the functions, launch and initialize the
+// engines, run the loop; then shut the engines down, whatever happened before.
+Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet,
+                    RunLog& log, LoopFigures* figures) {
+  const auto t0 = SteadyClock::now();
+  python::Interpreter interpreter;
+  python::FunctionRuntime runtime(cfg.argument_passing == "reference");
+  EngineSet engines(cfg, run_dir / "logs");
+  Outcome outcome;
+  try {
+    std::vector<loop::LoadedFunction> functions = load_functions(cfg, interpreter, runtime);
+    engines.launch();
+    log.info("started " + std::to_string(engines.size()) + " engines");
+    engines.initialize();
+    log.info("engines initialized in " +
+             std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) + " s");
+    run_loop(cfg, run_dir, quiet, log, engines, runtime, functions, figures);
+    if (interrupted()) outcome = {kExitInterrupted, interrupted_text()};
+  } catch (...) {
+    outcome = outcome_of(std::current_exception());
+  }
+  if (outcome.code == kExitInterrupted) {
+    log.info(outcome.error + ": shutting the engines down (Ctrl-C again to kill them)");
+    interrupt_signal().store(0);
+  } else if (outcome.code != kExitOk) {
+    log.error(outcome.error);
+  }
+  std::string shutdown_error = engines.shut_down(outcome.code == kExitOk, log);
+  if (!shutdown_error.empty()) {
+    if (outcome.code == kExitOk) outcome.code = kExitEngineError;
+    if (outcome.error.empty()) outcome.error = shutdown_error;
+  }
+  return outcome;
+}
+
+// summary.json and the last lines of the log.
+void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog& log,
+            const LoopFigures& figures, double wall_s, const Outcome& outcome) {
+  write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome);
+  if (figures.ran) {
     std::ostringstream s;
-    s << "simulated " << static_cast<double>(fti->sim_time_ns()) * 1e-9 << " s in " << wall
-      << " s wall, " << fti->cycles() << " loop cycles";
+    s << "simulated " << static_cast<double>(figures.sim_time_ns) * 1e-9 << " s in " << wall_s
+      << " s wall, " << figures.cycles << " loop cycles";
     log.info(s.str());
   }
   std::string listing;
@@ -344,7 +294,24 @@ int run_simulation(const RunOptions& options) {
     if (entry.is_regular_file()) listing += "\n  " + entry.path().filename().string();
   }
   log.info("run folder: " + run_dir.string() + listing);
-  return code;
+}
+
+}  // namespace
+
+int run_simulation(const RunOptions& options) {
+  install_signal_handlers();
+  RunLog log;
+  log.quiet = options.quiet;
+  config::SimulationConfig cfg;
+  fs::path run_dir;
+  if (int code = load(options, log, &cfg, &run_dir); code != kExitOk) return code;
+
+  const auto t0 = SteadyClock::now();
+  LoopFigures figures;
+  Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures);
+  const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
+  report(cfg, run_dir, log, figures, wall_s, outcome);
+  return outcome.code;
 }
 
 }  // namespace convoy::app

@@ -24,7 +24,9 @@ class EngineHandle {
   const std::filesystem::path& log_file() const { return log_file_; }
   launch::ChildProcess& process() { return process_; }
 
-  void attach(std::unique_ptr<transport::EngineChannel> channel, launch::ChildProcess process);
+  // Connects the handle. `process` is the engine's process if the coordinator started it;
+  // without one (a remote engine, an in-process test engine) nothing is waited for or killed.
+  void attach(std::unique_ptr<transport::EngineChannel> channel, launch::ChildProcess process = {});
   // Shared-memory arenas for blobs to and from a local engine (see transport/blobs.h).
   void create_arenas(size_t bytes_each);
   int out_arena_fd() const { return out_arena_.fd(); }

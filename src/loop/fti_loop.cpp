@@ -20,9 +20,9 @@ std::string key(const std::string& engine, const std::string& name) {
 }
 }  // namespace
 
-FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& runtime,
-                 const std::vector<python::LoadedFunction>& functions)
-    : engines_(std::move(engines)), runtime_(runtime), functions_(functions) {
+FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
+                 const std::vector<LoadedFunction>& functions)
+    : engines_(std::move(engines)), runner_(runner), functions_(functions) {
   for (size_t i = 0; i < engines_.size(); ++i) {
     by_name_[engines_[i]->name()] = engines_[i];
     engines_[i]->index = i;
@@ -104,7 +104,7 @@ void FtiLoop::take_outputs(EngineHandle& e, engine::StepReply* reply) {
   }
 }
 
-void FtiLoop::route(std::vector<engine::DataPack>& outputs, const python::LoadedFunction& fn) {
+void FtiLoop::route(std::vector<engine::DataPack>& outputs, const LoadedFunction& fn) {
   for (auto& dp : outputs) {
     auto it = by_name_.find(dp.id().engine_name());
     if (it == by_name_.end()) {
@@ -117,15 +117,15 @@ void FtiLoop::route(std::vector<engine::DataPack>& outputs, const python::Loaded
 }
 
 void FtiLoop::run_functions() {
-  runtime_.begin_cycle();
+  runner_.begin_cycle();
   for (size_t i = 0; i < functions_.size(); ++i) {
     if (functions_[i].preprocessing && due_mask_[function_engine_[i]])
-      runtime_.run_preprocessing(functions_[i], source_);
+      runner_.run_preprocessing(functions_[i], source_);
   }
   for (size_t i = 0; i < functions_.size(); ++i) {
     const auto& fn = functions_[i];
     if (fn.preprocessing || !due_mask_[function_engine_[i]]) continue;
-    runtime_.run_transceiver(fn, source_, &outputs_);
+    runner_.run_transceiver(fn, source_, &outputs_);
     route(outputs_, fn);
   }
 }

@@ -15,14 +15,16 @@
 #include <vector>
 
 #include "loop/engine_handle.h"
-#include "python/function_runtime.h"
+#include "loop/function_runner.h"
 
 namespace convoy::loop {
 
 class FtiLoop {
  public:
-  FtiLoop(std::vector<EngineHandle*> engines, python::FunctionRuntime& runtime,
-          const std::vector<python::LoadedFunction>& functions);
+  // `engines` in config order; `functions` in config order, run by `runner`. All three must
+  // outlive the loop.
+  FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
+          const std::vector<LoadedFunction>& functions);
 
   // Writes one CSV row per cycle (wall times per engine) to `csv` (may be null).
   void set_step_log(std::FILE* csv);
@@ -43,7 +45,7 @@ class FtiLoop {
  private:
   void take_outputs(EngineHandle& e, engine::StepReply* reply);
   void run_functions();
-  void route(std::vector<engine::DataPack>& outputs, const python::LoadedFunction& fn);
+  void route(std::vector<engine::DataPack>& outputs, const LoadedFunction& fn);
   void write_row(int64_t cycle_wall_ns);
 
   std::vector<EngineHandle*> engines_;
@@ -51,9 +53,9 @@ class FtiLoop {
   std::vector<char> due_mask_;           // by engine index: due this cycle
   std::vector<size_t> function_engine_;  // by function: index of its engine
   std::string row_;
-  python::FunctionRuntime& runtime_;
-  const std::vector<python::LoadedFunction>& functions_;
-  python::InputSource source_;
+  FunctionRunner& runner_;
+  const std::vector<LoadedFunction>& functions_;
+  InputSource source_;
   struct Pooled {
     engine::DataPack datapack;
     uint64_t cycle = 0;  // the loop cycle it came in (prime(): 0)

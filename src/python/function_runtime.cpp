@@ -5,14 +5,10 @@
 
 namespace convoy::python {
 
-std::string LoadedFunction::label() const {
-  return std::string(preprocessing ? "preprocessing" : "transceiver") + " function '" + name +
-         "' (" + file.string() + ")";
-}
-
 std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
                                                   const std::filesystem::path& file) {
   std::vector<LoadedFunction> out;
+  std::vector<py::object> pending;  // their callables, kept once the file has loaded
   try {
     py::module_ funcs = py::module_::import("nrp_core._functions");
     py::list registered = funcs.attr("_registered");
@@ -25,7 +21,7 @@ std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
       f.file = file;
       f.preprocessing = py::isinstance(fn, pf_class);
       f.engine = fn.attr("engine_name").cast<std::string>();
-      f.callable = fn.attr("function");
+      f.runner_index = callables_.size() + out.size();
       for (auto in : py::list(fn.attr("inputs"))) {
         FunctionInput fi;
         fi.keyword = in.attr("keyword").cast<std::string>();
@@ -35,6 +31,7 @@ std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
         f.inputs.push_back(fi);
       }
       out.push_back(std::move(f));
+      pending.push_back(fn.attr("function"));
     }
     registered.attr("clear")();
   } catch (py::error_already_set& e) {
@@ -47,6 +44,7 @@ std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
                     "@PreprocessingFunction (function '" +
                     name + "')");
   }
+  for (auto& callable : pending) callables_.push_back(std::move(callable));
   return out;
 }
 
@@ -83,7 +81,7 @@ py::object FunctionRuntime::call(const LoadedFunction& fn, const InputSource& sr
   try {
     py::dict kwargs;
     for (const auto& in : fn.inputs) kwargs[py::str(in.keyword)] = input_object(in, src, fn);
-    py::object result = fn.callable(**kwargs);
+    py::object result = callables_.at(fn.runner_index)(**kwargs);
     if (!py::isinstance<py::list>(result) && !py::isinstance<py::tuple>(result)) {
       throw FunctionError(fn.label() + " returned " + std::string(Py_TYPE(result.ptr())->tp_name) +
                           "; it must return a list of datapacks");
