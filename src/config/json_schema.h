@@ -1,14 +1,14 @@
-// A small JSON Schema validator (a draft-07 subset) over nlohmann::json.
+// JSON Schema (draft 7) over nlohmann::json: valijson validates; this adds our messages and
+// what a validator does not do.
 //
-// Supported keywords: type (string or array of strings), properties, required,
-// additionalProperties (bool or schema), items (a single schema), enum, const, minimum,
-// exclusiveMinimum (numeric, draft-07 style), maximum, minLength, minItems, oneOf, anyOf,
-// $ref (a JSON pointer into the same document, e.g. "#/definitions/EngineBase") and default
-// (see fill_defaults). Any other keyword (description, title, x-convoy-*) is ignored.
+// validate() turns valijson's results into one message per problem, naming the JSON pointer,
+// the rule and the offending value ("/EngineTimestep: must be > 0, got 0"); a keyword we have
+// no words for keeps valijson's. `$ref`s must be JSON pointers into the same document
+// (e.g. "#/definitions/EngineBase").
 //
 // Unknown keys: when an object schema lists `properties` and says nothing about
-// `additionalProperties`, a key it does not list is reported as a *warning*, not an error.
-// `additionalProperties: false` makes it an error.
+// `additionalProperties`, a key it does not list is reported as a *warning*, with the closest
+// listed key as a suggestion. `additionalProperties: false` makes it an error.
 #pragma once
 
 #include <functional>
@@ -25,13 +25,14 @@ struct SchemaIssue {
 };
 
 // Validates `instance` against `schema`; `$ref`s resolve against `schema` itself.
-// Returns errors and warnings in document order. Throws std::invalid_argument for a schema
-// this validator cannot handle (bad $ref, recursion too deep).
+// Returns the errors, then the warnings. Throws std::invalid_argument for a schema that
+// cannot be used (bad $ref, recursion too deep, rejected by valijson).
 std::vector<SchemaIssue> validate(const nlohmann::json& schema, const nlohmann::json& instance);
 
 // Adds, for every object in `instance`, the properties its schema gives a `default` for and
 // that are missing, then recurses (so defaults of defaults are filled too). For oneOf/anyOf the
 // first alternative that validates is followed. Expects a valid instance.
+// `x-convoy-*` and other unknown keywords are left for callers (see visit).
 void fill_defaults(const nlohmann::json& schema, nlohmann::json& instance);
 
 // Calls `fn(pointer, subschema, value)` for every value of `instance` that `schema` describes

@@ -121,6 +121,31 @@ TEST(JsonSchema, OneOfAndAnyOf) {
                   "a number, got string \"s\"; (2) must be a boolean, got string \"s\""});
 }
 
+TEST(JsonSchema, WrongTypeGetsOneMessage) {
+  const json schema = {{"type", "string"}, {"enum", {"tf", "cg"}}, {"minLength", 1}};
+  EXPECT_EQ(issues(schema, 5), Lines{": must be a string, got number 5"});
+}
+
+TEST(JsonSchema, AlternativesAmongOtherErrors) {
+  const json schema = {
+      {"properties",
+       {{"a", {{"oneOf", {{{"required", {"x"}}}, {{"type", "string"}}}}}},
+        {"b", {{"type", "number"}}},
+        {"c", {{"items", {{"anyOf", {{{"type", "number"}}, {{"type", "null"}}}}}}}}}}};
+  EXPECT_EQ(issues(schema, {{"a", json::object()}, {"b", "x"}, {"c", {1, "y"}}}),
+            (Lines{"/a: must match exactly one of the alternatives, but matches none; (1) /a/x: "
+                   "is required; (2) must be a string, got object",
+                   "/b: must be a number, got string \"x\"",
+                   "/c/1: must match at least one of the alternatives, but matches none; (1) "
+                   "must be a number, got string \"y\"; (2) must be null, got string \"y\""}));
+}
+
+TEST(JsonSchema, OtherKeywordsKeepValijsonWords) {
+  const auto lines = issues({{"maxLength", 2}}, "abc");
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0], ": ");
+}
+
 TEST(JsonSchema, FalseSchemaRejects) {
   EXPECT_EQ(issues({{"properties", {{"a", false}}}}, {{"a", 1}}), Lines{"/a: is not allowed"});
 }
