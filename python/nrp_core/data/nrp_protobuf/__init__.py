@@ -146,6 +146,12 @@ def _message_class(type_name):
     return message_factory.MessageFactory(pool).GetPrototype(descriptor)
 
 
+def datapack_class(type_name):
+    """The datapack class of a protobuf message type, by its full name ("my_pkg.RoadUser"):
+    any type registered in Convoy, compiled into it, or read from a .proto file."""
+    return _datapack_class(type_name)
+
+
 def _datapack_class(type_name):
     cls = _classes.get(type_name)
     if cls is None:
@@ -169,4 +175,4 @@ def __getattr__(name):
 
 
 __all__ = ["GazeboCameraDataPack", "GazeboJointDataPack", "GazeboLinkDataPack", "CameraData",
-           "JointData", "LinkData", "DataPackIdentifier", "ProtobufDataPack"]
+           "JointData", "LinkData", "DataPackIdentifier", "ProtobufDataPack", "datapack_class"]
