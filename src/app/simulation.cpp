@@ -17,6 +17,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "datapack/blobs.h"
 #include "loop/fti_loop.h"
 #include "python/function_runtime.h"
 #include "python/interpreter.h"
@@ -132,6 +133,21 @@ struct LoopFigures {
   double wall_s = 0;  // from prime() on: start-up and shutdown not counted
 };
 
+// Copies of frame-sized payloads (datapack::large_copies()) made by each process of the run:
+// the coordinator's own, and each engine's, which it prints last in its log on exit.
+nlohmann::json frame_copies(const config::SimulationConfig& cfg, const fs::path& run_dir) {
+  nlohmann::json out = {{"coordinator", datapack::large_copies().copies.load()}};
+  static const std::string kTag = "frame-sized copies: ";
+  for (const auto& e : cfg.engines) {
+    std::ifstream log(run_dir / "logs" / (e.name + ".log"));
+    std::string line, last;
+    while (std::getline(log, line))
+      if (line.rfind(kTag, 0) == 0) last = line;
+    if (!last.empty()) out[e.name] = std::strtoull(last.c_str() + kTag.size(), nullptr, 10);
+  }
+  return out;
+}
+
 // summary.json: what an engine or function of the run wrote there (a JSON object, e.g. an
 // experiment's own figures), with the coordinator's fields on top.
 void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
@@ -152,6 +168,7 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   // The loop alone, without start-up and shutdown: simulated over wall-clock time.
   j["loop_wall_s"] = loop.wall_s;
   j["real_time_factor"] = loop.wall_s > 0 ? sim_s / loop.wall_s : 0.0;
+  j["frame_copies"] = frame_copies(cfg, file.parent_path());
   std::ofstream(file) << j.dump(2) << "\n";
 }
 

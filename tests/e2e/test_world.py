@@ -177,6 +177,51 @@ class WorldEngine(unittest.TestCase):
                 # noisy camera's unchanged one comes again with it.
                 self.assertTrue(all(s[1][0] for s in seen))
 
+    def test_a_frame_is_copied_twice_from_readback_to_the_detector(self):
+        # The world engine converts each frame once, straight into its outgoing shared memory;
+        # a TF relaying it (only new frames) costs the coordinator one copy into the
+        # detector's shared memory; the detector reads it in place. summary.json counts the
+        # copies of frame-sized payloads of every process.
+        ex = Experiment(self)
+        shutil.copy(os.path.join(HERE, "..", "world", "data", "camera_world.sdf"),
+                    os.path.join(ex.dir, "world.sdf"))
+        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                           "GazeboWorldFile": "world.sdf", "EngineTimestep": 0.02})
+        ex.engines.append({"EngineType": "detector", "EngineName": "det", "Backend": "hog",
+                           "EngineTimestep": 0.02})
+        ex.function("tf", textwrap.dedent("""\
+            import json, os
+            from nrp_core import *
+            from nrp_core.data.nrp_protobuf import GazeboCameraDataPack
+
+            @EngineDataPack(keyword='cam', id=DataPackIdentifier('noisy_camera::cam', 'gazebo'))
+            @EngineDataPack(keyword='dets', id=DataPackIdentifier('detections', 'det'))
+            @TransceiverFunction('det')
+            def tf(cam, dets):
+                if not dets.isEmpty():
+                    with open(os.path.join(os.path.dirname(__file__), 'frames.txt'), 'w') as f:
+                        f.write(str(dets.data['frame']))
+                if not cam.isUpdated():
+                    return []
+                with open(os.path.join(os.path.dirname(__file__), 'relays.txt'), 'a') as f:
+                    f.write('x')
+                out = GazeboCameraDataPack('camera', 'det')
+                out.data = cam.data
+                return [out]
+            """))
+        ex.run(1.0)
+        with open(os.path.join(ex.dir, "relays.txt")) as f:
+            relays = len(f.read())
+        with open(os.path.join(ex.dir, "frames.txt")) as f:
+            detected = int(f.read())
+        with open(os.path.join(ex.dir, "run", "summary.json")) as f:
+            copies = json.load(f)["frame_copies"]
+        self.assertIn(relays, (10, 11))
+        self.assertGreaterEqual(detected, relays - 1)  # the last one may come after the end
+        self.assertEqual(copies["gazebo"], relays)
+        self.assertEqual(copies["coordinator"], relays)
+        self.assertEqual(copies["det"], 0)
+
     def test_sdf_models_are_inserted_at_their_init_pose(self):
         ex = Experiment(self)
         data = os.path.join(HERE, "..", "world", "data")
