@@ -76,6 +76,11 @@ int main(int argc, char** argv) {
       t += substeps * physics.step_size();
       cameras.update(t);
       std::vector<detector::Detection> dets;
+      // The frame the co-simulated detector receives, converted from the read-back pixels
+      // (with the camera's noise) as the world engine does for its reply.
+      image.Clear();
+      datapack::Builder image_out(&image, writer);
+      cameras.image_datapack(0, image_out);
       if (truth) {
         boxes.Clear();
         datapack::Builder out(&boxes, writer);
@@ -83,9 +88,6 @@ int main(int argc, char** argv) {
         dets = detector::detections_from_boxes(
             datapack::read_json(datapack::View(boxes, datapack::inline_blob_reader())), names);
       } else {
-        image.Clear();
-        datapack::Builder out(&image, writer);
-        cameras.image_datapack(0, out);
         cv::Mat img =
             detector::image_from_datapack(datapack::View(image, datapack::inline_blob_reader()));
         dets = yolo ? yolo->detect(img) : hog->detect(img);

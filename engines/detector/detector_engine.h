@@ -84,7 +84,7 @@ class DetectorEngine final : public Engine {
   void set_datapack(const datapack::View& dp) override {
     if (dp.empty()) return;
     if (backend_->input() == detector::BackendInput::kGroundTruth) {
-      if (dp.is_json() && dp.id().name() == "boxes") {
+      if (dp.is_json()) {
         nlohmann::json j = datapack::read_json(dp);
         if (j.is_object() && j.contains("boxes")) {
           pending_boxes_ = std::move(j);

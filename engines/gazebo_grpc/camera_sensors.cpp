@@ -257,12 +257,16 @@ void CameraSensors::convert(const Camera& cam, std::span<uint8_t> dst) const {
       if (noise) r = noisy(p, 0), g = noisy(p, 1), b = noisy(p, 2);
       dst[p] = static_cast<uint8_t>((299 * r + 587 * g + 114 * b + 500) / 1000);
     }
-  } else if (!noise) {
-    render::rgba_to_rgb(src, dst.data(), pixels);
   } else {
-    uint8_t* out = dst.data();
-    for (size_t p = 0; p < pixels; ++p)
-      for (int c = 0; c < 3; ++c) out[3 * p + c] = noisy(p, c);
+    // Two passes over the destination (RGBA to RGB, then the noise), each a vectorised loop.
+    render::rgba_to_rgb(src, dst.data(), pixels);
+    if (!noise) return;
+    uint8_t* px = dst.data();
+    const size_t n = dst.size();
+    for (size_t i = 0; i < n; ++i) {
+      const int v = px[i] + noise[i];
+      px[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
+    }
   }
 }
 

@@ -467,6 +467,34 @@ TEST(Engine, GroundTruthPassthrough) {
   EXPECT_EQ(j["detections"][1]["class_id"], -1);
 }
 
+TEST(Engine, AnUnknownDatapackComesBackEmpty) {
+  engines::DetectorEngine e;
+  e.initialize("det", nlohmann::json::object(), 1000);
+  for (const char* name : {"no_such_datapack", "camera", "detections"}) {
+    engine::DataPackId id;
+    id.set_name(name);
+    engine::DataPack dp;
+    *dp.mutable_id() = id;
+    datapack::InlineBlobWriter blobs;
+    datapack::Builder out(&dp, blobs);
+    EXPECT_NO_THROW(e.get_datapack(id, out)) << name;
+    EXPECT_EQ(dp.payload_case(), engine::DataPack::PAYLOAD_NOT_SET) << name;
+  }
+}
+
+TEST(Engine, BackendsComeFromOneTable) {
+  EXPECT_EQ(detector::backend_names(), (std::vector<std::string>{"ground_truth", "hog", "yolo"}));
+  auto truth = detector::make_backend(nlohmann::json::object());
+  EXPECT_EQ(truth->input(), detector::BackendInput::kGroundTruth);
+  EXPECT_EQ(detector::make_backend({{"Backend", "hog"}})->input(), detector::BackendInput::kImage);
+  try {
+    detector::make_backend({{"Backend", "ssd"}});
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "Backend 'ssd': must be one of \"ground_truth\", \"hog\", \"yolo\"");
+  }
+}
+
 TEST(Engine, ConfigErrors) {
   engines::DetectorEngine a;
   try {
