@@ -2,9 +2,9 @@
 //
 // A datapack's payload refers to its blobs by index. Who writes a blob decides where its
 // bytes go: inline in the message (remote engines), or into a shared-memory arena between
-// the coordinator and an engine it forked (transport/shm_blobs.h). Readers and writers are
-// passed explicitly, as a BlobContext: there is no ambient (thread-local) one, so a codec
-// without a context cannot quietly fall back to a slow path.
+// the coordinator and an engine it forked (transport/blobs.h). Readers and writers are
+// passed explicitly, with the datapack (datapack.h: View, Builder): there is no ambient
+// (thread-local) one, so a codec cannot quietly fall back to a slow path.
 #pragma once
 
 #include <atomic>
@@ -54,13 +54,6 @@ class InlineBlobWriter final : public BlobWriter {
 
 // Reads inline blobs only.
 const BlobReader& inline_blob_reader();
-
-// The blob reader and writer of one message exchange: the reader for datapacks received, the
-// writer for datapacks to be sent. Either may be null where that direction is not used.
-struct BlobContext {
-  BlobWriter* writer = nullptr;
-  const BlobReader* reader = nullptr;
-};
 
 // Copies of frame-sized payloads (>= kLargeBlobBytes) made in this process: by
 // BlobWriter::add, by a frame's conversion into a reserved blob, and by a decoder that must
