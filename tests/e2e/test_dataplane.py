@@ -281,3 +281,27 @@ class RegisteredProtobufTypes(unittest.TestCase):
         self.assertGreater(last["nanos"], 0)
         self.assertEqual(last["info"], {"class": "GoogleProtobufTimestampDataPack", "generic": True,
                                         "type": "google.protobuf.Timestamp"})
+
+    def test_a_message_type_convoy_does_not_know_is_a_clear_function_error(self):
+        ex = Experiment(self)
+        ex.engine("src", STAMP_SRC)
+        ex.engine("dst", STAMP_DST)
+        ex.function("tf_unknown", textwrap.dedent("""\
+            from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+            from nrp_core import *
+            from nrp_core.data.nrp_json import *
+
+            _file = descriptor_pb2.FileDescriptorProto(name="only_in_python.proto", package="xpkg")
+            _file.message_type.add(name="Foo")
+            _pool = descriptor_pool.DescriptorPool()
+            _pool.Add(_file)
+            Foo = message_factory.MessageFactory(_pool).GetPrototype(_pool.FindMessageTypeByName("xpkg.Foo"))
+
+            @TransceiverFunction("dst")
+            def send_unknown():
+                return [JsonDataPack("stamp_in", "dst", Foo())]
+            """))
+        r = ex.run(0.05, expect=4)
+        self.assertIn("tf_unknown", r.stderr)
+        self.assertIn("datapack 'stamp_in' of engine 'dst'", r.stderr)
+        self.assertIn("xpkg.Foo", r.stderr)
