@@ -187,8 +187,9 @@ class Schema {
     // A value of the wrong type gets that one message.
     std::vector<SchemaIssue> issues;
     for (const auto& [i, wrong_type] : out) {
-      if (wrong_type || std::none_of(out.begin(), out.end(), [&](const auto& other) {
-            return other.second && other.first.pointer == i.pointer;
+      // An init-capture: clang 14 cannot capture a structured binding.
+      if (wrong_type || std::none_of(out.begin(), out.end(), [&pointer = i.pointer](const auto& o) {
+            return o.second && o.first.pointer == pointer;
           })) {
         issues.push_back(i);
       }
