@@ -15,7 +15,19 @@ namespace {
 using json = nlohmann::json;
 namespace fs = std::filesystem;
 
-std::string quote(const std::string& text) { return json(text).dump(); }
+// Never throws: bytes that are not UTF-8 (an `-o` argument can hold any) show as U+FFFD.
+std::string quote(const std::string& text) {
+  return json(text).dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+bool valid_utf8(const std::string& text) {
+  try {
+    (void)json(text).dump();
+    return true;
+  } catch (const json::type_error&) {
+    return false;
+  }
+}
 
 std::string trim(const std::string& text) {
   const auto begin = text.find_first_not_of(" \t\r\n");
@@ -217,6 +229,8 @@ void apply_override(json& config, const std::string& override_text) {
   auto fail = [&](const std::string& why) {
     throw ConfigError("override " + quote(override_text) + ": " + why);
   };
+  // Keys and string values go into the config, whose messages quote them.
+  if (!valid_utf8(override_text)) fail("not valid UTF-8");
   const auto eq = override_text.find('=');
   if (eq == std::string::npos) fail("expected Key=Value");
   std::string key = trim(override_text.substr(0, eq));

@@ -170,6 +170,15 @@ TEST_F(ConfigTest, BadOverrideSyntax) {
                        "/EngineConfigs/0/EngineName is string \"python_1\""));
 }
 
+// Found by fuzz/config: an override that is not UTF-8 threw nlohmann's type_error while its
+// error message was being made.
+TEST_F(ConfigTest, OverrideThatIsNotUtf8) {
+  const std::string bad = "SimulationName=caf\xe9";
+  EXPECT_TRUE(Contains(error(minimal(), {bad}),
+                       "override \"SimulationName=caf\xef\xbf\xbd\": not valid UTF-8"));
+  EXPECT_TRUE(Contains(error(minimal(), {"NoEquals\xc4"}), "not valid UTF-8"));
+}
+
 TEST_F(ConfigTest, MissingFile) {
   EXPECT_THROW(load_simulation_config(dir_ / "nope.json", {}, share_), ConfigError);
   try {
