@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "datapack/ndarray.h"
 #include "python/interpreter.h"
 
 using namespace pybind11::literals;
@@ -66,6 +67,36 @@ TEST_F(MsgpackCodec, UnsupportedTypeRaisesTypeError) {
 
 TEST_F(MsgpackCodec, TruncatedInputRaises) {
   EXPECT_EQ(msgpack_decode(std::string_view("\x92\x01", 2)), nullptr);
+  PyErr_Clear();
+}
+
+// An inline numpy array (MessagePack ext 8, type 1) with the given header and data bytes.
+std::string ndarray_ext(std::string_view dtype, std::vector<uint64_t> shape, std::string data) {
+  std::string body;
+  datapack::append_ndarray_header(&body, dtype, shape);
+  body += data;
+  std::string out = {'\xc7', static_cast<char>(body.size()), datapack::kNdarrayExtType};
+  return out + body;
+}
+
+// Found by fuzz/python_codec: the shape was handed to numpy.empty before it was compared with
+// the data, so a header of a few bytes allocated tens of GB.
+TEST_F(MsgpackCodec, ArrayHeaderLargerThanItsDataIsRejectedBeforeAllocating) {
+  for (std::vector<uint64_t> shape : {std::vector<uint64_t>{1u << 20, 1u << 20},
+                                      std::vector<uint64_t>{~0ull, 2}, std::vector<uint64_t>{3}}) {
+    EXPECT_EQ(msgpack_decode(ndarray_ext("<f8", shape, std::string(16, '\0'))), nullptr);
+    ASSERT_TRUE(PyErr_ExceptionMatches(PyExc_ValueError));
+    PyErr_Clear();
+  }
+  PyObject* ok = msgpack_decode(ndarray_ext("<f8", {2}, std::string(16, '\0')));
+  ASSERT_NE(ok, nullptr);
+  Py_DECREF(ok);
+}
+
+// Raw bytes must never become PyObject pointers.
+TEST_F(MsgpackCodec, ObjectArraysAreRejected) {
+  EXPECT_EQ(msgpack_decode(ndarray_ext("|O", {1}, std::string(8, '\x41'))), nullptr);
+  ASSERT_TRUE(PyErr_ExceptionMatches(PyExc_ValueError));
   PyErr_Clear();
 }
 
