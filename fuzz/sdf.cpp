@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sdf/Console.hh>
 #include <stdexcept>
 
 #include "world_description.h"
@@ -19,6 +20,7 @@ fs::path world_file;
 }
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  sdf::Console::Instance()->SetQuiet(true);  // one message per bad input otherwise
   setenv("CONVOY_MODEL_PATH", CONVOY_FUZZ_MODEL_PATH, 1);
   fs::path dir = fs::temp_directory_path() / ("convoy-fuzz-sdf-" + std::to_string(getpid()));
   fs::create_directories(dir);

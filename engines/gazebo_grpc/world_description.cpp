@@ -26,6 +26,17 @@ Eigen::Vector3d to_eigen(const ignition::math::Vector3d& v) { return {v.X(), v.Y
 
 Rgba to_rgba(const ignition::math::Color& c) { return {c.R(), c.G(), c.B(), c.A()}; }
 
+// Root::Load, with what libsdformat throws turned into an error naming the file: it throws
+// std::invalid_argument for a bad version attribute (`<sdf version="x1.7">`, through
+// ignition::math::SemanticVersion).
+sdf::Errors load_sdf(sdf::Root& root, const fs::path& file, const sdf::ParserConfig& config) {
+  try {
+    return root.Load(file.string(), config);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(file.string() + ": libsdformat cannot read it: " + e.what());
+  }
+}
+
 std::string format_errors(const sdf::Errors& errors, const fs::path& file) {
   std::ostringstream out;
   for (const auto& e : errors) {
@@ -409,7 +420,7 @@ WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& ex
   if (!fs::exists(file)) throw std::runtime_error(file.string() + ": world file not found");
   Loader loader(file);
   sdf::Root root;
-  sdf::Errors errors = root.Load(file.string(), loader.config());
+  sdf::Errors errors = load_sdf(root, file, loader.config());
   if (!errors.empty()) throw std::runtime_error(format_errors(errors, file));
   if (root.WorldCount() == 0) throw std::runtime_error(file.string() + ": no <world> in the file");
   const sdf::World* w = root.WorldByIndex(0);
@@ -462,7 +473,7 @@ WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& ex
     if (!fs::exists(mf)) throw std::runtime_error(mf.string() + ": model file not found");
     Loader model_loader(mf);
     sdf::Root mroot;
-    auto merrors = mroot.Load(mf.string(), model_loader.config());
+    auto merrors = load_sdf(mroot, mf, model_loader.config());
     if (!merrors.empty()) throw std::runtime_error(format_errors(merrors, mf));
     if (!mroot.Model()) throw std::runtime_error(mf.string() + ": no <model> in the file");
     model_loader.model(mroot.Model(), insert.pose,
