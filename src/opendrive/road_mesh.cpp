@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iterator>
 #include <sstream>
+#include <stdexcept>
 
 namespace convoy::opendrive {
 namespace {
@@ -167,8 +168,22 @@ class SectionMesher {
             continue;
           }
           if (line.length <= 0) continue;
-          for (double x = a + line.s_offset; x < b - 1e-6; x += line.length + line.space) {
-            if (x + line.length > a + 1e-6)
+          // Dashes by index, from the first that reaches `a`: adding a period of 1e-300 to x
+          // would never end, nor would walking from a sOffset of -1e300 (reduced exactly).
+          const double period = line.length + line.space;
+          const double x0 =
+              a + (line.s_offset < 0 ? std::fmod(line.s_offset, period) : line.s_offset);
+          const double k0 = std::max(0.0, std::floor((a - x0 - line.length) / period));
+          const double k1 = std::ceil((b - x0) / period);
+          if (!(k1 - k0 <= kMaxSamples)) {
+            throw std::runtime_error("road " + road_.id + ": road mark of lane " +
+                                     std::to_string(sec_.lanes[i].id) + " has too many dashes (" +
+                                     std::to_string(line.length) + " m every " +
+                                     std::to_string(period) + " m)");
+          }
+          for (double k = k0; k < k1; ++k) {
+            const double x = x0 + k * period;
+            if (x < b - 1e-6 && x + line.length > a + 1e-6)
               paint(mesh, i, line, dz, std::max(x, a), std::min(x + line.length, b));
           }
         }

@@ -71,6 +71,14 @@ void sample_legs(const Network& network, Route& route, double ds) {
     }
   }
   route.length = ell;
+  // A lane width or offset polynomial that runs away (a typo in `d`) makes the lane centre
+  // millions of metres long: refuse before allocating the points.
+  if (!std::isfinite(ell) || ell / ds > kMaxSamples) {
+    throw std::runtime_error(network.source + ": road " + route.legs.front().road_id + " lane " +
+                             std::to_string(route.legs.front().lane_id) + ": a route of " +
+                             std::to_string(ell) + " m sampled every " + std::to_string(ds) +
+                             " m has too many points (lane width or offset out of range?)");
+  }
   std::vector<double> targets;
   if (route.closed) {
     const double n = std::max(1.0, std::round(ell / ds));
@@ -142,7 +150,13 @@ std::vector<double> road_stations(const Road& road, double s0, double s1,
       step = std::min(options.max_curve_segment, std::sqrt(8 * options.chord_tolerance / kappa));
     }
     if (varies_at(road, 0.5 * (a + b))) step = std::min(step, options.max_varying_segment);
-    const int n = std::max(1, static_cast<int>(std::ceil((b - a) / step - 1e-9)));
+    const double segments = std::ceil((b - a) / step - 1e-9);
+    if (!(segments + static_cast<double>(out.size()) <= kMaxSamples)) {
+      throw std::runtime_error("road " + road.id + ": too long or too curved to sample (" +
+                               std::to_string(b - a) + " m in steps of " + std::to_string(step) +
+                               " m)");
+    }
+    const int n = std::max(1, static_cast<int>(segments));
     for (int k = 0; k < n; ++k) out.push_back(a + (b - a) * k / n);
   }
   out.push_back(s1);

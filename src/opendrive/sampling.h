@@ -11,6 +11,10 @@
 
 namespace convoy::opendrive {
 
+// Most points one road_stations or sample_* call returns; more throws std::runtime_error (a
+// hostile or mistyped file must not take all memory: 100 km at 0.05 m fit).
+inline constexpr double kMaxSamples = 2e6;
+
 struct SamplingOptions {
   double max_curve_segment = 0.5;     // m, where the reference line curves
   double max_straight_segment = 5.0;  // m, straight with linear lane widths and offsets
