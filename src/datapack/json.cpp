@@ -4,6 +4,35 @@
 
 namespace convoy::datapack {
 
+namespace {
+
+// nlohmann's DOM builder, refusing containers nested deeper than kMaxJsonDepth: its
+// MessagePack reader recurses once per level (10,000 levels, 10 KB, overflowed the stack).
+class DepthLimitedSax : public nlohmann::detail::json_sax_dom_parser<nlohmann::json> {
+ public:
+  using Base = nlohmann::detail::json_sax_dom_parser<nlohmann::json>;
+  explicit DepthLimitedSax(nlohmann::json& out) : Base(out, /*allow_exceptions=*/true) {}
+  bool start_object(std::size_t n) { return enter() && Base::start_object(n); }
+  bool end_object() { return leave() && Base::end_object(); }
+  bool start_array(std::size_t n) { return enter() && Base::start_array(n); }
+  bool end_array() { return leave() && Base::end_array(); }
+  bool too_deep() const { return too_deep_; }
+
+ private:
+  bool enter() {
+    too_deep_ = ++depth_ > kMaxJsonDepth;
+    return !too_deep_;
+  }
+  bool leave() {
+    --depth_;
+    return true;
+  }
+  int depth_ = 0;
+  bool too_deep_ = false;
+};
+
+}  // namespace
+
 std::string describe(const engine::DataPackId& id) {
   std::string s = "datapack '" + id.name() + "'";
   if (!id.engine_name().empty()) s += " of engine '" + id.engine_name() + "'";
@@ -23,11 +52,20 @@ void write_json(Builder& out, const nlohmann::json& value) {
 nlohmann::json read_json(const View& in) {
   if (!in.is_json()) throw std::runtime_error(in.describe() + " holds no JSON value");
   const std::string& raw = in.message().json_msgpack();
+  nlohmann::json value;
   try {
-    return nlohmann::json::from_msgpack(raw.begin(), raw.end());
+    DepthLimitedSax sax(value);
+    if (!nlohmann::json::sax_parse(raw.begin(), raw.end(), &sax,
+                                   nlohmann::json::input_format_t::msgpack)) {
+      throw std::runtime_error(in.describe() + ": " +
+                               (sax.too_deep() ? "MessagePack nested deeper than " +
+                                                     std::to_string(kMaxJsonDepth) + " levels"
+                                               : std::string("malformed MessagePack")));
+    }
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(in.describe() + ": malformed MessagePack (" + e.what() + ")");
   }
+  return value;
 }
 
 nlohmann::json ndarray_json(Builder& out, std::string_view dtype, std::span<const uint64_t> shape,

@@ -12,6 +12,10 @@
 
 namespace convoy::datapack {
 
+// Deepest nesting of arrays and maps a JSON datapack may have (both codecs, C++ and Python):
+// deeper data is refused rather than read recursively off the end of the stack.
+inline constexpr int kMaxJsonDepth = 200;
+
 void write_json(Builder& out, const nlohmann::json& value);
 // Throws std::runtime_error naming the datapack unless it holds a JSON value.
 nlohmann::json read_json(const View& in);

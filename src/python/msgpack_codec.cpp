@@ -4,10 +4,13 @@
 #include <cstring>
 #include <vector>
 
+#include "datapack/json.h"
 #include "datapack/ndarray.h"
 
 namespace convoy::python {
 namespace {
+
+constexpr int kMaxDepth = datapack::kMaxJsonDepth;
 
 void put_be(std::string* out, uint64_t v, int bytes) {
   for (int i = bytes - 1; i >= 0; --i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xff));
@@ -122,7 +125,7 @@ bool encode_ndarray(PyObject* obj, std::string* out, datapack::Builder* owner) {
 }
 
 bool encode(PyObject* obj, std::string* out, datapack::Builder* owner, int depth) {
-  if (depth > 200) {
+  if (depth > kMaxDepth) {
     PyErr_SetString(PyExc_ValueError, "datapack data nested too deeply (cycle?)");
     return false;
   }
@@ -335,8 +338,30 @@ class Decoder {
     p_ += n;
     return b;
   }
+  // Each item takes a byte at least: a count larger than what is left is truncated data,
+  // found before allocating for it. Nesting is bounded as in encode(), so that hostile data
+  // cannot overflow the stack.
+  bool open_container(size_t items) {
+    if (static_cast<size_t>(end_ - p_) < items) {
+      fail("truncated MessagePack data");
+      return false;
+    }
+    if (depth_ >= kMaxDepth) {
+      fail("MessagePack data nested too deeply");
+      return false;
+    }
+    ++depth_;
+    return true;
+  }
   PyObject* array(size_t n) {
-    if (!ok_) return nullptr;
+    if (!ok_ || !open_container(n)) return nullptr;
+    return close_container(array_items(n));
+  }
+  PyObject* close_container(PyObject* value) {
+    --depth_;
+    return value;
+  }
+  PyObject* array_items(size_t n) {
     PyObject* list = PyList_New(static_cast<Py_ssize_t>(n));
     if (!list) return nullptr;
     for (size_t i = 0; i < n; ++i) {
@@ -350,7 +375,10 @@ class Decoder {
     return list;
   }
   PyObject* map(size_t n) {
-    if (!ok_) return nullptr;
+    if (!ok_ || !open_container(n)) return nullptr;
+    return close_container(map_items(n));
+  }
+  PyObject* map_items(size_t n) {
     PyObject* dict = PyDict_New();
     if (!dict) return nullptr;
     for (size_t i = 0; i < n; ++i) {
@@ -383,6 +411,7 @@ class Decoder {
   const uint8_t* end_;
   const datapack::View* owner_;
   bool ok_ = true;
+  int depth_ = 0;
 };
 
 PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {

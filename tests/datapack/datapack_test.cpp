@@ -96,6 +96,30 @@ TEST(Json, MalformedAndWrongPayloadsNameTheDatapack) {
   }
 }
 
+// Found by fuzz/datapack: 10,000 nested one-item arrays (10 KB) overflowed the stack in
+// nlohmann's MessagePack reader. Nesting up to kMaxJsonDepth levels still reads.
+TEST(Json, DeepNestingIsRefusedNotOverflowingTheStack) {
+  engine::DataPack dp;
+  dp.mutable_id()->set_name("deep");
+  dp.set_json_msgpack(std::string(100'000, '\x91') + '\xc0');
+  try {
+    read_json(in(dp));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("datapack 'deep': MessagePack nested deeper than 200"),
+              std::string::npos)
+        << e.what();
+  }
+  dp.set_json_msgpack(std::string(kMaxJsonDepth, '\x91') + '\xc0');
+  nlohmann::json j = read_json(in(dp));
+  for (int i = 0; i < kMaxJsonDepth; ++i) j = nlohmann::json(j.at(0));
+  EXPECT_TRUE(j.is_null());
+  dp.set_json_msgpack(std::string(kMaxJsonDepth + 1, '\x91') + '\xc0');
+  EXPECT_THROW(read_json(in(dp)), std::runtime_error);
+  dp.set_json_msgpack("\x92\x01");  // truncated
+  EXPECT_THROW(read_json(in(dp)), std::runtime_error);
+}
+
 // A frame written into a shared-memory arena is filled in place and read in place: the only
 // copy is the writer's own fill.
 TEST(Camera, LargeFramesAreWrittenAndReadInPlaceInSharedMemory) {

@@ -93,6 +93,26 @@ TEST_F(MsgpackCodec, ArrayHeaderLargerThanItsDataIsRejectedBeforeAllocating) {
   Py_DECREF(ok);
 }
 
+// Hostile containers: nesting that would overflow the stack, counts larger than the data.
+TEST_F(MsgpackCodec, DeepNestingAndHugeCountsAreRefused) {
+  const std::string deep = std::string(100'000, '\x91') + '\xc0';
+  EXPECT_EQ(msgpack_decode(deep), nullptr);
+  ASSERT_TRUE(PyErr_ExceptionMatches(PyExc_ValueError));
+  PyErr_Clear();
+  for (std::string_view huge : {std::string_view("\xdd\xff\xff\xff\xff\xc0", 6),
+                                std::string_view("\xdf\xff\xff\xff\xff\xc0", 6)}) {
+    EXPECT_EQ(msgpack_decode(huge), nullptr);
+    ASSERT_TRUE(PyErr_ExceptionMatches(PyExc_ValueError));
+    PyErr_Clear();
+  }
+  // As deep as encode() writes (200 levels) still decodes; one more does not.
+  py::object v = py::none();
+  for (int i = 0; i < 200; ++i) v = py::list(py::make_tuple(v));
+  EXPECT_TRUE(roundtrip(v).equal(v));
+  EXPECT_EQ(msgpack_decode(std::string(201, '\x91') + '\xc0'), nullptr);
+  PyErr_Clear();
+}
+
 // Raw bytes must never become PyObject pointers.
 TEST_F(MsgpackCodec, ObjectArraysAreRejected) {
   EXPECT_EQ(msgpack_decode(ndarray_ext("|O", {1}, std::string(8, '\x41'))), nullptr);
