@@ -14,6 +14,7 @@
 #include "convoy/engine.grpc.pb.h"
 #include "core/clock.h"
 #include "core/memory.h"
+#include "core/utf8.h"
 #include "transport/blobs.h"
 #include "transport/frame_socket.h"
 
@@ -109,7 +110,9 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
         reply->set_error("empty request");
     }
   } catch (const std::exception& e) {
-    reply->set_error(e.what());
+    // `error` is a protobuf string: bytes that are not UTF-8 would make the whole reply
+    // unreadable to the coordinator, which would then report a dead engine instead.
+    reply->set_error(valid_utf8(e.what()));
     if (request.kind_case() == engine::Request::kShutdown) return false;
   }
   return true;
