@@ -4,6 +4,8 @@
 // transport::ShmBlobReader on a small arena whose offsets and sizes come from the input.
 #include "datapack/proto.h"
 
+#include <google/protobuf/stubs/logging.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -46,6 +48,9 @@ void read_all(const List& datapacks) {
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  // Parsing logs every string field that is not UTF-8: millions of lines in a run.
+  google::protobuf::SetLogHandler(
+      [](google::protobuf::LogLevel, const char*, int, const std::string&) {});
   arena = new transport::ShmArena();
   arena->create("convoy-fuzz", 4096);
   std::memset(arena->data(), 0x5a, arena->size());
