@@ -64,6 +64,11 @@ json parse_json(const std::string& text, const std::string& label) {
     }
     throw ConfigError(label + ": malformed JSON at line " + std::to_string(line) + ", column " +
                       std::to_string(column) + ": " + reason);
+  } catch (const json::out_of_range& e) {
+    // A number past double's range (5E555): nlohmann gives no position for it.
+    std::string reason = e.what();
+    if (auto at = reason.find("] "); at != std::string::npos) reason = reason.substr(at + 2);
+    throw ConfigError(label + ": malformed JSON: " + reason);
   }
 }
 

@@ -199,6 +199,17 @@ TEST_F(ConfigTest, MalformedJsonHasLineAndColumn) {
   }
 }
 
+// Found by fuzz/config: a number past double's range escaped as nlohmann's out_of_range.
+TEST_F(ConfigTest, NumberOutOfRangeIsMalformedJson) {
+  write(file(), "{\"SimulationTimeout\": 5E555}");
+  try {
+    load_simulation_config(file(), {}, share_);
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), prefix() + "malformed JSON: number overflow parsing '5E555'");
+  }
+}
+
 TEST_F(ConfigTest, WrongTypeNamesPointer) {
   json doc = minimal();
   doc["EngineConfigs"][0]["EngineTimestep"] = "abc";
