@@ -396,6 +396,16 @@ PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
   } catch (const std::exception& ex) {
     return fail(ex.what());
   }
+  // Plain data only: an object array would be built from pointers off the wire.
+  const size_t item = datapack::dtype_size(header.dtype);
+  if (item == 0) return fail("numpy array dtype is not plain data (object or structured)");
+  uint64_t count = 1;
+  for (uint64_t d : header.shape) {
+    if (d != 0 && count > UINT64_MAX / d) return fail("numpy array shape overflows");
+    count *= d;
+  }
+  if (count > UINT64_MAX / item || count * item != data.size())
+    return fail("ndarray size does not match its shape");
   PyObject* shape = PyTuple_New(static_cast<Py_ssize_t>(header.shape.size()));
   for (size_t i = 0; i < header.shape.size(); ++i)
     PyTuple_SET_ITEM(shape, static_cast<Py_ssize_t>(i),

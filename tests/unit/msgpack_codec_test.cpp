@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "datapack/ndarray.h"
 #include "python/interpreter.h"
 
 using namespace pybind11::literals;
@@ -54,6 +55,33 @@ TEST_F(MsgpackCodec, NumpyArraysKeepDtypeAndShape) {
   std::string bytes;
   ASSERT_TRUE(msgpack_encode(a.ptr(), &bytes));
   EXPECT_LT(bytes.size(), 60 * 4 + 64u);
+}
+
+// An array from the wire is plain data only: an object array's bytes would be taken as
+// pointers. A forged header whose shape does not match its bytes is refused too.
+TEST_F(MsgpackCodec, ObjectArraysAndForgedShapesAreRefused) {
+  std::string body;
+  const uint64_t shape[1] = {2};
+  datapack::append_ndarray_header(&body, "|O8", shape);
+  body.append(16, '\x41');  // two "pointers"
+  std::string bytes = "\xc7";
+  bytes.push_back(static_cast<char>(body.size()));
+  bytes.push_back(static_cast<char>(datapack::kNdarrayExtType));
+  bytes += body;
+  EXPECT_EQ(msgpack_decode(bytes), nullptr);
+  ASSERT_TRUE(PyErr_Occurred());
+  PyErr_Clear();
+
+  body.clear();
+  const uint64_t huge[2] = {uint64_t{1} << 62, 4};  // wraps to 0 elements of 8 bytes
+  datapack::append_ndarray_header(&body, "<f8", huge);
+  bytes = "\xc7";
+  bytes.push_back(static_cast<char>(body.size()));
+  bytes.push_back(static_cast<char>(datapack::kNdarrayExtType));
+  bytes += body;
+  EXPECT_EQ(msgpack_decode(bytes), nullptr);
+  ASSERT_TRUE(PyErr_Occurred());
+  PyErr_Clear();
 }
 
 TEST_F(MsgpackCodec, UnsupportedTypeRaisesTypeError) {
