@@ -9,6 +9,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "transport/frame_socket.h"
+#include "transport/grpc_security.h"
 
 namespace convoy::app {
 
@@ -56,7 +57,24 @@ void EngineSet::launch(loop::EngineHandle& handle) {
                       "/ServerAddress: EmptyLaunchCommand needs the address of the running "
                       "engine");
     }
-    auto channel = transport::make_grpc_channel(ec.server_address, deadline_after(10.0));
+    transport::ClientSecurity security;
+    security.tls = ec.server_tls;
+    security.ca_file = ec.tls_ca_file;
+    security.cert_file = ec.tls_cert_file;
+    security.key_file = ec.tls_key_file;
+    security.server_name = ec.tls_server_name;
+    security.token = ec.auth_token;
+    if (security.token.empty()) {
+      if (const char* env = std::getenv(transport::kTokenEnv)) security.token = env;
+    }
+    std::unique_ptr<transport::EngineChannel> channel;
+    try {
+      channel = transport::make_grpc_channel(ec.server_address, deadline_after(10.0), security);
+    } catch (const std::invalid_argument& e) {
+      throw UserError(cfg_.file.string() + ": " + ec.pointer + ": " + e.what());
+    } catch (const std::runtime_error& e) {
+      throw EngineError(ec.name, "engine '" + ec.name + "': " + e.what());
+    }
     if (!channel) {
       throw EngineError(ec.name, "engine '" + ec.name + "': nothing answers at ServerAddress " +
                                      ec.server_address + " (EmptyLaunchCommand)");

@@ -172,6 +172,15 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   std::ofstream(file) << j.dump(2) << "\n";
 }
 
+// The effective config as the run folder keeps it: tokens are written as "***".
+nlohmann::json redacted(nlohmann::json config) {
+  if (config.contains("EngineConfigs") && config["EngineConfigs"].is_array()) {
+    for (auto& e : config["EngineConfigs"])
+      if (e.is_object() && e.contains("AuthToken")) e["AuthToken"] = "***";
+  }
+  return config;
+}
+
 // The config and the run folder. Returns kExitOk, or the exit code once it has
 // logged why the run cannot start.
 int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, fs::path* run_dir) {
@@ -191,7 +200,7 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   log.open(*run_dir / "logs" / "coordinator.log");
   log.info("run folder: " + run_dir->string());
   for (const auto& w : cfg->warnings) log.info("warning: " + w);
-  std::ofstream(*run_dir / "config.json") << cfg->json.dump(2) << "\n";
+  std::ofstream(*run_dir / "config.json") << redacted(cfg->json).dump(2) << "\n";
   std::error_code stale;
   fs::remove(*run_dir / "summary.json", stale);  // a reused folder's; the run writes its own
   if (cfg->loop != "FTILoop")

@@ -367,7 +367,20 @@ SimulationConfig load_simulation_config(const fs::path& file,
         duration_ns(e["EngineTimestep"], engine.pointer + "/EngineTimestep", true, report);
     engine.command_timeout_s = e["EngineCommandTimeout"].get<double>();
     engine.server_address = e.value("ServerAddress", "");
+    if (e.contains("ServerTLS")) {
+      const json& tls = e["ServerTLS"];
+      engine.server_tls = true;
+      engine.tls_ca_file = tls.value("CACertificate", "");
+      engine.tls_cert_file = tls.value("ClientCertificate", "");
+      engine.tls_key_file = tls.value("ClientKey", "");
+      engine.tls_server_name = tls.value("ServerName", "");
+      if (engine.tls_cert_file.empty() != engine.tls_key_file.empty())
+        report.add(engine.pointer + "/ServerTLS",
+                   "ClientCertificate and ClientKey go together, got only one of them");
+    }
+    engine.auth_token = e.value("AuthToken", "");
     engine.json = e;
+    engine.json.erase("AuthToken");  // the engine gets its config in Initialize: not the token
     config.engines.push_back(std::move(engine));
   }
   report.throw_if_errors();

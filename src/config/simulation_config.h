@@ -33,6 +33,10 @@ struct EngineConfig {
   int64_t timestep_ns = 10'000'000;
   double command_timeout_s = 0;  // <= 0: no timeout
   std::string server_address;    // "" = none
+  // ServerTLS (an EmptyLaunchCommand engine reached over TLS) and AuthToken.
+  bool server_tls = false;
+  std::string tls_ca_file, tls_cert_file, tls_key_file, tls_server_name;
+  std::string auth_token;  // "" = none given (then $CONVOY_ENGINE_TOKEN); never logged
   std::string pointer;           // e.g. "/EngineConfigs/1", for error messages
   nlohmann::json json;           // the full engine object, defaults filled, paths absolute
 };
