@@ -47,6 +47,11 @@ void EngineServer::get(const engine::DataPackId& id, engine::DataPack* out) {
   *out->mutable_id() = id;
   datapack::Builder builder(out, *blob_writer_);
   engine_.get_datapack(id, builder);
+  if (const size_t bytes = out->ByteSizeLong(); bytes > transport::kMaxMessageBytes) {
+    throw std::length_error("datapack '" + id.name() + "' is " + std::to_string(bytes) +
+                            " bytes, more than one message may carry (" +
+                            std::to_string(transport::kMaxMessageBytes) + " bytes)");
+  }
 }
 
 void EngineServer::put(const engine::DataPack& dp) {
@@ -159,7 +164,15 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     if (writer) writer->next_message();
     bool more = handle(request, &reply);
     out.clear();
-    reply.SerializeToString(&out);
+    if (!reply.SerializeToString(&out) || out.size() > transport::kMaxMessageBytes) {
+      const size_t bytes = reply.ByteSizeLong();
+      reply.Clear();
+      reply.set_error("the reply is " + std::to_string(bytes) +
+                      " bytes, more than one message may carry (" +
+                      std::to_string(transport::kMaxMessageBytes) + " bytes)");
+      out.clear();
+      reply.SerializeToString(&out);
+    }
     if (!socket.send(out) || !more) break;
     follow(usual_work_ns, now_ns() - received);
   }
@@ -284,8 +297,8 @@ void EngineServer::serve_grpc(const std::string& address) {
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &port);
-  builder.SetMaxReceiveMessageSize(-1);
-  builder.SetMaxSendMessageSize(-1);
+  builder.SetMaxReceiveMessageSize(static_cast<int>(transport::kMaxMessageBytes));
+  builder.SetMaxSendMessageSize(static_cast<int>(transport::kMaxMessageBytes));
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || port == 0) throw std::runtime_error("cannot listen for gRPC at " + address);

@@ -5,6 +5,7 @@
 #include "convoy/engine.grpc.pb.h"
 #include "core/interrupt.h"
 #include "transport/engine_channel.h"
+#include "transport/frame_socket.h"
 
 namespace convoy::transport {
 namespace {
@@ -94,8 +95,8 @@ class GrpcChannel final : public EngineChannel {
 
 std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline) {
   grpc::ChannelArguments args;
-  args.SetMaxReceiveMessageSize(-1);
-  args.SetMaxSendMessageSize(-1);
+  args.SetMaxReceiveMessageSize(static_cast<int>(kMaxMessageBytes));
+  args.SetMaxSendMessageSize(static_cast<int>(kMaxMessageBytes));
   auto channel = grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args);
   auto wait_until =
       deadline == Deadline::max() ? SteadyClock::now() + std::chrono::seconds(60) : deadline;
