@@ -60,7 +60,10 @@ TEST(FrameSocket, OversizedFrameHeaderEndsTheStream) {
   int fds[2];
   make_socket_pair(fds);
   FrameSocket b(fds[1]);
-  const unsigned char header[4] = {0xff, 0xff, 0xff, 0xff};  // 4 GiB - 1
+  const size_t len = kMaxMessageBytes + 1;
+  const unsigned char header[4] = {
+      static_cast<unsigned char>(len), static_cast<unsigned char>(len >> 8),
+      static_cast<unsigned char>(len >> 16), static_cast<unsigned char>(len >> 24)};
   ASSERT_EQ(::write(fds[0], header, 4), 4);
   std::string got;
   EXPECT_EQ(b.recv(&got, deadline_after(2.0)), RecvStatus::kClosed);
