@@ -83,7 +83,11 @@ void EngineSet::launch(loop::EngineHandle& handle) {
     return;
   }
   int fds[2];
-  transport::make_socket_pair(fds);
+  try {
+    transport::make_socket_pair(fds);
+  } catch (const std::exception& e) {  // e.g. out of file descriptors
+    throw EngineError(ec.name, "engine '" + ec.name + "': cannot start: " + e.what());
+  }
   launch::LaunchSpec spec;
   spec.program = ec.proc_cmd.empty() ? "convoy-engine-" + ec.type : ec.proc_cmd;
   spec.args = ec.proc_start_params;
@@ -91,7 +95,14 @@ void EngineSet::launch(loop::EngineHandle& handle) {
                    {"--convoy-fd", "3", "--convoy-spin-us", std::to_string(engine_spin_us())});
   spec.pass_fds = {fds[1]};
   if (size_t bytes = shm_arena_bytes(); bytes > 0) {  // CONVOY_SHM_MB=0: blobs inline
-    handle.create_arenas(bytes);
+    try {
+      handle.create_arenas(bytes);
+    } catch (const std::exception& e) {
+      close(fds[0]);
+      close(fds[1]);
+      throw EngineError(
+          ec.name, "engine '" + ec.name + "': cannot create its shared-memory arenas: " + e.what());
+    }
     spec.args.insert(spec.args.end(), {"--convoy-shm-out", "4", "--convoy-shm-in", "5"});
     spec.pass_fds.push_back(handle.out_arena_fd());
     spec.pass_fds.push_back(handle.in_arena_fd());

@@ -1,8 +1,10 @@
 #include "app/simulation.h"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <ctime>
@@ -42,6 +44,18 @@ namespace {
 void on_signal(int sig) {
   if (interrupted()) _exit(kExitInterrupted);  // second Ctrl-C: give up at once
   interrupt_signal().store(sig);
+}
+
+// Each forked engine holds three of the coordinator's file descriptors (its socket and two
+// arenas): with the usual soft limit of 1024, some 300 engines would exhaust them, well below
+// config::kMaxEngines.
+void raise_file_limit() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0 ||
+      limit.rlim_cur >= std::min<rlim_t>(limit.rlim_max, 65536))
+    return;
+  limit.rlim_cur = std::min<rlim_t>(limit.rlim_max, 65536);
+  setrlimit(RLIMIT_NOFILE, &limit);
 }
 
 void install_signal_handlers() {
@@ -326,6 +340,7 @@ void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog
 
 int run_simulation(const RunOptions& options) {
   install_signal_handlers();
+  raise_file_limit();
   RunLog log;
   log.quiet = options.quiet;
   config::SimulationConfig cfg;

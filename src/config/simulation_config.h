@@ -12,6 +12,7 @@
 //   simulation_config.json: /EngineConfigs/2/EngineTimestep: must be > 0, got 0
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -63,6 +64,22 @@ struct SimulationConfig {
   nlohmann::json json;                // whole config after overrides, defaults, path resolution
   std::vector<std::string> warnings;  // e.g. unknown keys, same format as errors
 };
+
+// Limits on hostile or mistaken input, checked before the config is used.
+// A config file larger than this is refused before it is read.
+constexpr size_t kMaxConfigBytes = size_t{64} << 20;
+// More engines than this are refused at load (each is a process with two shared-memory
+// arenas and a socket; realistic experiments have a handful).
+constexpr size_t kMaxEngines = 1024;
+// Names that become part of a file name (logs/<EngineName>.log, the run folder
+// <SimulationName>-<date>-<time>-<pid>) are at most this long, so that the file name stays
+// under the usual 255-byte limit.
+constexpr size_t kMaxNameBytes = 200;
+
+// Why `name` cannot be part of a file name inside the run folder, or "" if it can: it must not
+// be empty, longer than kMaxNameBytes, contain '/', '\\', "..", NUL or other control
+// characters. Anything else (spaces, non-ASCII) is allowed, as in NRP-Core.
+std::string name_problem(const std::string& name);
 
 // A user mistake in the config; what() holds one line per problem.
 class ConfigError : public std::runtime_error {

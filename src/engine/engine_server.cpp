@@ -48,6 +48,11 @@ void EngineServer::get(const engine::DataPackId& id, engine::DataPack* out) {
   *out->mutable_id() = id;
   datapack::Builder builder(out, *blob_writer_);
   engine_.get_datapack(id, builder);
+  if (const size_t bytes = out->ByteSizeLong(); bytes > transport::kMaxMessageBytes) {
+    throw std::length_error("datapack '" + id.name() + "' is " + std::to_string(bytes) +
+                            " bytes, more than one message may carry (" +
+                            std::to_string(transport::kMaxMessageBytes) + " bytes)");
+  }
 }
 
 void EngineServer::put(const engine::DataPack& dp) {
@@ -160,7 +165,15 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     if (writer) writer->next_message();
     bool more = handle(request, &reply);
     out.clear();
-    reply.SerializeToString(&out);
+    if (!reply.SerializeToString(&out) || out.size() > transport::kMaxMessageBytes) {
+      const size_t bytes = reply.ByteSizeLong();
+      reply.Clear();
+      reply.set_error("the reply is " + std::to_string(bytes) +
+                      " bytes, more than one message may carry (" +
+                      std::to_string(transport::kMaxMessageBytes) + " bytes)");
+      out.clear();
+      reply.SerializeToString(&out);
+    }
     if (!socket.send(out) || !more) break;
     follow(usual_work_ns, now_ns() - received);
   }
@@ -270,8 +283,9 @@ class GrpcService final : public engine::Engine::Service {
     if (!token_.empty()) {
       const auto& meta = context->client_metadata();
       auto it = meta.find(transport::kTokenMetadataKey);
-      const std::string_view given =
-          it == meta.end() ? std::string_view() : std::string_view(it->second.data(), it->second.size());
+      const std::string_view given = it == meta.end()
+                                         ? std::string_view()
+                                         : std::string_view(it->second.data(), it->second.size());
       if (!transport::same_token(token_, given)) {
         std::fprintf(stderr, "refused a call from %s: %s token\n", context->peer().c_str(),
                      it == meta.end() ? "no" : "wrong");
@@ -301,8 +315,8 @@ void EngineServer::serve_grpc(const std::string& address,
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort(address, transport::server_credentials(security), &port);
-  builder.SetMaxReceiveMessageSize(-1);
-  builder.SetMaxSendMessageSize(-1);
+  builder.SetMaxReceiveMessageSize(static_cast<int>(transport::kMaxMessageBytes));
+  builder.SetMaxSendMessageSize(static_cast<int>(transport::kMaxMessageBytes));
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || port == 0) throw std::runtime_error("cannot listen for gRPC at " + address);

@@ -17,7 +17,8 @@ enum class CallStatus { kOk, kClosed, kTimeout, kInterrupted };
 class EngineChannel {
  public:
   virtual ~EngineChannel() = default;
-  // Starts a call. At most one call is in flight per channel.
+  // Starts a call. At most one call is in flight per channel. Throws std::length_error, and
+  // sends nothing, when the request is larger than a message may be (kMaxMessageBytes).
   virtual void start(const engine::Request& request, Deadline deadline) = 0;
   // Waits for the reply of the call in flight, until the deadline given to start() or
   // `limit`, whichever comes first.

@@ -1,5 +1,4 @@
 #include <grpcpp/grpcpp.h>
-
 #include <netdb.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -11,6 +10,7 @@
 #include "convoy/engine.grpc.pb.h"
 #include "core/interrupt.h"
 #include "transport/engine_channel.h"
+#include "transport/frame_socket.h"
 #include "transport/grpc_security.h"
 
 namespace convoy::transport {
@@ -147,8 +147,8 @@ std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Dea
 std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline,
                                                  const ClientSecurity& security) {
   grpc::ChannelArguments args;
-  args.SetMaxReceiveMessageSize(-1);
-  args.SetMaxSendMessageSize(-1);
+  args.SetMaxReceiveMessageSize(static_cast<int>(kMaxMessageBytes));
+  args.SetMaxSendMessageSize(static_cast<int>(kMaxMessageBytes));
   if (security.tls && !security.server_name.empty())
     args.SetSslTargetNameOverride(security.server_name);
   auto channel = grpc::CreateCustomChannel(address, channel_credentials(security), args);
