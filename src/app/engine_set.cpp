@@ -9,6 +9,7 @@
 #include "core/clock.h"
 #include "core/error.h"
 #include "transport/frame_socket.h"
+#include "transport/grpc_security.h"
 
 namespace convoy::app {
 
@@ -56,7 +57,24 @@ void EngineSet::launch(loop::EngineHandle& handle) {
                       "/ServerAddress: EmptyLaunchCommand needs the address of the running "
                       "engine");
     }
-    auto channel = transport::make_grpc_channel(ec.server_address, deadline_after(10.0));
+    transport::ClientSecurity security;
+    security.tls = ec.server_tls;
+    security.ca_file = ec.tls_ca_file;
+    security.cert_file = ec.tls_cert_file;
+    security.key_file = ec.tls_key_file;
+    security.server_name = ec.tls_server_name;
+    security.token = ec.auth_token;
+    if (security.token.empty()) {
+      if (const char* env = std::getenv(transport::kTokenEnv)) security.token = env;
+    }
+    std::unique_ptr<transport::EngineChannel> channel;
+    try {
+      channel = transport::make_grpc_channel(ec.server_address, deadline_after(10.0), security);
+    } catch (const std::invalid_argument& e) {
+      throw UserError(cfg_.file.string() + ": " + ec.pointer + ": " + e.what());
+    } catch (const std::runtime_error& e) {
+      throw EngineError(ec.name, "engine '" + ec.name + "': " + e.what());
+    }
     if (!channel) {
       throw EngineError(ec.name, "engine '" + ec.name + "': nothing answers at ServerAddress " +
                                      ec.server_address + " (EmptyLaunchCommand)");
@@ -65,7 +83,11 @@ void EngineSet::launch(loop::EngineHandle& handle) {
     return;
   }
   int fds[2];
-  transport::make_socket_pair(fds);
+  try {
+    transport::make_socket_pair(fds);
+  } catch (const std::exception& e) {  // e.g. out of file descriptors
+    throw EngineError(ec.name, "engine '" + ec.name + "': cannot start: " + e.what());
+  }
   launch::LaunchSpec spec;
   spec.program = ec.proc_cmd.empty() ? "convoy-engine-" + ec.type : ec.proc_cmd;
   spec.args = ec.proc_start_params;
@@ -73,7 +95,14 @@ void EngineSet::launch(loop::EngineHandle& handle) {
                    {"--convoy-fd", "3", "--convoy-spin-us", std::to_string(engine_spin_us())});
   spec.pass_fds = {fds[1]};
   if (size_t bytes = shm_arena_bytes(); bytes > 0) {  // CONVOY_SHM_MB=0: blobs inline
-    handle.create_arenas(bytes);
+    try {
+      handle.create_arenas(bytes);
+    } catch (const std::exception& e) {
+      close(fds[0]);
+      close(fds[1]);
+      throw EngineError(
+          ec.name, "engine '" + ec.name + "': cannot create its shared-memory arenas: " + e.what());
+    }
     spec.args.insert(spec.args.end(), {"--convoy-shm-out", "4", "--convoy-shm-in", "5"});
     spec.pass_fds.push_back(handle.out_arena_fd());
     spec.pass_fds.push_back(handle.in_arena_fd());

@@ -1,8 +1,10 @@
 #include "app/simulation.h"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <ctime>
@@ -42,6 +44,18 @@ namespace {
 void on_signal(int sig) {
   if (interrupted()) _exit(kExitInterrupted);  // second Ctrl-C: give up at once
   interrupt_signal().store(sig);
+}
+
+// Each forked engine holds three of the coordinator's file descriptors (its socket and two
+// arenas): with the usual soft limit of 1024, some 300 engines would exhaust them, well below
+// config::kMaxEngines.
+void raise_file_limit() {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0 ||
+      limit.rlim_cur >= std::min<rlim_t>(limit.rlim_max, 65536))
+    return;
+  limit.rlim_cur = std::min<rlim_t>(limit.rlim_max, 65536);
+  setrlimit(RLIMIT_NOFILE, &limit);
 }
 
 void install_signal_handlers() {
@@ -172,6 +186,15 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   std::ofstream(file) << j.dump(2) << "\n";
 }
 
+// The effective config as the run folder keeps it: tokens are written as "***".
+nlohmann::json redacted(nlohmann::json config) {
+  if (config.contains("EngineConfigs") && config["EngineConfigs"].is_array()) {
+    for (auto& e : config["EngineConfigs"])
+      if (e.is_object() && e.contains("AuthToken")) e["AuthToken"] = "***";
+  }
+  return config;
+}
+
 // The config and the run folder. Returns kExitOk, or the exit code once it has
 // logged why the run cannot start.
 int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, fs::path* run_dir) {
@@ -191,7 +214,7 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   log.open(*run_dir / "logs" / "coordinator.log");
   log.info("run folder: " + run_dir->string());
   for (const auto& w : cfg->warnings) log.info("warning: " + w);
-  std::ofstream(*run_dir / "config.json") << cfg->json.dump(2) << "\n";
+  std::ofstream(*run_dir / "config.json") << redacted(cfg->json).dump(2) << "\n";
   std::error_code stale;
   fs::remove(*run_dir / "summary.json", stale);  // a reused folder's; the run writes its own
   if (cfg->loop != "FTILoop")
@@ -317,6 +340,7 @@ void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog
 
 int run_simulation(const RunOptions& options) {
   install_signal_handlers();
+  raise_file_limit();
   RunLog log;
   log.quiet = options.quiet;
   config::SimulationConfig cfg;

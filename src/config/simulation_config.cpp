@@ -35,15 +35,29 @@ std::string trim(const std::string& text) {
   return text.substr(begin, text.find_last_not_of(" \t\r\n") - begin + 1);
 }
 
+// The whole file, refused when larger than kMaxConfigBytes: a regular file by its size before
+// anything is read, anything else (a pipe, a device) once one byte past the limit is read.
 std::string read_text(const fs::path& path, const std::string& label) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw ConfigError(label + ": cannot open (is a directory)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(label + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
+  auto too_large = [&](const std::string& size) {
+    return ConfigError(label + ": too large (" + size + "; the limit for a config file is " +
+                       std::to_string(kMaxConfigBytes >> 20) + " MiB)");
+  };
+  if (const uintmax_t size = fs::file_size(path, ec); !ec && size > kMaxConfigBytes) {
+    throw too_large(std::to_string(size) + " bytes");
+  }
+  std::string text;
+  char chunk[1 << 16];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    text.append(chunk, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxConfigBytes)
+      throw too_large("more than " + std::to_string(kMaxConfigBytes) + " bytes");
+  }
   if (in.bad()) throw ConfigError(label + ": cannot read");
-  return text.str();
+  return text;
 }
 
 json parse_json(const std::string& text, const std::string& label) {
@@ -230,6 +244,23 @@ int64_t seconds_to_ns(double seconds) {
   return std::llround(ns);
 }
 
+std::string name_problem(const std::string& name) {
+  const std::string why = " (it becomes part of a file name in the run folder)";
+  if (name.empty()) return "must not be empty" + why;
+  if (name.size() > kMaxNameBytes) {
+    return "must be at most " + std::to_string(kMaxNameBytes) + " bytes long" + why + ", got " +
+           std::to_string(name.size()) + " bytes";
+  }
+  if (name.find_first_of("/\\") != std::string::npos || name.find("..") != std::string::npos) {
+    return "must not contain '/', '\\' or '..'" + why + ", got " + quote(name);
+  }
+  if (std::any_of(name.begin(), name.end(),
+                  [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; })) {
+    return "must not contain NUL or other control characters" + why + ", got " + quote(name);
+  }
+  return "";
+}
+
 void apply_override(json& config, const std::string& override_text) {
   auto fail = [&](const std::string& why) {
     throw ConfigError("override " + quote(override_text) + ": " + why);
@@ -304,6 +335,14 @@ SimulationConfig load_simulation_config(const fs::path& file,
     }
   }
 
+  // Refused before anything else: validating (and later starting) them all would take long.
+  if (doc.is_object() && doc.contains("EngineConfigs") && doc["EngineConfigs"].is_array() &&
+      doc["EngineConfigs"].size() > kMaxEngines) {
+    throw ConfigError(report.label +
+                      ": /EngineConfigs: " + std::to_string(doc["EngineConfigs"].size()) +
+                      " engines, more than the limit of " + std::to_string(kMaxEngines));
+  }
+
   // The top level is checked with engines as plain objects; each engine is then checked
   // against EngineBase merged with its own type's schema.
   const json schema = load_simulation_schema(share_dir);
@@ -359,7 +398,22 @@ SimulationConfig load_simulation_config(const fs::path& file,
     visit(engine_schemas[i], engines[i], resolve_paths("/EngineConfigs/" + std::to_string(i)));
   }
 
-  // Checks the schemas cannot express.
+  // Checks the schemas cannot express. Names become file names in the run folder.
+  auto check_name = [&](const std::string& pointer, const json& value) {
+    if (std::string problem = name_problem(value.get<std::string>()); !problem.empty()) {
+      report.add(pointer, problem);
+    }
+  };
+  check_name("/SimulationName", doc["SimulationName"]);
+  for (size_t i = 0; i < engines.size(); ++i) {
+    check_name("/EngineConfigs/" + std::to_string(i) + "/EngineName", engines[i]["EngineName"]);
+  }
+  for (size_t i = 0; i < doc["DataPackProcessingFunctions"].size(); ++i) {
+    check_name("/DataPackProcessingFunctions/" + std::to_string(i) + "/Name",
+               doc["DataPackProcessingFunctions"][i]["Name"]);
+  }
+  if (doc.contains("StatusFunction"))
+    check_name("/StatusFunction/Name", doc["StatusFunction"]["Name"]);
   check_unique(engines, "/EngineConfigs", "EngineName", "engine", report);
   check_unique(doc["DataPackProcessingFunctions"], "/DataPackProcessingFunctions", "Name",
                "function", report);
@@ -386,7 +440,20 @@ SimulationConfig load_simulation_config(const fs::path& file,
         duration_ns(e["EngineTimestep"], engine.pointer + "/EngineTimestep", true, report);
     engine.command_timeout_s = e["EngineCommandTimeout"].get<double>();
     engine.server_address = e.value("ServerAddress", "");
+    if (e.contains("ServerTLS")) {
+      const json& tls = e["ServerTLS"];
+      engine.server_tls = true;
+      engine.tls_ca_file = tls.value("CACertificate", "");
+      engine.tls_cert_file = tls.value("ClientCertificate", "");
+      engine.tls_key_file = tls.value("ClientKey", "");
+      engine.tls_server_name = tls.value("ServerName", "");
+      if (engine.tls_cert_file.empty() != engine.tls_key_file.empty())
+        report.add(engine.pointer + "/ServerTLS",
+                   "ClientCertificate and ClientKey go together, got only one of them");
+    }
+    engine.auth_token = e.value("AuthToken", "");
     engine.json = e;
+    engine.json.erase("AuthToken");  // the engine gets its config in Initialize: not the token
     config.engines.push_back(std::move(engine));
   }
   report.throw_if_errors();

@@ -12,6 +12,7 @@
 //   simulation_config.json: /EngineConfigs/2/EngineTimestep: must be > 0, got 0
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -33,6 +34,10 @@ struct EngineConfig {
   int64_t timestep_ns = 10'000'000;
   double command_timeout_s = 0;  // <= 0: no timeout
   std::string server_address;    // "" = none
+  // ServerTLS (an EmptyLaunchCommand engine reached over TLS) and AuthToken.
+  bool server_tls = false;
+  std::string tls_ca_file, tls_cert_file, tls_key_file, tls_server_name;
+  std::string auth_token;  // "" = none given (then $CONVOY_ENGINE_TOKEN); never logged
   std::string pointer;           // e.g. "/EngineConfigs/1", for error messages
   nlohmann::json json;           // the full engine object, defaults filled, paths absolute
 };
@@ -59,6 +64,22 @@ struct SimulationConfig {
   nlohmann::json json;                // whole config after overrides, defaults, path resolution
   std::vector<std::string> warnings;  // e.g. unknown keys, same format as errors
 };
+
+// Limits on hostile or mistaken input, checked before the config is used.
+// A config file larger than this is refused before it is read.
+constexpr size_t kMaxConfigBytes = size_t{64} << 20;
+// More engines than this are refused at load (each is a process with two shared-memory
+// arenas and a socket; realistic experiments have a handful).
+constexpr size_t kMaxEngines = 1024;
+// Names that become part of a file name (logs/<EngineName>.log, the run folder
+// <SimulationName>-<date>-<time>-<pid>) are at most this long, so that the file name stays
+// under the usual 255-byte limit.
+constexpr size_t kMaxNameBytes = 200;
+
+// Why `name` cannot be part of a file name inside the run folder, or "" if it can: it must not
+// be empty, longer than kMaxNameBytes, contain '/', '\\', "..", NUL or other control
+// characters. Anything else (spaces, non-ASCII) is allowed, as in NRP-Core.
+std::string name_problem(const std::string& name);
 
 // A user mistake in the config; what() holds one line per problem.
 class ConfigError : public std::runtime_error {

@@ -96,7 +96,8 @@ NdarrayRef read_ndarray(const View& in, const nlohmann::json& value) {
     throw std::runtime_error(in.describe() + ": " + e.what());
   }
   const size_t item = dtype_size(ref.header.dtype);
-  if (item == 0 || ref.header.count() * item != ref.data.size())
+  const uint64_t count = ref.header.count();
+  if (item == 0 || count > UINT64_MAX / item || count * item != ref.data.size())
     throw std::runtime_error(in.describe() + ": numpy array of " + std::to_string(ref.data.size()) +
                              " bytes does not match its dtype '" + ref.header.dtype +
                              "' and shape");

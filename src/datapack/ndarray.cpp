@@ -1,6 +1,7 @@
 #include "datapack/ndarray.h"
 
 #include <charconv>
+#include <cstdint>
 #include <stdexcept>
 
 namespace convoy::datapack {
@@ -24,7 +25,10 @@ void put_index(Out* out, uint32_t index) {
 
 uint64_t NdarrayHeader::count() const {
   uint64_t n = 1;
-  for (uint64_t d : shape) n *= d;
+  for (uint64_t d : shape) {
+    if (d != 0 && n > UINT64_MAX / d) return UINT64_MAX;  // a forged shape: matches no data
+    n *= d;
+  }
   return n;
 }
 
@@ -68,11 +72,14 @@ uint32_t parse_blob_index(std::string_view rest) {
 
 size_t dtype_size(std::string_view dtype) {
   if (dtype == "B" || dtype == "b" || dtype == "?") return 1;
-  if (dtype.size() < 3) return 0;
-  if (dtype[1] == 'U') return 0;  // unicode strings: not a plain numeric array
+  if (dtype.size() < 3 || std::string_view("<>|=").find(dtype[0]) == std::string_view::npos)
+    return 0;
+  const char kind = dtype[1];
+  if (std::string_view("biufcSU").find(kind) == std::string_view::npos) return 0;
   size_t n = 0;
   auto [p, ec] = std::from_chars(dtype.data() + 2, dtype.data() + dtype.size(), n);
-  return ec == std::errc() && p == dtype.data() + dtype.size() ? n : 0;
+  if (ec != std::errc() || p != dtype.data() + dtype.size() || n == 0 || n > 64) return 0;
+  return kind == 'U' ? 4 * n : n;  // "<U3": three UCS-4 characters
 }
 
 bool is_uint8(std::string_view dtype) {

@@ -39,7 +39,11 @@ void append_blob_index(std::vector<uint8_t>* out, uint32_t index);
 // Throws std::runtime_error unless `rest` is exactly one index.
 uint32_t parse_blob_index(std::string_view rest);
 
-// Bytes per element of a dtype string ("<f4" -> 4); 0 when unknown.
+// Bytes per element of a dtype string ("<f4" -> 4); 0 when unknown or not plain data.
+// Only plain data travels: booleans, integers, floats, complex numbers and fixed-size byte
+// or unicode strings ("?", "b", "B" or "|b1", "<i4", "<u2", "<f8", "<c16", "|S5", "<U3").
+// Object arrays ("|O8") and structured or void types are refused: their bytes would be
+// pointers or records that a receiver must never build from data off the wire.
 size_t dtype_size(std::string_view dtype);
 // Whether a dtype is one byte unsigned ("|u1", "<u1", "u1", "B").
 bool is_uint8(std::string_view dtype);

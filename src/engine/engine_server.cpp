@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
+#include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
@@ -48,6 +49,11 @@ void EngineServer::get(const engine::DataPackId& id, engine::DataPack* out) {
   *out->mutable_id() = id;
   datapack::Builder builder(out, *blob_writer_);
   engine_.get_datapack(id, builder);
+  if (const size_t bytes = out->ByteSizeLong(); bytes > transport::kMaxMessageBytes) {
+    throw std::length_error("datapack '" + id.name() + "' is " + std::to_string(bytes) +
+                            " bytes, more than one message may carry (" +
+                            std::to_string(transport::kMaxMessageBytes) + " bytes)");
+  }
 }
 
 void EngineServer::put(const engine::DataPack& dp) {
@@ -162,7 +168,15 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     if (writer) writer->next_message();
     bool more = handle(request, &reply);
     out.clear();
-    reply.SerializeToString(&out);
+    if (!reply.SerializeToString(&out) || out.size() > transport::kMaxMessageBytes) {
+      const size_t bytes = reply.ByteSizeLong();
+      reply.Clear();
+      reply.set_error("the reply is " + std::to_string(bytes) +
+                      " bytes, more than one message may carry (" +
+                      std::to_string(transport::kMaxMessageBytes) + " bytes)");
+      out.clear();
+      reply.SerializeToString(&out);
+    }
     if (!socket.send(out) || !more) break;
     follow(usual_work_ns, now_ns() - received);
   }
@@ -225,50 +239,64 @@ class RequestQueue {
 
 class GrpcService final : public engine::Engine::Service {
  public:
-  explicit GrpcService(RequestQueue& queue) : queue_(queue) {}
+  GrpcService(RequestQueue& queue, std::string token) : queue_(queue), token_(std::move(token)) {}
 
-  grpc::Status Initialize(grpc::ServerContext*, const engine::InitializeRequest* req,
+  grpc::Status Initialize(grpc::ServerContext* c, const engine::InitializeRequest* req,
                           engine::InitializeReply* out) override {
     engine::Request r;
     *r.mutable_initialize() = *req;
-    return run(r, [&](engine::Reply& rep) { *out = rep.initialize(); });
+    return run(c, r, [&](engine::Reply& rep) { *out = rep.initialize(); });
   }
-  grpc::Status Step(grpc::ServerContext*, const engine::StepRequest* req,
+  grpc::Status Step(grpc::ServerContext* c, const engine::StepRequest* req,
                     engine::StepReply* out) override {
     engine::Request r;
     *r.mutable_step() = *req;
-    return run(r, [&](engine::Reply& rep) { *out = std::move(*rep.mutable_step()); });
+    return run(c, r, [&](engine::Reply& rep) { *out = std::move(*rep.mutable_step()); });
   }
   grpc::Status RunLoopStep(grpc::ServerContext* c, const engine::StepRequest* req,
                            engine::StepReply* out) override {
     return Step(c, req, out);
   }
-  grpc::Status GetDataPacks(grpc::ServerContext*, const engine::GetDataPacksRequest* req,
+  grpc::Status GetDataPacks(grpc::ServerContext* c, const engine::GetDataPacksRequest* req,
                             engine::GetDataPacksReply* out) override {
     engine::Request r;
     *r.mutable_get_datapacks() = *req;
-    return run(r, [&](engine::Reply& rep) { *out = std::move(*rep.mutable_get_datapacks()); });
+    return run(c, r, [&](engine::Reply& rep) { *out = std::move(*rep.mutable_get_datapacks()); });
   }
-  grpc::Status SetDataPacks(grpc::ServerContext*, const engine::SetDataPacksRequest* req,
+  grpc::Status SetDataPacks(grpc::ServerContext* c, const engine::SetDataPacksRequest* req,
                             engine::Empty*) override {
     engine::Request r;
     *r.mutable_set_datapacks() = *req;
-    return run(r, [](engine::Reply&) {});
+    return run(c, r, [](engine::Reply&) {});
   }
-  grpc::Status Reset(grpc::ServerContext*, const engine::Empty*, engine::Empty*) override {
+  grpc::Status Reset(grpc::ServerContext* c, const engine::Empty*, engine::Empty*) override {
     engine::Request r;
     r.mutable_reset();
-    return run(r, [](engine::Reply&) {});
+    return run(c, r, [](engine::Reply&) {});
   }
-  grpc::Status Shutdown(grpc::ServerContext*, const engine::Empty*, engine::Empty*) override {
+  grpc::Status Shutdown(grpc::ServerContext* c, const engine::Empty*, engine::Empty*) override {
     engine::Request r;
     r.mutable_shutdown();
-    return run(r, [](engine::Reply&) {});
+    return run(c, r, [](engine::Reply&) {});
   }
 
  private:
   template <typename F>
-  grpc::Status run(const engine::Request& request, F&& take) {
+  grpc::Status run(grpc::ServerContext* context, const engine::Request& request, F&& take) {
+    if (!token_.empty()) {
+      const auto& meta = context->client_metadata();
+      auto it = meta.find(transport::kTokenMetadataKey);
+      const std::string_view given = it == meta.end()
+                                         ? std::string_view()
+                                         : std::string_view(it->second.data(), it->second.size());
+      if (!transport::same_token(token_, given)) {
+        std::fprintf(stderr, "refused a call from %s: %s token\n", context->peer().c_str(),
+                     it == meta.end() ? "no" : "wrong");
+        std::fflush(stderr);
+        return grpc::Status(grpc::StatusCode::UNAUTHENTICATED,
+                            it == meta.end() ? "no token given" : "wrong token");
+      }
+    }
     std::lock_guard<std::mutex> lock(mutex_);  // one call at a time, in arrival order
     engine::Reply reply = queue_.submit(request);
     if (!reply.error().empty()) return grpc::Status(grpc::StatusCode::INTERNAL, reply.error());
@@ -276,23 +304,36 @@ class GrpcService final : public engine::Engine::Service {
     return grpc::Status::OK;
   }
   RequestQueue& queue_;
+  std::string token_;  // "" = none required; never logged
   std::mutex mutex_;
 };
 
 }  // namespace
 
-void EngineServer::serve_grpc(const std::string& address) {
+void EngineServer::serve_grpc(const std::string& address,
+                              const transport::ServerSecurity& security) {
+  transport::check_listening_policy(address, security);
   RequestQueue queue;
-  GrpcService service(queue);
+  GrpcService service(queue, security.token);
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &port);
-  builder.SetMaxReceiveMessageSize(-1);
-  builder.SetMaxSendMessageSize(-1);
+  builder.AddListeningPort(address, transport::server_credentials(security), &port);
+  builder.SetMaxReceiveMessageSize(static_cast<int>(transport::kMaxMessageBytes));
+  builder.SetMaxSendMessageSize(static_cast<int>(transport::kMaxMessageBytes));
   builder.RegisterService(&service);
   std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
   if (!server || port == 0) throw std::runtime_error("cannot listen for gRPC at " + address);
-  std::fprintf(stderr, "serving gRPC at %s\n", address.c_str());
+  const bool tls = !security.cert_file.empty();
+  std::fprintf(stderr, "serving gRPC at %s (%s%s%s)\n", address.c_str(), tls ? "TLS" : "plain",
+               tls && !security.client_ca_file.empty() ? ", client certificates required" : "",
+               security.token.empty() ? ", no token" : ", token required");
+  if (security.insecure && !transport::is_loopback_address(address) && !tls &&
+      security.token.empty()) {
+    std::fprintf(stderr,
+                 "warning: --insecure: anyone who reaches %s can step this engine and feed it "
+                 "datapacks\n",
+                 address.c_str());
+  }
   std::fflush(stderr);
   queue.run([this](const engine::Request& r, engine::Reply* reply) { return handle(r, reply); });
   // Let the Shutdown reply go out, then stop.
@@ -306,6 +347,8 @@ int engine_main(int argc, char** argv) {
   int fd = -1;
   int64_t spin_us = 0;
   int shm_out = -1, shm_in = -1;
+  transport::ServerSecurity security;
+  std::string token_file;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto value = [&](const char* flag) -> std::string {
@@ -327,8 +370,23 @@ int engine_main(int argc, char** argv) {
       spin_us = std::stoll(value("--convoy-spin-us"));
     else if (a == "--address" || a == "--serverurl")
       address = value("--address");
+    else if (a == "--tls-cert")
+      security.cert_file = value("--tls-cert");
+    else if (a == "--tls-key")
+      security.key_file = value("--tls-key");
+    else if (a == "--tls-client-ca")
+      security.client_ca_file = value("--tls-client-ca");
+    else if (a == "--token-file")
+      token_file = value("--token-file");
+    else if (a == "--insecure")
+      security.insecure = true;
     else if (a == "-h" || a == "--help") {
-      std::printf("usage: %s [--type T] (--convoy-fd N | --address host:port)\n", argv[0]);
+      std::printf(
+          "usage: %s [--type T] (--convoy-fd N | --address host:port [--tls-cert PEM --tls-key "
+          "PEM [--tls-client-ca PEM]] [--token-file FILE] [--insecure])\n"
+          "  The token is read from --token-file or $%s. Without TLS or a token the server "
+          "listens\n  on the loopback only, unless --insecure.\n",
+          argv[0], transport::kTokenEnv);
       return 0;
     } else {
       std::fprintf(stderr, "note: ignoring argument %s\n", a.c_str());
@@ -348,10 +406,23 @@ int engine_main(int argc, char** argv) {
   EngineServer server(*engine);
   server.set_spin_us(spin_us);
   try {
-    if (fd >= 0)
+    if (fd >= 0) {
       server.serve_socket(fd, shm_out, shm_in);
-    else
-      server.serve_grpc(address);
+    } else {
+      if (!token_file.empty()) {
+        std::ifstream in(token_file);
+        if (!in) throw std::invalid_argument("--token-file '" + token_file + "' cannot be read");
+        std::getline(in, security.token);
+        if (security.token.empty())
+          throw std::invalid_argument("--token-file '" + token_file + "' holds no token");
+      } else if (const char* env = std::getenv(transport::kTokenEnv)) {
+        security.token = env;
+      }
+      server.serve_grpc(address, security);
+    }
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "engine server: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "engine server error: %s\n", e.what());
     return 1;

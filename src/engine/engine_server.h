@@ -6,6 +6,7 @@
 
 #include "engine/engine.h"
 #include "transport/blobs.h"
+#include "transport/grpc_security.h"
 
 namespace convoy::engines {
 
@@ -27,8 +28,10 @@ class EngineServer {
   // Blobs of replies go into the arena `shm_out_fd`, those of requests come from `shm_in_fd`
   // (-1: inline).
   void serve_socket(int fd, int shm_out_fd = -1, int shm_in_fd = -1);
-  // Serves gRPC at `address` until Shutdown.
-  void serve_grpc(const std::string& address);
+  // Serves gRPC at `address` until Shutdown, with TLS and a token as `security` says (see
+  // transport/grpc_security.h; throws std::invalid_argument when the address is not the
+  // loopback and there is neither, unless security.insecure).
+  void serve_grpc(const std::string& address, const transport::ServerSecurity& security);
 
  private:
   void do_step(const engine::StepRequest& request, engine::StepReply* reply);

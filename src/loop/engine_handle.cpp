@@ -3,6 +3,7 @@
 #include <deque>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/clock.h"
 #include "core/error.h"
@@ -31,7 +32,13 @@ void EngineHandle::start(const engine::Request& request, const char* what, doubl
   timeout_s_ = timeout_s > 0 ? timeout_s : config_.command_timeout_s;
   what_ = what;
   call_started_ns = now_ns();
-  channel_->start(request, deadline_after(timeout_s_));
+  try {
+    channel_->start(request, deadline_after(timeout_s_));
+  } catch (const std::length_error& e) {
+    // Only the datapacks the functions send make a request this large.
+    throw FunctionError("engine '" + name() + "': " + what + ": " + e.what() +
+                        " (the datapacks the functions sent to it)");
+  }
   if (shm_writer_) shm_writer_->next_message();  // blobs of the next request go elsewhere
   busy_ = true;
 }

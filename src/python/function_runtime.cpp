@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "python/datapack_convert.h"
+#include "transport/frame_socket.h"
 
 namespace convoy::python {
 
@@ -107,6 +108,14 @@ void FunctionRuntime::run_transceiver(const LoadedFunction& fn, const InputSourc
       }
       datapack::Builder out(&outputs->back(), writer ? *writer : inline_writer_);
       from_python(item, out);
+      if (const size_t bytes = outputs->back().ByteSizeLong();
+          bytes > transport::kMaxMessageBytes) {
+        const auto& id = outputs->back().id();
+        throw std::length_error("datapack '" + id.name() + "' for engine '" + id.engine_name() +
+                                "' is " + std::to_string(bytes) +
+                                " bytes, more than one message may carry (" +
+                                std::to_string(transport::kMaxMessageBytes) + " bytes)");
+      }
     } catch (py::error_already_set& e) {
       throw FunctionError(fn.label() + ": " + format_exception(e));
     } catch (const std::exception& e) {

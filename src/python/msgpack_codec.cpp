@@ -426,44 +426,32 @@ PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
   } catch (const std::exception& ex) {
     return fail(ex.what());
   }
-  static PyObject* numpy_empty = nullptr;
-  static PyObject* numpy_dtype = nullptr;
-  if (!numpy_empty) {
-    PyObject* np = PyImport_ImportModule("numpy");
-    if (!np) return fail("numpy is needed to decode an array");
-    numpy_empty = PyObject_GetAttrString(np, "empty");
-    numpy_dtype = PyObject_GetAttrString(np, "dtype");
-    Py_DECREF(np);
-  }
-  // The dtype and the size are checked before numpy allocates: a header of a few bytes could
-  // otherwise ask for any amount of memory, or for an array of PyObject pointers.
-  PyObject* dtype = PyObject_CallFunction(numpy_dtype, "s", header.dtype.c_str());
-  if (!dtype) return fail("bad ndarray dtype");
-  PyObject* has_object = PyObject_GetAttrString(dtype, "hasobject");
-  PyObject* item_size = PyObject_GetAttrString(dtype, "itemsize");
-  const bool objects = !has_object || PyObject_IsTrue(has_object) != 0;
-  uint64_t bytes = item_size ? PyLong_AsUnsignedLongLong(item_size) : 0;
-  Py_XDECREF(has_object);
-  Py_XDECREF(item_size);
-  if (PyErr_Occurred() || objects) {
-    Py_DECREF(dtype);
-    PyErr_Clear();
-    return fail("ndarray of Python objects or of an unknown dtype");
-  }
+  // Plain data only: an object array would be built from pointers off the wire.
+  const size_t item = datapack::dtype_size(header.dtype);
+  if (item == 0) return fail("numpy array dtype is not plain data (object or structured)");
+  uint64_t count = 1;
   for (uint64_t d : header.shape) {
-    if (__builtin_mul_overflow(bytes, d, &bytes)) bytes = UINT64_MAX;
+    if (d != 0 && count > UINT64_MAX / d) return fail("numpy array shape overflows");
+    count *= d;
   }
-  if (bytes != data.size()) {
-    Py_DECREF(dtype);
+  if (count > UINT64_MAX / item || count * item != data.size())
     return fail("ndarray size does not match its shape");
-  }
   PyObject* shape = PyTuple_New(static_cast<Py_ssize_t>(header.shape.size()));
   for (size_t i = 0; i < header.shape.size(); ++i)
     PyTuple_SET_ITEM(shape, static_cast<Py_ssize_t>(i),
                      PyLong_FromUnsignedLongLong(header.shape[i]));
-  PyObject* arr = PyObject_CallFunctionObjArgs(numpy_empty, shape, dtype, nullptr);
+  static PyObject* numpy_empty = nullptr;
+  if (!numpy_empty) {
+    PyObject* np = PyImport_ImportModule("numpy");
+    if (!np) {
+      Py_DECREF(shape);
+      return fail("numpy is needed to decode an array");
+    }
+    numpy_empty = PyObject_GetAttrString(np, "empty");
+    Py_DECREF(np);
+  }
+  PyObject* arr = PyObject_CallFunction(numpy_empty, "Os", shape, header.dtype.c_str());
   Py_DECREF(shape);
-  Py_DECREF(dtype);
   if (!arr) return fail("bad ndarray dtype");
   Py_buffer view;
   if (PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) != 0) {

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -34,21 +35,32 @@ void ShmArena::attach(int fd) {
 }
 
 std::span<uint8_t> ShmBlobWriter::reserve(engine::DataPack* dp, size_t size, uint32_t* index) {
-  auto* blob = dp->add_blobs();
-  *index = static_cast<uint32_t>(dp->blobs_size() - 1);
   const size_t half_size = arena_.size() / 2;
-  const bool big = size >= kShmBlobThreshold;
-  if (big && fresh_message_ && size <= half_size) {
-    fresh_message_ = false;  // the message's first blob in shared memory: the other half
-    half_ ^= 1;
-    used_ = 0;
-  }
-  const size_t aligned = (used_ + 63) & ~size_t{63};
-  if (!big || fresh_message_ || aligned + size > half_size) {
-    std::string* bytes = blob->mutable_inline_();  // small, or the arena is full
+  if (size < kShmBlobThreshold) {  // small: in the message
+    auto* blob = dp->add_blobs();
+    *index = static_cast<uint32_t>(dp->blobs_size() - 1);
+    std::string* bytes = blob->mutable_inline_();
     bytes->resize(size);
     return {reinterpret_cast<uint8_t*>(bytes->data()), size};
   }
+  // The message's first blob in shared memory goes to the other half.
+  const size_t aligned = fresh_message_ ? 0 : (used_ + 63) & ~size_t{63};
+  const size_t free_bytes = half_size - std::min(aligned, half_size);
+  if (size > free_bytes) {
+    // Inline, it would make a message as large as the blob: refused, with what to change.
+    throw std::length_error("datapack '" + dp->id().name() + "' of engine '" +
+                            dp->id().engine_name() + "': a blob of " + std::to_string(size) +
+                            " bytes does not fit in the shared-memory arena (" +
+                            std::to_string(free_bytes) + " of " + std::to_string(half_size) +
+                            " bytes free for this message: half of the arena; CONVOY_SHM_MB "
+                            "sets the arena size)");
+  }
+  if (fresh_message_) {
+    fresh_message_ = false;
+    half_ ^= 1;
+  }
+  auto* blob = dp->add_blobs();
+  *index = static_cast<uint32_t>(dp->blobs_size() - 1);
   const size_t offset = static_cast<size_t>(half_) * half_size + aligned;
   used_ = aligned + size;
   blob->set_in_shm(true);

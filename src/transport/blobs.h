@@ -43,7 +43,10 @@ class ShmArena {
   size_t size_ = 0;
 };
 
-// Writes blobs at or above kShmBlobThreshold into an arena, alternating halves.
+// Writes blobs at or above kShmBlobThreshold into an arena, alternating halves. The large
+// blobs of one message must fit together in half the arena: reserve() throws
+// std::length_error, naming the datapack, for one that does not (it does not fall back to the
+// message, which would then be as large as the blob).
 class ShmBlobWriter final : public datapack::BlobWriter {
  public:
   explicit ShmBlobWriter(ShmArena& arena) : arena_(arena) {}

@@ -17,7 +17,8 @@ enum class CallStatus { kOk, kClosed, kTimeout, kInterrupted };
 class EngineChannel {
  public:
   virtual ~EngineChannel() = default;
-  // Starts a call. At most one call is in flight per channel.
+  // Starts a call. At most one call is in flight per channel. Throws std::length_error, and
+  // sends nothing, when the request is larger than a message may be (kMaxMessageBytes).
   virtual void start(const engine::Request& request, Deadline deadline) = 0;
   // Waits for the reply of the call in flight, until the deadline given to start() or
   // `limit`, whichever comes first.
@@ -30,7 +31,14 @@ class EngineChannel {
 
 // Local engine on an inherited stream socket (see FrameSocket).
 std::unique_ptr<EngineChannel> make_socket_channel(int fd);
-// Engine serving gRPC at `address` (host:port or unix:path). Waits until `deadline` for it.
+struct ClientSecurity;  // transport/grpc_security.h
+
+// Engine serving gRPC at `address` (host:port or unix:path), with TLS and a token as
+// `security` says. Waits until `deadline` for it; nullptr when nothing answers. Throws
+// std::runtime_error when something answers but the connection cannot be made (a failed TLS
+// handshake, plain against TLS), std::invalid_argument for unreadable certificate files.
 std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline);
+std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline,
+                                                 const ClientSecurity& security);
 
 }  // namespace convoy::transport

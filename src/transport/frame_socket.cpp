@@ -24,7 +24,7 @@ void FrameSocket::close() {
 }
 
 bool FrameSocket::send(const std::string& payload) {
-  if (fd_ < 0) return false;
+  if (fd_ < 0 || payload.size() > kMaxMessageBytes) return false;
   uint32_t len = static_cast<uint32_t>(payload.size());
   unsigned char header[4] = {static_cast<unsigned char>(len), static_cast<unsigned char>(len >> 8),
                              static_cast<unsigned char>(len >> 16),
@@ -121,6 +121,7 @@ RecvStatus FrameSocket::recv(std::string* payload, Deadline deadline) {
     if (avail >= 4) {
       const auto* h = reinterpret_cast<const unsigned char*>(buffer_.data() + buffer_pos_);
       size_t len = h[0] | (h[1] << 8) | (h[2] << 16) | (static_cast<size_t>(h[3]) << 24);
+      if (len > kMaxMessageBytes) return RecvStatus::kClosed;  // the stream cannot be trusted
       if (avail >= 4 + len) {
         payload->assign(buffer_.data() + buffer_pos_ + 4, len);
         buffer_pos_ += 4 + len;

@@ -2,13 +2,21 @@
 //
 // A frame is a 4-byte little-endian length followed by that many bytes. Reads honour a
 // deadline and report a closed peer distinctly, so a crashed engine is noticed at once.
+// A frame carries one message of at most kMaxMessageBytes: larger ones are not sent, and a
+// header announcing one ends the stream (its peer is broken or hostile).
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "core/clock.h"
 
 namespace convoy::transport {
+
+// The largest message (a request or reply, with its inline datapacks) between the
+// coordinator and an engine: 1 GiB, half of protobuf's 2 GiB limit. Large payloads belong in
+// shared-memory blobs (transport/blobs.h), which a message only points to.
+constexpr size_t kMaxMessageBytes = size_t{1} << 30;
 
 enum class RecvStatus { kOk, kClosed, kTimeout, kInterrupted };
 
@@ -21,9 +29,10 @@ class FrameSocket {
 
   int fd() const { return fd_; }
 
-  // Sends one frame. Returns false if the peer has gone.
+  // Sends one frame. Returns false if the peer has gone or `payload` is larger than
+  // kMaxMessageBytes (then nothing is sent).
   bool send(const std::string& payload);
-  // Receives one frame into `payload`.
+  // Receives one frame into `payload`; kClosed for a frame larger than kMaxMessageBytes.
   RecvStatus recv(std::string* payload, Deadline deadline);
   void close();
   // Polls up to `ns` for data before sleeping, pausing or (yield) giving up the CPU between

@@ -1,18 +1,27 @@
 #include <grpcpp/grpcpp.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <future>
 
 #include "convoy/engine.grpc.pb.h"
 #include "core/interrupt.h"
 #include "transport/engine_channel.h"
+#include "transport/frame_socket.h"
+#include "transport/grpc_security.h"
 
 namespace convoy::transport {
 namespace {
 
 class GrpcChannel final : public EngineChannel {
  public:
-  GrpcChannel(std::string address, std::shared_ptr<grpc::Channel> channel)
-      : address_(std::move(address)), stub_(engine::Engine::NewStub(channel)) {}
+  GrpcChannel(std::string address, std::shared_ptr<grpc::Channel> channel, std::string token)
+      : address_(std::move(address)),
+        stub_(engine::Engine::NewStub(channel)),
+        token_(std::move(token)) {}
 
   ~GrpcChannel() override {
     if (context_) context_->TryCancel();
@@ -21,6 +30,7 @@ class GrpcChannel final : public EngineChannel {
 
   void start(const engine::Request& request, Deadline deadline) override {
     context_ = std::make_unique<grpc::ClientContext>();
+    if (!token_.empty()) context_->AddMetadata(kTokenMetadataKey, token_);
     if (deadline != Deadline::max()) {
       context_->set_deadline(std::chrono::system_clock::now() + (deadline - SteadyClock::now()));
     }
@@ -46,7 +56,12 @@ class GrpcChannel final : public EngineChannel {
         status.error_code() == grpc::StatusCode::CANCELLED)
       return CallStatus::kClosed;
     *reply = std::move(result);
-    if (!status.ok()) reply->set_error(status.error_message());
+    if (status.error_code() == grpc::StatusCode::UNAUTHENTICATED) {
+      reply->set_error("the engine server refused the coordinator at " + address_ + ": " +
+                       status.error_message() + " (AuthToken, or $" + kTokenEnv + ")");
+    } else if (!status.ok()) {
+      reply->set_error(status.error_message());
+    }
     return CallStatus::kOk;
   }
 
@@ -85,25 +100,87 @@ class GrpcChannel final : public EngineChannel {
 
   std::string address_;
   std::unique_ptr<engine::Engine::Stub> stub_;
+  std::string token_;  // sent with every call; never logged
   std::unique_ptr<grpc::ClientContext> context_;
   std::future<std::pair<grpc::Status, engine::Reply>> pending_;
   Deadline deadline_{};
 };
 
+// Whether a TCP connection to host:port opens within half a second: something listens.
+bool tcp_answers(const std::string& address) {
+  if (address.rfind("unix", 0) == 0) return false;
+  std::string host = address, port;
+  const auto colon = host.rfind(':');
+  if (colon == std::string::npos) return false;
+  port = host.substr(colon + 1);
+  host = host.substr(0, colon);
+  if (host.size() > 1 && host.front() == '[') host = host.substr(1, host.size() - 2);
+  addrinfo hints{};
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (getaddrinfo(host.c_str(), port.c_str(), &hints, &found) != 0) return false;
+  bool open = false;
+  for (addrinfo* a = found; a && !open; a = a->ai_next) {
+    int fd = socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) continue;
+    if (connect(fd, a->ai_addr, a->ai_addrlen) == 0) {
+      open = true;
+    } else if (errno == EINPROGRESS) {
+      pollfd p{fd, POLLOUT, 0};
+      int err = 0;
+      socklen_t len = sizeof err;
+      open = poll(&p, 1, 500) == 1 && getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &len) == 0 &&
+             err == 0;
+    }
+    ::close(fd);
+  }
+  freeaddrinfo(found);
+  return open;
+}
+
 }  // namespace
 
 std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline) {
+  return make_grpc_channel(address, deadline, ClientSecurity{});
+}
+
+std::unique_ptr<EngineChannel> make_grpc_channel(const std::string& address, Deadline deadline,
+                                                 const ClientSecurity& security) {
   grpc::ChannelArguments args;
-  args.SetMaxReceiveMessageSize(-1);
-  args.SetMaxSendMessageSize(-1);
-  auto channel = grpc::CreateCustomChannel(address, grpc::InsecureChannelCredentials(), args);
-  auto wait_until =
+  args.SetMaxReceiveMessageSize(static_cast<int>(kMaxMessageBytes));
+  args.SetMaxSendMessageSize(static_cast<int>(kMaxMessageBytes));
+  if (security.tls && !security.server_name.empty())
+    args.SetSslTargetNameOverride(security.server_name);
+  auto channel = grpc::CreateCustomChannel(address, channel_credentials(security), args);
+  const auto wait_until =
       deadline == Deadline::max() ? SteadyClock::now() + std::chrono::seconds(60) : deadline;
-  if (!channel->WaitForConnected(std::chrono::system_clock::now() +
-                                 (wait_until - SteadyClock::now()))) {
-    return nullptr;
+  // Something that accepts TCP connections but never lets the channel become ready, for two
+  // seconds, does not speak what we speak: a failed TLS handshake, or TLS against plain.
+  Deadline answered_since = Deadline::max();
+  for (;;) {
+    const auto now = SteadyClock::now();
+    if (now >= wait_until) return nullptr;
+    const auto slice = std::min(wait_until, now + std::chrono::milliseconds(250));
+    if (channel->WaitForConnected(std::chrono::system_clock::now() + (slice - now))) break;
+    if (interrupted()) return nullptr;
+    if (channel->GetState(false) != GRPC_CHANNEL_TRANSIENT_FAILURE) continue;
+    if (!tcp_answers(address)) {
+      answered_since = Deadline::max();
+      continue;
+    }
+    if (answered_since == Deadline::max()) answered_since = SteadyClock::now();
+    if (SteadyClock::now() - answered_since > std::chrono::seconds(2)) {
+      throw std::runtime_error(
+          security.tls ? "the server at " + address +
+                             " answers but the TLS handshake fails (is its certificate signed "
+                             "by ServerTLS/CACertificate, and for ServerName? does it want a "
+                             "client certificate? does it speak TLS?)"
+                       : "the server at " + address +
+                             " answers but not as a plain gRPC engine server (does it require "
+                             "TLS? then give ServerTLS)");
+    }
   }
-  return std::make_unique<GrpcChannel>(address, std::move(channel));
+  return std::make_unique<GrpcChannel>(address, std::move(channel), security.token);
 }
 
 }  // namespace convoy::transport

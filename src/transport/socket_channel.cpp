@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <stdexcept>
 
 #include "transport/engine_channel.h"
 #include "transport/frame_socket.h"
@@ -19,7 +20,11 @@ class SocketChannel final : public EngineChannel {
     started_ns_ = now_ns();
     deadline_ = deadline;
     out_.clear();
-    request.SerializeToString(&out_);
+    if (!request.SerializeToString(&out_) || out_.size() > kMaxMessageBytes) {
+      throw std::length_error("the request is " + std::to_string(request.ByteSizeLong()) +
+                              " bytes, more than one message may carry (" +
+                              std::to_string(kMaxMessageBytes) + " bytes)");
+    }
     send_failed_ = !socket_.send(out_);
   }
 

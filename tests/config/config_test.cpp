@@ -274,6 +274,83 @@ TEST_F(ConfigTest, DuplicateNames) {
                             "\"tf_1\" (also /DataPackProcessingFunctions/0)");
 }
 
+TEST_F(ConfigTest, NameProblems) {
+  for (const std::string ok : {"python_1", "my engine", "car.v2", "Fahrzeug_ä", "a.b-c"}) {
+    EXPECT_EQ(name_problem(ok), "") << ok;
+  }
+  EXPECT_TRUE(Contains(name_problem(""), "must not be empty"));
+  for (const std::string bad : {"../x", "..", "a/b", "/abs", "a\\b", "x..y"}) {
+    EXPECT_TRUE(Contains(name_problem(bad), "must not contain '/', '\\' or '..'")) << bad;
+  }
+  EXPECT_TRUE(Contains(name_problem(std::string("a\0b", 3)), "\"a\\u0000b\""));
+  EXPECT_TRUE(Contains(name_problem("a\nb"), "control characters"));
+  EXPECT_EQ(name_problem(std::string(kMaxNameBytes, 'x')), "");
+  EXPECT_TRUE(Contains(name_problem(std::string(kMaxNameBytes + 1, 'x')),
+                       "must be at most 200 bytes long"));
+}
+
+// Names that become file names in the run folder: each is checked where it is in the file.
+TEST_F(ConfigTest, NamesThatWouldLeaveTheRunFolder) {
+  json doc = minimal();
+  doc["EngineConfigs"].push_back(engine("../x"));
+  EXPECT_EQ(error(doc), prefix() +
+                            "/EngineConfigs/1/EngineName: must not contain '/', '\\' or '..' (it "
+                            "becomes part of a file name in the run folder), got \"../x\"");
+  doc = minimal();
+  doc["SimulationName"] = "../../escape";
+  EXPECT_TRUE(Contains(error(doc), prefix() + "/SimulationName: must not contain '/'"));
+  doc["SimulationName"] = "";
+  EXPECT_TRUE(Contains(error(doc), prefix() + "/SimulationName: must not be empty"));
+  doc["SimulationName"] = "My experiment 2";  // spaces are fine
+  EXPECT_EQ(error(doc), "");
+  doc = minimal();
+  doc["DataPackProcessingFunctions"] = {{{"Name", "tf/../../x"}, {"FileName", "tf.py"}}};
+  EXPECT_TRUE(Contains(error(doc), prefix() + "/DataPackProcessingFunctions/0/Name: must not"));
+  doc = minimal();
+  doc["StatusFunction"] = {{"Name", std::string("st\0x", 4)}, {"FileName", "tf.py"}};
+  EXPECT_TRUE(Contains(error(doc), prefix() + "/StatusFunction/Name: must not contain NUL"));
+  // Overrides are checked as well.
+  EXPECT_TRUE(Contains(error(minimal(), {"EngineConfigs/0/EngineName=a/b"}),
+                       prefix() + "/EngineConfigs/0/EngineName: must not contain '/'"));
+}
+
+TEST_F(ConfigTest, TooManyEngines) {
+  json doc = minimal();
+  doc["EngineConfigs"] = json::array();
+  for (size_t i = 0; i < kMaxEngines; ++i)
+    doc["EngineConfigs"].push_back(engine("e" + std::to_string(i)));
+  EXPECT_EQ(load(doc).engines.size(), kMaxEngines);
+  doc["EngineConfigs"].push_back(engine("one_more"));
+  EXPECT_EQ(error(doc), prefix() + "/EngineConfigs: 1025 engines, more than the limit of 1024");
+}
+
+// A config file above kMaxConfigBytes is refused by its size, before it is read: a sparse
+// 1 GiB file costs no disk and no time.
+TEST_F(ConfigTest, OversizedConfigFileRefused) {
+  write(file(), minimal().dump());
+  fs::resize_file(file(), size_t{1} << 30);
+  try {
+    load_simulation_config(file(), {}, share_);
+    FAIL() << "an oversized config was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), prefix() +
+                                         "too large (1073741824 bytes; the limit for a config "
+                                         "file is 64 MiB)");
+  }
+  fs::resize_file(file(), kMaxConfigBytes + 1);
+  EXPECT_THROW(load_simulation_config(file(), {}, share_), ConfigError);
+}
+
+// Not a regular file: read up to the limit, not forever.
+TEST_F(ConfigTest, EndlessConfigStreamRefused) {
+  try {
+    load_simulation_config("/dev/zero", {}, share_);
+    FAIL() << "/dev/zero was read as a config";
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(Contains(e.what(), "/dev/zero: too large (more than 67108864 bytes"));
+  }
+}
+
 TEST_F(ConfigTest, MissingFiles) {
   json doc = minimal();
   doc["EngineConfigs"][0]["PythonFileName"] = "missing.py";

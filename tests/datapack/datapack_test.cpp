@@ -37,7 +37,13 @@ TEST(Ndarray, HeaderRoundTripsAndRejectsTruncation) {
   EXPECT_THROW(parse_blob_index("abc"), std::runtime_error);
   EXPECT_EQ(dtype_size("<f4"), 4u);
   EXPECT_EQ(dtype_size("|u1"), 1u);
-  EXPECT_EQ(dtype_size("<U8"), 0u);
+  EXPECT_EQ(dtype_size("<U8"), 32u);
+  EXPECT_EQ(dtype_size("|b1"), 1u);
+  EXPECT_EQ(dtype_size("<c16"), 16u);
+  for (const char* not_plain : {"|O8", "|O", "|V8", "<M8", "", "<f", "<f0", "xf4", "<f4x"})
+    EXPECT_EQ(dtype_size(not_plain), 0u) << not_plain;
+  NdarrayHeader forged{"<f8", {uint64_t{1} << 62, 1u << 4}};
+  EXPECT_EQ(forged.count(), UINT64_MAX);
   EXPECT_TRUE(is_uint8("|u1"));
   EXPECT_FALSE(is_uint8("<f4"));
 }
