@@ -127,7 +127,24 @@ Geometry Geometry::arc(double s, double x, double y, double hdg, double length, 
 
 Geometry Geometry::spiral(double s, double x, double y, double hdg, double length,
                           double curv_start, double curv_end) {
-  return {s, x, y, hdg, length, GeometryKind::kSpiral, Spiral{curv_start, curv_end}};
+  Spiral sp{curv_start, curv_end, 0, {}};
+  const double rate = length > 0 ? (curv_end - curv_start) / length : 0.0;
+  const double max_k = std::max(std::abs(curv_start), std::abs(curv_end));
+  const double turn = max_k * std::max(length, 0.0);
+  const int panels =
+      std::isfinite(turn)
+          ? static_cast<int>(std::min(1.0 + std::floor(turn / 0.5), 1.0 * kMaxSpiralPanels))
+          : kMaxSpiralPanels;
+  sp.panel = std::max(length, 0.0) / panels;
+  sp.starts.resize(static_cast<size_t>(panels) + 1);
+  auto theta = [&](double t) { return t * (curv_start + 0.5 * rate * t); };
+  for (int i = 0; i < panels; ++i) {
+    const double a = i * sp.panel, b = (i + 1) * sp.panel;
+    sp.starts[i + 1] = {
+        sp.starts[i][0] + gauss([&](double t) { return std::cos(theta(t)); }, a, b),
+        sp.starts[i][1] + gauss([&](double t) { return std::sin(theta(t)); }, a, b)};
+  }
+  return {s, x, y, hdg, length, GeometryKind::kSpiral, std::move(sp)};
 }
 
 Geometry Geometry::poly3(double s, double x, double y, double hdg, double length,
@@ -159,7 +176,7 @@ Geometry Geometry::param_poly3(double s, double x, double y, double hdg, double 
 }
 
 Pose2 Geometry::at(double ds) const {
-  ds = std::clamp(ds, 0.0, length);
+  ds = std::isnan(ds) ? 0.0 : std::clamp(ds, 0.0, length);
   Pose2 local;
   switch (kind) {
     case GeometryKind::kLine:
@@ -178,7 +195,18 @@ Pose2 Geometry::at(double ds) const {
     case GeometryKind::kSpiral: {
       const Spiral& sp = std::get<Spiral>(shape);
       const double rate = length > 0 ? (sp.curv_end - sp.curv_start) / length : 0.0;
-      local = clothoid(sp.curv_start, rate, ds);
+      if (sp.starts.empty()) {  // not made by Geometry::spiral()
+        local = clothoid(sp.curv_start, rate, ds);
+        break;
+      }
+      auto theta = [&](double t) { return t * (sp.curv_start + 0.5 * rate * t); };
+      const size_t last = sp.starts.size() - 1;
+      const size_t i =
+          sp.panel > 0 ? std::min(static_cast<size_t>(ds / sp.panel), last > 0 ? last - 1 : 0) : 0;
+      const double a = i * sp.panel;
+      local = {sp.starts[i][0] + gauss([&](double t) { return std::cos(theta(t)); }, a, ds),
+               sp.starts[i][1] + gauss([&](double t) { return std::sin(theta(t)); }, a, ds),
+               theta(ds), sp.curv_start + rate * ds};
       break;
     }
     case GeometryKind::kPoly3:

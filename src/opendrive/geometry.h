@@ -34,7 +34,13 @@ struct Arc {
 struct Spiral {
   double curv_start = 0;
   double curv_end = 0;
+  // The local position at the start of each integration panel (of at most 0.5 rad of heading
+  // change, at most kMaxSpiralPanels of them), filled by Geometry::spiral(): a pose is then
+  // the panel's start plus one panel's integral, however long or tightly wound the spiral.
+  double panel = 0;
+  std::vector<std::array<double, 2>> starts;
 };
+inline constexpr int kMaxSpiralPanels = 100000;
 
 // u(p) = u[0] + u[1] p + u[2] p^2 + u[3] p^3, likewise v, for p in [0, p_end], in the local
 // frame of the geometry's start (u along hdg, v to its left). Poly3 (v as a cubic of u) is the

@@ -23,6 +23,9 @@ namespace convoy::opendrive {
 // a + b ds + c ds^2 + d ds^3 with ds = s - start. Used for elevation, laneOffset and lane
 // width records; `start` is always a road s (a width record's sOffset is added to its
 // section's s when the file is read).
+// The largest lane width or lane offset a map may have, in metres.
+inline constexpr double kMaxLateralMetres = 1000;
+
 struct CubicRecord {
   double start = 0;
   double a = 0;

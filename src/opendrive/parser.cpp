@@ -213,6 +213,29 @@ Road Reader::read_road(const XMLElement* e, size_t index) {
   for (size_t i = 0; i < road.sections.size(); ++i) {
     road.sections[i].s_end = i + 1 < road.sections.size() ? road.sections[i + 1].s : road.length;
   }
+  // Lane widths and the lane offset stay within kMaxLateralMetres where each record applies:
+  // a polynomial that runs away (a 320 km wide lane) is a broken map, and would make the
+  // sampling and the meshes that follow the lanes' borders take minutes.
+  auto check = [&](const std::vector<CubicRecord>& records, double end, const XMLElement* where_e,
+                   const std::string& what) {
+    for (size_t i = 0; i < records.size(); ++i) {
+      const double a = records[i].start;
+      const double b = i + 1 < records.size() ? records[i + 1].start : end;
+      for (int k = 0; k <= 16; ++k) {
+        const double s_at = a + (b - a) * k / 16;
+        const double w = records[i].value(s_at);
+        if (!(std::abs(w) <= kMaxLateralMetres)) {
+          fail(where_e, where,
+               what + " reaches " + std::to_string(w) + " m at s=" + std::to_string(s_at) +
+                   " (at most " + std::to_string(static_cast<int>(kMaxLateralMetres)) + " m)");
+        }
+      }
+    }
+  };
+  check(road.lane_offsets, road.length, lanes, "laneOffset");
+  for (const auto& sec : road.sections)
+    for (const auto& lane : sec.lanes)
+      check(lane.widths, sec.s_end, lanes, "lane " + std::to_string(lane.id) + " width");
   return road;
 }
 
