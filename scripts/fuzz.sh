@@ -61,6 +61,8 @@ fuzz_one() {
   [[ -d fuzz/regressions/$t ]] && cp -n fuzz/regressions/"$t"/* "$corpus"/ 2>/dev/null || true
   local extra=()
   [[ $t == python_codec ]] && extra+=(-detect_leaks=0)
+  # A fixed seed (the tests set CONVOY_FUZZ_SEED) makes a short run repeat the same inputs.
+  [[ -n ${CONVOY_FUZZ_SEED:-} ]] && extra+=(-seed="$CONVOY_FUZZ_SEED")
   echo "== fuzzing $t for ${seconds}s (corpus $corpus)"
   local rc=0
   sanitizer_env "$t"
