@@ -38,8 +38,8 @@ struct EngineConfig {
   bool server_tls = false;
   std::string tls_ca_file, tls_cert_file, tls_key_file, tls_server_name;
   std::string auth_token;  // "" = none given (then $CONVOY_ENGINE_TOKEN); never logged
-  std::string pointer;           // e.g. "/EngineConfigs/1", for error messages
-  nlohmann::json json;           // the full engine object, defaults filled, paths absolute
+  std::string pointer;     // e.g. "/EngineConfigs/1", for error messages
+  nlohmann::json json;     // the full engine object, defaults filled, paths absolute
 };
 
 struct FunctionConfig {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "datapack/ndarray.h"
 #include "python/interpreter.h"
 
@@ -57,31 +59,26 @@ TEST_F(MsgpackCodec, NumpyArraysKeepDtypeAndShape) {
   EXPECT_LT(bytes.size(), 60 * 4 + 64u);
 }
 
+// An inline numpy array (MessagePack ext 8, type 1) with the given header and data bytes.
+std::string ndarray_ext(std::string_view dtype, std::vector<uint64_t> shape, std::string data) {
+  std::string body;
+  datapack::append_ndarray_header(&body, dtype, shape);
+  body += data;
+  std::string out = {'\xc7', static_cast<char>(body.size()), datapack::kNdarrayExtType};
+  return out + body;
+}
+
 // An array from the wire is plain data only: an object array's bytes would be taken as
 // pointers. A forged header whose shape does not match its bytes is refused too.
 TEST_F(MsgpackCodec, ObjectArraysAndForgedShapesAreRefused) {
-  std::string body;
-  const uint64_t shape[1] = {2};
-  datapack::append_ndarray_header(&body, "|O8", shape);
-  body.append(16, '\x41');  // two "pointers"
-  std::string bytes = "\xc7";
-  bytes.push_back(static_cast<char>(body.size()));
-  bytes.push_back(static_cast<char>(datapack::kNdarrayExtType));
-  bytes += body;
-  EXPECT_EQ(msgpack_decode(bytes), nullptr);
-  ASSERT_TRUE(PyErr_Occurred());
-  PyErr_Clear();
-
-  body.clear();
-  const uint64_t huge[2] = {uint64_t{1} << 62, 4};  // wraps to 0 elements of 8 bytes
-  datapack::append_ndarray_header(&body, "<f8", huge);
-  bytes = "\xc7";
-  bytes.push_back(static_cast<char>(body.size()));
-  bytes.push_back(static_cast<char>(datapack::kNdarrayExtType));
-  bytes += body;
-  EXPECT_EQ(msgpack_decode(bytes), nullptr);
-  ASSERT_TRUE(PyErr_Occurred());
-  PyErr_Clear();
+  const std::string two_pointers(16, '\x41');
+  const uint64_t wraps = uint64_t{1} << 62;  // x 4 wraps to 0 elements of 8 bytes
+  for (const std::string& bytes :
+       {ndarray_ext("|O8", {2}, two_pointers), ndarray_ext("<f8", {wraps, 4}, "")}) {
+    EXPECT_EQ(msgpack_decode(bytes), nullptr);
+    ASSERT_TRUE(PyErr_Occurred());
+    PyErr_Clear();
+  }
 }
 
 TEST_F(MsgpackCodec, UnsupportedTypeRaisesTypeError) {
@@ -95,15 +92,6 @@ TEST_F(MsgpackCodec, UnsupportedTypeRaisesTypeError) {
 TEST_F(MsgpackCodec, TruncatedInputRaises) {
   EXPECT_EQ(msgpack_decode(std::string_view("\x92\x01", 2)), nullptr);
   PyErr_Clear();
-}
-
-// An inline numpy array (MessagePack ext 8, type 1) with the given header and data bytes.
-std::string ndarray_ext(std::string_view dtype, std::vector<uint64_t> shape, std::string data) {
-  std::string body;
-  datapack::append_ndarray_header(&body, dtype, shape);
-  body += data;
-  std::string out = {'\xc7', static_cast<char>(body.size()), datapack::kNdarrayExtType};
-  return out + body;
 }
 
 // Found by fuzz/python_codec: the shape was handed to numpy.empty before it was compared with
