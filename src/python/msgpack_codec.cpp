@@ -463,7 +463,7 @@ PyObject* Decoder::ndarray(const uint8_t* b, size_t n, bool in_blob) {
     Py_DECREF(arr);
     return fail("ndarray size does not match its shape");
   }
-  std::memcpy(view.buf, data.data(), data.size());
+  if (!data.empty()) std::memcpy(view.buf, data.data(), data.size());  // empty: data() may be null
   datapack::count_copy(data.size());
   PyBuffer_Release(&view);
   return arr;
