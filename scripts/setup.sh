@@ -14,6 +14,7 @@ PACKAGES=(
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev libglm-dev libpng-dev libjpeg-dev
   libtinyxml2-dev libjemalloc-dev libopencv-dev python3-onnx python3-opencv
   clang libfuzzer-14-dev
+  python3-grpcio mosquitto libmosquitto-dev
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
