@@ -96,3 +96,36 @@ class EmptyDataPack(DataPack):
     def __init__(self, name, engine_name, type=""):
         DataPack.__init__(self, name, engine_name)
         self._id.dataPackType = type
+
+
+class RawData:
+    """Data without an identifier, as NRP-Core's *RawData classes: what a status function
+    returns to the client. `.data` is a JSON value (JsonRawData) or a protobuf message
+    (the <Package><Message>RawData classes of nrp_core.data.nrp_protobuf)."""
+
+    __slots__ = ("_data",)
+    _type = ""
+
+    def __init__(self, data=None):
+        self._data = data
+
+    @property
+    def data(self):
+        return self._data
+
+    @data.setter
+    def data(self, value):
+        self._data = value
+
+    def __repr__(self):
+        return "%s(%r)" % (type(self).__name__, self._data)
+
+
+class JsonRawData(RawData):
+    """JSON data without an identifier (a dict by default)."""
+
+    __slots__ = ()
+    _type = "json"
+
+    def __init__(self, data=None):
+        RawData.__init__(self, {} if data is None else data)

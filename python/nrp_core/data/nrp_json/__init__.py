@@ -1,5 +1,5 @@
 """JSON datapacks, as in NRP-Core's nrp_core.data.nrp_json."""
 
-from nrp_core._datapacks import DataPackIdentifier, JsonDataPack  # noqa: F401
+from nrp_core._datapacks import DataPackIdentifier, JsonDataPack, JsonRawData  # noqa: F401
 
-__all__ = ["JsonDataPack", "DataPackIdentifier"]
+__all__ = ["JsonDataPack", "JsonRawData", "DataPackIdentifier"]
