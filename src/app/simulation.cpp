@@ -296,7 +296,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
     std::vector<loop::LoadedFunction> functions = load_functions(cfg, interpreter, runtime);
     engines.launch();
     log.info("started " + std::to_string(engines.size()) + " engines");
-    engines.initialize();
+    engines.initialize(log);
     log.info("engines initialized in " +
              std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) + " s");
     run_loop(cfg, run_dir, quiet, log, engines, runtime, functions, figures);
