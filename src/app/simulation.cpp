@@ -222,9 +222,15 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   if (cfg->datapack_processor != "tf")
     log.info("warning: DataPackProcessor " + cfg->datapack_processor +
              " is not available yet; running tf");
+  if (cfg->process_launcher_type != "Basic")
+    log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
+             " is not available; using Basic");
   for (const char* key :
-       {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph"}) {
-    if (cfg->json.contains(key) && !cfg->json[key].empty()) {
+       {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph",
+        "EventLoop", "EventLoopTimeout", "EventLoopTimestep", "ROSNode", "MQTTNode"}) {
+    // An object counts when present ("ROSNode": {} starts a node with the defaults in NRP-Core);
+    // an empty list asks for nothing.
+    if (cfg->json.contains(key) && (!cfg->json[key].empty() || cfg->json[key].is_object())) {
       log.info(std::string("warning: ") + key + " is not supported yet; ignored");
     }
   }

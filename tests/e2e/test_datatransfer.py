@@ -218,6 +218,23 @@ class Files(DataTransferCase):
                              'within 5 s' % address)
         self.check_files(self.dump_files())
 
+    def test_unsupported_nrp_core_keys_warn_once_by_name(self):
+        self.experiment()
+        with open(os.path.join(self.dir, "simulation_config.json")) as f:
+            cfg = json.load(f)
+        cfg.update({"ProcessLauncherType": "Docker", "EventLoop": {"Timeout": 1},
+                    "ROSNode": {}, "MQTTNode": {"MQTTBroker": "localhost:1"},
+                    "EventLoopTimestep": 0.1})
+        cfg["EngineConfigs"][1]["EngineExtraConfigs"] = {}
+        self.write_config(cfg)
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        for needle in ("ProcessLauncherType Docker is not available",
+                       "EventLoop is not supported yet", "EventLoopTimestep is not supported yet",
+                       "ROSNode is not supported yet", "MQTTNode is not supported yet",
+                       "/EngineConfigs/1/EngineExtraConfigs: unknown key"):
+            self.assertEqual(r.stderr.count(needle), 1, "%s: %r" % (needle, r))
+
     def test_same_config_same_files(self):
         self.experiment()
         first = self.run_convoy()
