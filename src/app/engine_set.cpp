@@ -128,7 +128,7 @@ void EngineSet::launch(loop::EngineHandle& handle) {
   handle.attach(transport::make_socket_channel(fds[0]), child);
 }
 
-void EngineSet::initialize() {
+void EngineSet::initialize(RunLog& log) {
   for (auto& e : engines_) {
     engine::Request request;
     auto* init = request.mutable_initialize();
@@ -143,6 +143,8 @@ void EngineSet::initialize() {
   for (auto& e : engines_) {
     engine::Reply reply;
     e->finish(&reply);
+    for (const auto& w : reply.initialize().warnings())
+      log.info("warning: engine '" + e->name() + "': " + w);
   }
 }
 

@@ -22,8 +22,9 @@ class EngineSet {
   // Forks each BasicFork engine (socket, shared-memory arenas) or connects to an
   // EmptyLaunchCommand engine's ServerAddress. Throws UserError or EngineError.
   void launch();
-  // Sends Initialize to every engine, then collects the replies. Throws EngineError.
-  void initialize();
+  // Sends Initialize to every engine, then collects the replies, logging the warnings they
+  // carry. Throws EngineError.
+  void initialize(RunLog& log);
   // Shuts every engine down (see EngineHandle::shutdown), the longer timeout after a clean
   // run. Logs each failure with the engine's last log lines; returns the first one, or "".
   std::string shut_down(bool clean, RunLog& log);

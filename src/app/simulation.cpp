@@ -222,9 +222,15 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   if (cfg->datapack_processor != "tf")
     log.info("warning: DataPackProcessor " + cfg->datapack_processor +
              " is not available yet; running tf");
+  if (cfg->process_launcher_type != "Basic")
+    log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
+             " is not available; using Basic");
   for (const char* key :
-       {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph"}) {
-    if (cfg->json.contains(key) && !cfg->json[key].empty()) {
+       {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph",
+        "EventLoop", "EventLoopTimeout", "EventLoopTimestep", "ROSNode", "MQTTNode"}) {
+    // An object counts when present ("ROSNode": {} starts a node with the defaults in NRP-Core);
+    // an empty list asks for nothing.
+    if (cfg->json.contains(key) && (!cfg->json[key].empty() || cfg->json[key].is_object())) {
       log.info(std::string("warning: ") + key + " is not supported yet; ignored");
     }
   }
@@ -296,7 +302,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
     std::vector<loop::LoadedFunction> functions = load_functions(cfg, interpreter, runtime);
     engines.launch();
     log.info("started " + std::to_string(engines.size()) + " engines");
-    engines.initialize();
+    engines.initialize(log);
     log.info("engines initialized in " +
              std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) + " s");
     run_loop(cfg, run_dir, quiet, log, engines, runtime, functions, figures);

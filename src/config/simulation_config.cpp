@@ -397,6 +397,17 @@ SimulationConfig load_simulation_config(const fs::path& file,
   for (size_t i = 0; have_engines && i < engines.size(); ++i) {
     visit(engine_schemas[i], engines[i], resolve_paths("/EngineConfigs/" + std::to_string(i)));
   }
+  // Strings an engine type's schema marks "x-convoy-file-name" become file names in the run
+  // folder (the data-transfer engine's dumps/name): the same rule as EngineName.
+  for (size_t i = 0; have_engines && i < engines.size(); ++i) {
+    const std::string prefix = "/EngineConfigs/" + std::to_string(i);
+    visit(engine_schemas[i], engines[i], [&](const std::string& pointer, const json& s, json& v) {
+      if (!v.is_string() || !s.value("x-convoy-file-name", false)) return;
+      if (std::string problem = name_problem(v.get<std::string>()); !problem.empty()) {
+        report.add(prefix + pointer, problem);
+      }
+    });
+  }
 
   // Checks the schemas cannot express. Names become file names in the run folder.
   auto check_name = [&](const std::string& pointer, const json& value) {

@@ -6,7 +6,8 @@
 //   <share>/engines/<type>.schema.json       extra keys of one engine type, merged with EngineBase
 //   <share>/engines/<alias>.alias            file whose content is the real type name
 // Properties marked "x-convoy-path" are resolved against the config file's directory;
-// "x-convoy-path-must-exist" makes a missing file an error.
+// "x-convoy-path-must-exist" makes a missing file an error. Strings marked "x-convoy-file-name"
+// (in engine types' schemas) must pass name_problem(), as EngineName does.
 //
 // Every error reads `<config file>: <JSON pointer>: <message>`, for example
 //   simulation_config.json: /EngineConfigs/2/EngineTimestep: must be > 0, got 0

@@ -43,6 +43,9 @@ class Engine {
   virtual bool unchanged(const engine::DataPackId& id) { return false; }
   virtual void reset() {}
   virtual void shutdown() {}
+  // Warnings of initialize (a broker that cannot be reached, say), each once: they go back in
+  // the Initialize reply, and the coordinator shows them with the engine's name.
+  virtual std::vector<std::string> take_warnings() { return {}; }
 };
 
 using EngineFactory = std::function<std::unique_ptr<Engine>()>;

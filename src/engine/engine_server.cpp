@@ -90,6 +90,7 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
         auto ids = engine_.initialize(init.engine_name(), config, init.timestep_ns());
         initialized_ = true;
         for (auto& id : ids) *reply->mutable_initialize()->add_registered() = id;
+        for (auto& w : engine_.take_warnings()) reply->mutable_initialize()->add_warnings(w);
         break;
       }
       case engine::Request::kStep:
