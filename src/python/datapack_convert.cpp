@@ -224,10 +224,10 @@ bool encode_generic(py::handle data, Builder& out) {
 
 py::object message_from_datapack(const View& in, py::handle message_class) {
   const engine::ProtoPayload& payload = in.message().proto();
-  const bool standard =
+  const bool other_type =  // a Gazebo message's standard type, or a wrong one
       in.proto_type() != message_class.attr("DESCRIPTOR").attr("full_name").cast<std::string>();
   // Small messages: Python parses the bytes itself (the cheapest way for a few fields).
-  if (!standard && payload.blob_fields_size() == 0 &&
+  if (!other_type && payload.blob_fields_size() == 0 &&
       payload.data().size() < datapack::kLargeBlobBytes)
     return message_class.attr("FromString")(py::bytes(payload.data()));
   // Large ones are parsed straight into the new message's C++ object (bytes fields copied
