@@ -25,6 +25,11 @@ const PyProtoApi* api() {
     try {
       impl = pybind11::module_::import("google.protobuf.internal.api_implementation");
       if (impl.attr("Type")().cast<std::string>() != "cpp") return nullptr;
+      // The layout above is that of protobuf 3.x (Python 3.x and 4.21); later versions put
+      // another function first.
+      const auto version =
+          pybind11::module_::import("google.protobuf").attr("__version__").cast<std::string>();
+      if (!(version.rfind("3.", 0) == 0 || version.rfind("4.21.", 0) == 0)) return nullptr;
     } catch (pybind11::error_already_set&) {
       return nullptr;
     }
