@@ -1,6 +1,7 @@
 // Fuzzes what arrives from an engine or the coordinator: engine::Request / Reply / DataPack
 // parsed from the input, then every datapack in them read as the receiver would (JSON and its
-// numpy arrays, camera, any registered protobuf type), with the inline blob reader and with
+// numpy arrays, camera, any registered protobuf type, large bytes fields in blobs, NRP-Core's
+// Gazebo messages from the standard types), with the inline blob reader and with
 // transport::ShmBlobReader on a small arena whose offsets and sizes come from the input.
 #include "datapack/proto.h"
 
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <memory>
 
+#include "datapack/nrp.h"
 #include "datapack/registry.h"
 #include "read_datapack.h"
 #include "transport/blobs.h"
@@ -31,6 +33,17 @@ void read_with(const engine::DataPack& dp, const datapack::BlobReader& blobs) {
   try {
     datapack::read_proto(view, m.get());
   } catch (const std::runtime_error&) {
+  }
+  // NRP-Core's Gazebo messages are also read from their standard types (a python_grpc
+  // engine's Gazebo.Camera from a TF's convoy.data.Camera).
+  for (const char* gazebo : {"Gazebo.Camera", "Gazebo.Joint", "Gazebo.Link"}) {
+    if (datapack::standard_type_of(gazebo) != view.proto_type()) continue;
+    std::unique_ptr<google::protobuf::Message> g(
+        datapack::Registry::global().require(gazebo).prototype->New());
+    try {
+      datapack::read_message(view, g.get());
+    } catch (const std::runtime_error&) {
+    }
   }
 }
 

@@ -1,4 +1,8 @@
 // Protobuf datapacks: any registered message (registry.h) in DataPack.proto.
+//
+// A large value (>= kLargeBlobBytes) of a top-level `bytes` field (Image.data, BytesValue.value)
+// travels as a blob, like a camera frame: into the writer's arena between local processes
+// (one copy), inline for remote engines. ProtoPayload.blob_fields says where it goes back.
 #pragma once
 
 #include <google/protobuf/message.h>
@@ -10,11 +14,12 @@
 
 namespace convoy::datapack {
 
-// Sets the payload (and DataPackId.type) to `message`.
+// Sets the payload (and DataPackId.type) to `message`; large bytes values into blobs.
 void write_proto(Builder& out, const google::protobuf::Message& message);
 
-// Parses the payload into `message`. Throws std::runtime_error naming the datapack when it
-// holds another type, or bytes that do not parse.
+// Parses the payload into `message` (large bytes values copied from their blobs). Throws
+// std::runtime_error naming the datapack when it holds another type, bytes that do not
+// parse, or blob references that do not fit the message.
 void read_proto(const View& in, google::protobuf::Message* message);
 
 template <typename M>

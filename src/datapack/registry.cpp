@@ -67,6 +67,7 @@ const TypeInfo& Registry::add(const pb::Descriptor* descriptor, const pb::Messag
   auto& slot = types_[descriptor->full_name()];
   if (!slot) slot = std::make_unique<TypeInfo>();
   slot->name = descriptor->full_name();
+  slot->named_class = !python_class.empty();
   slot->python_class = python_class.empty() ? default_python_class(descriptor) : python_class;
   slot->descriptor = descriptor;
   slot->prototype = prototype;

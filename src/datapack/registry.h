@@ -28,6 +28,9 @@ struct TypeInfo {
   // The nrp_core.data.nrp_protobuf class of its datapacks ("GazeboCameraDataPack"); by
   // default NRP-Core's rule: the package's parts capitalised, the message name, "DataPack".
   std::string python_class;
+  // python_class was given at registration: when two types share a class name (the standard
+  // convoy.data.Camera and NRP-Core's Gazebo.Camera), Python's name lookup takes this one.
+  bool named_class = false;
   const google::protobuf::Descriptor* descriptor = nullptr;
   const google::protobuf::Message* prototype = nullptr;
 };

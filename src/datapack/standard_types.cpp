@@ -1,5 +1,6 @@
 // The protobuf datapack types every Convoy program knows. One line per type.
 #include "convoy/datapacks.pb.h"
+#include "datapack/nrp.h"
 #include "datapack/registry.h"
 
 namespace convoy::datapack {
@@ -9,6 +10,10 @@ void register_standard_types(Registry& r) {
   r.add<data::Camera>("GazeboCameraDataPack");
   r.add<data::Joint>("GazeboJointDataPack");
   r.add<data::Link>("GazeboLinkDataPack");
+  // NRP-Core's message set (datapack/nrp.h): Dump, EngineTest, Gazebo, NrpGenericProto,
+  // Wrappers. Gazebo.Camera / Joint / Link travel as the three above, whose Python classes
+  // keep the names GazeboCameraDataPack... (Registry::add: a named class wins).
+  register_nrp_packages(r);
 }
 
 }  // namespace convoy::datapack

@@ -4,24 +4,52 @@
 #include <pybind11/numpy.h>
 
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <unordered_map>
 
 #include "convoy/datapacks.pb.h"
 #include "datapack/camera.h"
 #include "datapack/json.h"
+#include "datapack/nrp.h"
 #include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "python/msgpack_codec.h"
+#include "python/proto_api.h"
 
 // What Python sees of the datapack registry (nrp_core.data.nrp_protobuf builds its classes
 // from it).
 PYBIND11_EMBEDDED_MODULE(_convoy_datapack, m) {
   using convoy::datapack::Registry;
+  // Python class name -> type name. Where two types share a class name, the one named at
+  // registration wins (GazeboCameraDataPack is convoy.data.Camera, not Gazebo.Camera).
   m.def("types", [] {
     pybind11::dict out;
-    for (const auto* t : Registry::global().all()) out[pybind11::str(t->python_class)] = t->name;
+    for (const auto* t : Registry::global().all()) {
+      pybind11::str cls(t->python_class);
+      if (!t->named_class && out.contains(cls)) continue;
+      out[cls] = t->name;
+    }
+    for (const auto* t : Registry::global().all())
+      if (t->named_class) out[pybind11::str(t->python_class)] = t->name;
     return out;
+  });
+  // The same for RawData classes: here the type with the default (NRP-Core) name wins
+  // (GazeboCameraRawData holds a Gazebo.Camera, as in NRP-Core).
+  m.def("raw_types", [] {
+    pybind11::dict out;
+    for (const auto* t : Registry::global().all()) {
+      pybind11::str cls(t->python_class);
+      if (t->named_class && out.contains(cls)) continue;
+      out[cls] = t->name;
+    }
+    for (const auto* t : Registry::global().all())
+      if (!t->named_class) out[pybind11::str(t->python_class)] = t->name;
+    return out;
+  });
+  // The .proto file a type comes from ("nrp_protobuf/dump.proto").
+  m.def("proto_file", [](const std::string& type) {
+    return Registry::global().add_by_name(type).descriptor->file()->name();
   });
   m.def("python_class",
         [](const std::string& type) { return Registry::global().add_by_name(type).python_class; });
@@ -175,8 +203,8 @@ py::object proto_data(const View& in, ImageAccess access) {
   if (auto it = converters().find(type); it != converters().end())
     return it->second.to_data(in, access);
   try {
-    const std::string& bytes = in.message().proto().data();
-    return generic_class(type).attr("_message").attr("FromString")(py::bytes(bytes));
+    const py::object& cls = generic_class(type).attr("_message");
+    return message_from_datapack(in, cls);
   } catch (py::error_already_set& e) {
     throw std::runtime_error(in.describe() + " holds protobuf type " + type +
                              ", which Python cannot decode: " + e.what());
@@ -188,17 +216,47 @@ bool encode_generic(py::handle data, Builder& out) {
   if (!PyObject_HasAttrString(reinterpret_cast<PyObject*>(Py_TYPE(data.ptr())), "DESCRIPTOR") ||
       !py::hasattr(data, "SerializeToString"))
     return false;
-  const std::string type = data.attr("DESCRIPTOR").attr("full_name").cast<std::string>();
-  datapack::Registry::global().add_by_name(type);
-  auto* dp = out.message();
-  dp->mutable_id()->set_type(type);
-  auto* payload = dp->mutable_proto();
-  payload->set_type_name(type);
-  payload->set_data(data.attr("SerializeToString")().cast<std::string>());
+  message_to_datapack(data, out);
   return true;
 }
 
 }  // namespace
+
+py::object message_from_datapack(const View& in, py::handle message_class) {
+  const engine::ProtoPayload& payload = in.message().proto();
+  const bool other_type =  // a Gazebo message's standard type, or a wrong one
+      in.proto_type() != message_class.attr("DESCRIPTOR").attr("full_name").cast<std::string>();
+  // Small messages: Python parses the bytes itself (the cheapest way for a few fields).
+  if (!other_type && payload.blob_fields_size() == 0 &&
+      payload.data().size() < datapack::kLargeBlobBytes)
+    return message_class.attr("FromString")(py::bytes(payload.data()));
+  // Large ones are parsed straight into the new message's C++ object (bytes fields copied
+  // once, from their blobs).
+  py::object msg = message_class();
+  if (google::protobuf::Message* m = mutable_cpp_message(msg)) {
+    datapack::read_message(in, m);
+    return msg;
+  }
+  const datapack::TypeInfo& t = datapack::Registry::global().add_by_name(
+      msg.attr("DESCRIPTOR").attr("full_name").cast<std::string>());
+  std::unique_ptr<google::protobuf::Message> tmp(t.prototype->New());
+  datapack::read_message(in, tmp.get());
+  return message_class.attr("FromString")(py::bytes(tmp->SerializeAsString()));
+}
+
+void message_to_datapack(py::handle message, Builder& out) {
+  if (const google::protobuf::Message* m = cpp_message(message)) {
+    datapack::Registry::global().add_by_name(m->GetDescriptor()->full_name());
+    datapack::write_message(out, *m);
+    return;
+  }
+  const std::string type = message.attr("DESCRIPTOR").attr("full_name").cast<std::string>();
+  const datapack::TypeInfo& t = datapack::Registry::global().add_by_name(type);
+  std::unique_ptr<google::protobuf::Message> tmp(t.prototype->New());
+  if (!tmp->ParseFromString(message.attr("SerializeToString")().cast<std::string>()))
+    throw std::runtime_error("cannot re-read a " + type + " message");
+  datapack::write_message(out, *tmp);
+}
 
 py::object decode_json(const std::string& msgpack, const View* owner) {
   PyObject* v = msgpack_decode(msgpack, owner);

@@ -38,4 +38,13 @@ void from_python(py::handle datapack, datapack::Builder& out);
 // Data only (a JSON value or a protobuf data object) into `out`, whose id is set.
 void data_from_python(py::handle data, datapack::Builder& out);
 
+// A Python protobuf message of `message_class` read from a protobuf datapack of its type (or,
+// for NRP-Core's Gazebo messages, of their standard type: datapack/nrp.h). Throws
+// std::runtime_error (datapack errors) or py::error_already_set.
+py::object message_from_datapack(const datapack::View& in, py::handle message_class);
+// A Python protobuf message into `out` (id set): registered by its full name, Gazebo messages
+// as their standard types, large bytes fields into blobs. Throws std::invalid_argument for a
+// type Convoy does not know.
+void message_to_datapack(py::handle message, datapack::Builder& out);
+
 }  // namespace convoy::python

@@ -15,6 +15,8 @@ Interpreter::Interpreter() {
   // Engines and TFs print progress; flush it line by line into the logs.
   setenv("PYTHONUNBUFFERED", "1", 0);
   guard_ = std::make_unique<py::scoped_interpreter>(false);
+  // NRP-Core's generated protobuf modules (nrp_protobuf.dump_pb2...), made by the build.
+  add_path(CONVOY_PYTHON_GEN_DIR);
   add_path(package_dir());
 }
 

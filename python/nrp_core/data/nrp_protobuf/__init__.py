@@ -11,11 +11,18 @@ frame (no copy): copy it (image_data.copy()) to change it or keep it beyond the 
 
 Every other protobuf message registered in Convoy's datapack registry (src/datapack) has a
 datapack class here too, made on first use: `<Package><Message>DataPack` by NRP-Core's rule
-(or the name given at registration), whose .data is a message of Debian's Python protobuf.
+(or the name given at registration), whose .data is a message of Debian's Python protobuf,
+and a `<Package><Message>RawData` class (what status functions return), whose .data is the
+message alone. NRP-Core's message set (Dump, EngineTest, Gazebo, NrpGenericProto, Wrappers)
+is always registered: DumpStringDataPack, NrpGenericProtoImageDataPack,
+WrappersBoolValueDataPack, EngineTestTestPayloadRawData... Their .data is an instance of the
+class that `from nrp_protobuf import dump_pb2` gives engines (dump_pb2.String).
 """
+import importlib
+
 import numpy as np
 
-from nrp_core._datapacks import DataPack, DataPackIdentifier  # noqa: F401
+from nrp_core._datapacks import DataPack, DataPackIdentifier, RawData  # noqa: F401
 
 
 def _alias(name):
@@ -125,8 +132,30 @@ def _registry():
     return _convoy_datapack
 
 
+def _module_class(type_name):
+    """The class of the generated module (nrp_protobuf.dump_pb2.String) of a type compiled
+    from proto/nrp_protobuf, so that TFs, engines and user code share one class."""
+    file_name = _registry().proto_file(type_name)
+    if not (file_name.startswith("nrp_protobuf/") and file_name.endswith(".proto")):
+        return None
+    module = importlib.import_module(file_name[:-len(".proto")].replace("/", ".") + "_pb2")
+    from google.protobuf import descriptor_pool
+    names = []
+    d = descriptor_pool.Default().FindMessageTypeByName(type_name)
+    while d is not None:
+        names.insert(0, d.name)
+        d = d.containing_type
+    cls = module
+    for n in names:
+        cls = getattr(cls, n)
+    return cls
+
+
 def _message_class(type_name):
     """The Python protobuf class of a registered message, built from Convoy's descriptors."""
+    cls = _module_class(type_name)
+    if cls is not None:
+        return cls
     from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
     pool = descriptor_pool.Default()
     try:
@@ -165,14 +194,55 @@ def _datapack_class(type_name):
     return cls
 
 
+class ProtobufRawData(RawData):
+    """A protobuf message without an identifier (what a status function returns): .data is
+    the message (mutable in place)."""
+
+    __slots__ = ()
+    _message = None  # the message class, set on each subclass
+
+    def __init__(self, data=None):
+        RawData.__init__(self, self._message() if data is None else data)
+
+
+_raw_classes = {}  # type name -> RawData class
+
+
+def _raw_data_class(type_name, name):
+    cls = _raw_classes.get(type_name)
+    if cls is None:
+        cls = type(name, (ProtobufRawData,),
+                   {"__slots__": (), "_type": type_name, "_message": _message_class(type_name)})
+        _raw_classes[type_name] = cls
+    return cls
+
+
 def __getattr__(name):
-    # `from nrp_core.data.nrp_protobuf import RoadUserDataPack`: any registered type's class.
+    # `from nrp_core.data.nrp_protobuf import RoadUserDataPack`: any registered type's class;
+    # `...RawData`: its RawData class.
     registry = _registry()
-    type_name = registry.types().get(name) if registry is not None else None
-    if type_name is None:
-        raise AttributeError("module %r has no attribute %r" % (__name__, name))
-    return _datapack_class(type_name)
+    if registry is not None:
+        if name.endswith("RawData"):
+            type_name = registry.raw_types().get(name[:-len("RawData")] + "DataPack")
+            if type_name is not None:
+                return _raw_data_class(type_name, name)
+        else:
+            type_name = registry.types().get(name)
+            if type_name is not None:
+                return _datapack_class(type_name)
+    raise AttributeError("module %r has no attribute %r" % (__name__, name))
 
 
-__all__ = ["GazeboCameraDataPack", "GazeboJointDataPack", "GazeboLinkDataPack", "CameraData",
-           "JointData", "LinkData", "DataPackIdentifier", "ProtobufDataPack", "datapack_class"]
+def _all_names():
+    names = ["GazeboCameraDataPack", "GazeboJointDataPack", "GazeboLinkDataPack", "CameraData",
+             "JointData", "LinkData", "DataPackIdentifier", "ProtobufDataPack", "ProtobufRawData",
+             "datapack_class"]
+    registry = _registry()
+    if registry is not None:  # `from nrp_core.data.nrp_protobuf import *` gives every class
+        names += sorted(n for n in registry.types() if n not in names)
+        names += sorted(n[:-len("DataPack")] + "RawData" for n in registry.raw_types()
+                        if n.endswith("DataPack"))
+    return names
+
+
+__all__ = _all_names()
