@@ -120,13 +120,14 @@ const char* NrpServer::name(State s) {
 }
 
 void NrpServer::listen(const std::string& address, bool insecure) {
-  transport::ServerSecurity security;
-  security.insecure = insecure;
-  try {
-    transport::check_listening_policy(address, security);
-  } catch (const std::invalid_argument& e) {
-    throw UserError(std::string("--server_address: ") + e.what());
+  if (!insecure && !transport::is_loopback_address(address)) {
+    throw UserError("--server_address " + address +
+                    " is not a loopback address: the NRP-Core server has neither TLS nor a "
+                    "token, so anyone who reaches it could step the simulation and feed it "
+                    "datapacks. Listen on localhost (127.0.0.1), or say --insecure");
   }
+  if (insecure && !transport::is_loopback_address(address))
+    log_.info("warning: --insecure: serving at " + address + " without TLS or token");
   grpc::ServerBuilder builder;
   int port = 0;
   builder.AddListeningPort(address, grpc::InsecureServerCredentials(), &port);
