@@ -265,7 +265,8 @@ class NrpCore:
 
     def stop(self):
         """Stops a run_loop / run_until_timeout in progress (between two loop cycles)."""
-        self._call("stopLoop", _pb.EmptyMessage())
+        # Its answer ("Running") may come after the run's own ("Stopped"): it changes nothing.
+        self._call("stopLoop", _pb.EmptyMessage(), keep_state=True)
 
     def reset(self):
         """Sends the datapacks set with set_*_datapack() to their engines, resets the
@@ -347,7 +348,7 @@ class NrpCore:
         t.start()
         return t
 
-    def _call(self, method, request):
+    def _call(self, method, request, keep_state=False):
         what = {"runLoop": "run_loop()", "runUntilTimeout": "run_until_timeout()",
                 "stopLoop": "stop()"}.get(method, method + "()")
         if self._closed:
@@ -365,8 +366,9 @@ class NrpCore:
                                       (what, self._server.describe_exit())) from None
             raise ConnectionError("%s: NRPCoreSim at %s: %s (%s)" %
                                   (what, self._address, e.details(), code.name)) from None
-        self._sim_state = response.simState.currentState
-        if self._sim_state == "Failed":
+        if not keep_state:
+            self._sim_state = response.simState.currentState
+        if response.simState.currentState == "Failed":
             raise NrpCoreError("%s failed: %s\nThe only possible action now is shutdown()." %
                                (what, response.simState.errorMsg))
         return response

@@ -171,10 +171,18 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   return kExitOk;
 }
 
+// The functions see what the engines see (engine_set.cpp): the run folder and the share
+// folder. Before the interpreter starts, which copies the environment into os.environ.
+void export_run_environment(const fs::path& run_dir) {
+  setenv("CONVOY_RUN_DIR", run_dir.c_str(), 1);
+  setenv("CONVOY_SHARE_DIR", share_dir().c_str(), 0);
+}
+
 // The run proper, with the interpreter up: load the functions, launch and initialize the
 // engines, run the loop; then shut the engines down, whatever happened before.
 Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet,
                     RunLog& log, LoopFigures* figures) {
+  export_run_environment(run_dir);
   python::Interpreter interpreter;
   Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
@@ -251,6 +259,7 @@ int serve_simulation(const RunOptions& options) {
   Outcome outcome;
   LoopFigures figures;
   {
+    export_run_environment(run_dir);
     python::Interpreter interpreter;
     NrpServer server(cfg, run_dir, log);
     try {

@@ -316,3 +316,21 @@ class GeneratedCode(E2ETestCase):
                              "protoc --proto_path=proto --python_out=/tmp "
                              "proto/convoy/nrp_server.proto && cp /tmp/convoy/nrp_server_pb2.py "
                              "python/nrp_client/")
+
+
+class RLExample(E2ETestCase):
+    def test_drives_the_car_step_by_step_and_resets_between_episodes(self):
+        script = os.path.join(REPO, "experiments", "rl_parkring", "rl_drive.py")
+        env = dict(os.environ, CONVOY_RUNS_DIR=os.path.join(self.dir, "runs"))
+        r = subprocess.run([sys.executable, script, "--steps", "500", "--gains", "0.05", "1.2",
+                            "-q"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                           timeout=240, env=env)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertIn("the car's link at [0.0, -1.7, 0.6]", r.stdout)
+        returns = [line for line in r.stdout.splitlines() if line.startswith("  return")]
+        self.assertEqual(len(returns), 2, r.stdout)
+        # the sluggish gain leaves the track at the first bend; the other one stays on it
+        self.assertIn("left the track", returns[0])
+        self.assertNotIn("left the track", returns[1])
+        self.assertIn("after 500 steps (25.0 s simulated", returns[1])
+        self.assertIn("best steering gain 1.20", r.stdout)
