@@ -68,11 +68,11 @@ class GazeboEngine final : public Engine {
       if (m.contains("InitPose")) insert.pose = pose_from_json(m["InitPose"]);
       extra.push_back(insert);
     }
-    rng_.seed(config.value("GazeboRNGSeed", 0u));
+    seed_ = config.value("GazeboRNGSeed", 0u);
+    rng_.seed(seed_);
     desc_ = world::load_world(file, extra);
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
-    cameras_ =
-        std::make_unique<world::CameraSensors>(desc_, *physics_, config.value("GazeboRNGSeed", 0u));
+    cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
 
     std::vector<engine::DataPackId> ids;
     auto add = [&](const std::string& dp_name, const std::string& type) {
@@ -89,7 +89,8 @@ class GazeboEngine final : public Engine {
           if (index < 0)
             throw std::runtime_error("joint '" + pid.joint + "' has no degree of freedom");
           controllers_.push_back({index, pid.velocity, pid.target,
-                                  world::JointPid(pid.p, pid.i, pid.d, pid.i_max, pid.i_min), 0});
+                                  world::JointPid(pid.p, pid.i, pid.d, pid.i_max, pid.i_min), 0,
+                                  pid.target});
           std::string short_name = pid.joint.substr(model.name.size() + 2);
           for (const std::string& n : {plugin + "::" + short_name, pid.joint}) {
             joint_dps_[n] = controllers_.size() - 1;
@@ -122,6 +123,25 @@ class GazeboEngine final : public Engine {
     }
     cameras_->update(0.0);
     return ids;
+  }
+
+  // The world as loaded: the models at their initial poses, the joint controllers at their
+  // SDF targets, the clock and the camera noise from the start. The description is kept, so
+  // the physics world and the cameras are made again from it (same indices, same datapacks).
+  void reset() override {
+    cameras_.reset();
+    physics_ = std::make_unique<world::PhysicsWorld>(desc_);
+    cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
+    for (auto& c : controllers_) {
+      c.target = c.initial_target;
+      c.feed_forward = 0;
+      c.pid.reset();
+    }
+    rng_.seed(seed_);
+    time_ns_ = 0;
+    physics_steps_ = 0;
+    sent_frames_.clear();
+    cameras_->update(0.0);
   }
 
   int64_t step(int64_t duration_ns) override {
@@ -206,6 +226,7 @@ class GazeboEngine final : public Engine {
     double target;
     world::JointPid pid;
     double feed_forward;
+    double initial_target;  // the SDF's Target
   };
   std::string name_;
   world::WorldDesc desc_;
@@ -217,6 +238,7 @@ class GazeboEngine final : public Engine {
   std::unordered_map<std::string, size_t> joint_dps_;
   std::unordered_map<std::string, int> link_dps_;
   std::mt19937_64 rng_;
+  unsigned seed_ = 0;
   int64_t time_ns_ = 0;
   int64_t physics_steps_ = 0;
   std::unordered_map<std::string, uint64_t>

@@ -85,7 +85,11 @@ class PythonJsonEngine final : public Engine {
     python::data_from_python(data, out);
   }
 
-  void reset() override { call("reset"); }
+  // As NRP-Core's python_json server: the script's reset(), then its clock back to 0.
+  void reset() override {
+    call("reset");
+    script_.attr("_time_ns") = 0;
+  }
 
   void shutdown() override {
     if (script_) call("shutdown");

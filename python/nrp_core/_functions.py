@@ -1,19 +1,21 @@
 """Decorators that declare transceiver, preprocessing and status functions.
 
-Decorators run bottom-up, so input decorators (@EngineDataPack, @PreprocessedDataPack) may
-sit above or below @TransceiverFunction / @PreprocessingFunction: inputs declared on the
-bare function are kept until the function decorator wraps it."""
+Decorators run bottom-up, so input decorators (@EngineDataPack, @PreprocessedDataPack,
+@SimulationIteration, @SimulationTime) may sit above or below @TransceiverFunction /
+@PreprocessingFunction / @StatusFunction: inputs declared on the bare function are kept until
+the function decorator wraps it."""
 
 _registered = []  # filled while the coordinator executes one function file
 
 
 class _Input:
-    __slots__ = ("keyword", "id", "preprocessed")
+    __slots__ = ("keyword", "id", "preprocessed", "kind")
 
-    def __init__(self, keyword, id, preprocessed):
+    def __init__(self, keyword, id, preprocessed, kind="datapack"):
         self.keyword = keyword
         self.id = id
         self.preprocessed = preprocessed
+        self.kind = kind  # "datapack", "iteration" or "time"
 
 
 class _Function:
@@ -48,12 +50,27 @@ class _Preprocessing(_Function):
     kind = "PreprocessingFunction"
 
 
-def _input_decorator(keyword, id, preprocessed):
+class _Status(_Function):
+    """The status function: linked to no engine, run after the transceiver functions of
+    every loop cycle. It returns (done, [data]): done ends the run (standalone) or the
+    client's run_until_timeout(); the data (RawData or datapacks) go to the client."""
+    kind = "StatusFunction"
+
+    def __init__(self, function):
+        _Function.__init__(self, "", function)
+
+
+def _check_keyword(keyword, what):
     if not isinstance(keyword, str):
-        raise TypeError("datapack keyword must be a string, got %r" % (keyword,))
-    if not hasattr(id, "dataPackName"):
-        raise TypeError("id must be a DataPackIdentifier, got %r" % (id,))
-    inp = _Input(keyword, id, preprocessed)
+        raise TypeError("%s keyword must be a string, got %r" % (what, keyword))
+
+
+def _input_decorator(keyword, id, preprocessed, kind="datapack"):
+    if kind == "datapack":
+        _check_keyword(keyword, "datapack")
+        if not hasattr(id, "dataPackName"):
+            raise TypeError("id must be a DataPackIdentifier, got %r" % (id,))
+    inp = _Input(keyword, id, preprocessed, kind)
 
     def wrap(target):
         if isinstance(target, _Function):
@@ -89,3 +106,22 @@ def PreprocessingFunction(engine_name):
     """Declares a preprocessing function of `engine_name`: its inputs come from that engine
     only, and the datapacks it returns stay in the coordinator's local cache."""
     return lambda function: _Preprocessing(engine_name, function)
+
+
+def SimulationIteration(keyword):
+    """Passes the number of the loop cycle (0 for the first) as argument `keyword`."""
+    _check_keyword(keyword, "SimulationIteration")
+    return _input_decorator(keyword, None, False, "iteration")
+
+
+def SimulationTime(keyword):
+    """Passes the simulated time of the loop cycle, in nanoseconds, as argument `keyword`."""
+    _check_keyword(keyword, "SimulationTime")
+    return _input_decorator(keyword, None, False, "time")
+
+
+def StatusFunction():
+    """Declares the status function (config key StatusFunction; at most one). It returns a
+    tuple (done, [data]): done (a bool) ends the run cleanly when true; data are RawData
+    objects (e.g. JsonRawData) or datapacks, which a client of the NRP-Core server receives."""
+    return lambda function: _Status(function)

@@ -1,5 +1,8 @@
 // convoy: the coordinator's command line. Also installed as NRPCoreSim, which behaves like
 // `convoy run` and takes NRP-Core's options.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -21,8 +24,40 @@ void usage(const char* prog) {
       "  --run-dir DIR       where to write logs, steps.csv and summary.json\n"
       "                      (default: ./runs/<SimulationName>-<time>-<pid>, or under "
       "$CONVOY_RUNS_DIR)\n"
-      "  -q, --quiet         only errors on the terminal\n",
+      "  -q, --quiet         only errors on the terminal\n"
+      "  -d, --dir FOLDER    the experiment folder: work there, -c is relative to it\n"
+      "  -m, --mode MODE     standalone (default) or server: serve the simulation to a\n"
+      "                      Python client (python/nrp_client) at --server_address\n"
+      "  --server_address HOST:PORT   where the server listens (loopback addresses only,\n"
+      "                      unless --insecure)\n"
+      "  --slave             started by a client: ignore Ctrl-C, end when the client ends\n"
+      "  --logoutput all|engines|silent   all: this program's output into --logfilename;\n"
+      "                      silent: none; engines: (engines log into the run folder anyway)\n"
+      "  --logfilename FILE  default .console_output.log\n",
       prog);
+}
+
+// NRP-Core's --logoutput: `all` sends this program's stdout and stderr to `file`, `silent` to
+// /dev/null. Returns false (after saying why) when that is impossible.
+bool redirect_output(const std::string& mode, const std::string& file) {
+  if (mode == "engines") return true;  // each engine logs into the run folder
+  if (mode != "all" && mode != "silent") {
+    std::fprintf(stderr, "error: --logoutput must be all, engines or silent, got '%s'\n",
+                 mode.c_str());
+    return false;
+  }
+  const std::string target = mode == "silent" ? "/dev/null" : file;
+  int fd = open(target.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    std::fprintf(stderr, "error: --logfilename %s: %s\n", target.c_str(), std::strerror(errno));
+    return false;
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  dup2(fd, STDOUT_FILENO);
+  dup2(fd, STDERR_FILENO);
+  close(fd);
+  return true;
 }
 
 }  // namespace
@@ -44,9 +79,20 @@ int main(int argc, char** argv) {
     i = 2;
   }
   convoy::app::RunOptions options;
+  std::string mode = "standalone", dir, log_output, log_filename = ".console_output.log";
   for (; i < argc; ++i) {
     std::string a = argv[i];
+    std::string inline_value;  // --key=value
+    bool has_inline = false;
+    if (a.rfind("--", 0) == 0) {
+      if (size_t eq = a.find('='); eq != std::string::npos) {
+        inline_value = a.substr(eq + 1);
+        a = a.substr(0, eq);
+        has_inline = true;
+      }
+    }
     auto value = [&]() -> std::string {
+      if (has_inline) return inline_value;
       if (i + 1 >= argc) {
         std::fprintf(stderr, "error: %s needs a value\n", a.c_str());
         std::exit(2);
@@ -61,7 +107,25 @@ int main(int argc, char** argv) {
       options.run_dir = value();
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
-    else if (a == "-h" || a == "--help") {
+    else if (a == "-d" || a == "--dir")
+      dir = value();
+    else if (a == "-m" || a == "--mode")
+      mode = value();
+    else if (a == "--server_address")
+      options.server_address = value();
+    else if (a == "--slave")
+      options.slave = true;
+    else if (a == "--insecure")
+      options.insecure = true;
+    else if (a == "--logoutput")
+      log_output = value();
+    else if (a == "--logfilename")
+      log_filename = value();
+    else if (a == "--cloglevel" || a == "--floglevel" || a == "--logdir" || a == "-p" ||
+             a == "--plugins") {
+      std::fprintf(stderr, "warning: NRP-Core's option %s is accepted and ignored\n", a.c_str());
+      value();
+    } else if (a == "-h" || a == "--help") {
       usage(prog.c_str());
       return 0;
     } else {
@@ -70,9 +134,33 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  if (!dir.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec)) {
+      std::fprintf(stderr, "error: -d %s: not a directory\n", dir.c_str());
+      return 2;
+    }
+    std::filesystem::current_path(dir, ec);
+    if (ec) {
+      std::fprintf(stderr, "error: -d %s: %s\n", dir.c_str(), ec.message().c_str());
+      return 2;
+    }
+  }
+  if (!log_output.empty() && !redirect_output(log_output, log_filename)) return 2;
+  if (mode == "server") {
+    options.server = true;
+    if (options.server_address.empty()) {
+      std::fprintf(stderr, "error: -m server needs --server_address HOST:PORT\n");
+      return 2;
+    }
+  } else if (mode != "standalone") {
+    std::fprintf(stderr, "error: -m must be standalone or server, got '%s'\n", mode.c_str());
+    return 2;
+  }
   if (options.config_file.empty()) {
     std::fprintf(stderr, "error: no config given (-c simulation_config.json)\n");
     return 2;
   }
-  return convoy::app::run_simulation(options);
+  return options.server ? convoy::app::serve_simulation(options)
+                        : convoy::app::run_simulation(options);
 }

@@ -14,7 +14,9 @@
 #include <sstream>
 
 #include "app/engine_set.h"
+#include "app/nrp_server.h"
 #include "app/run_log.h"
+#include "app/session.h"
 #include "config/simulation_config.h"
 #include "core/clock.h"
 #include "core/error.h"
@@ -58,13 +60,16 @@ void raise_file_limit() {
   setrlimit(RLIMIT_NOFILE, &limit);
 }
 
-void install_signal_handlers() {
+void install_signal_handlers(bool ignore_sigint = false) {
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;  // no SA_RESTART: blocking waits return and see the flag
-  sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  if (ignore_sigint)
+    signal(SIGINT, SIG_IGN);  // a client's process: Ctrl-C in its terminal is the client's
+  else
+    sigaction(SIGINT, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
 }
 
@@ -81,71 +86,6 @@ fs::path make_run_dir(const RunOptions& options, const std::string& sim_name) {
   fs::create_directories(dir / "logs");
   return fs::absolute(dir);
 }
-
-// Checks that every function names engines that exist, and PF inputs are their own engine's.
-void check_functions(const std::vector<loop::LoadedFunction>& functions,
-                     const config::SimulationConfig& cfg) {
-  std::set<std::string> engines;
-  std::string list;
-  for (const auto& e : cfg.engines) {
-    engines.insert(e.name);
-    list += (list.empty() ? "" : ", ") + e.name;
-  }
-  for (const auto& fn : functions) {
-    const char* deco = fn.preprocessing ? "@PreprocessingFunction" : "@TransceiverFunction";
-    if (!engines.count(fn.engine)) {
-      throw UserError(fn.file.string() + ": " + deco + "(\"" + fn.engine + "\") in function '" +
-                      fn.name + "' names an unknown engine (engines: " + list + ")");
-    }
-    for (const auto& in : fn.inputs) {
-      if (!engines.count(in.engine)) {
-        throw UserError(fn.file.string() + ": input '" + in.keyword + "' of function '" + fn.name +
-                        "' reads datapack '" + in.datapack + "' from unknown engine '" + in.engine +
-                        "' (engines: " + list + ")");
-      }
-      if (fn.preprocessing && !in.preprocessed && in.engine != fn.engine) {
-        throw UserError(fn.file.string() + ": preprocessing function '" + fn.name +
-                        "' may only read datapacks of its engine '" + fn.engine + "', not '" +
-                        in.engine + "'");
-      }
-    }
-  }
-}
-
-// How a run ended: its exit code and, unless it went well, why.
-struct Outcome {
-  int code = kExitOk;
-  std::string error;
-};
-
-std::string interrupted_text() {
-  return "interrupted by signal " + std::to_string(interrupt_signal().load());
-}
-
-// The exit code of a run that a step ended by throwing `thrown`.
-Outcome outcome_of(std::exception_ptr thrown) {
-  try {
-    std::rethrow_exception(thrown);
-  } catch (const UserError& e) {
-    return {kExitUserError, e.what()};
-  } catch (const EngineError& e) {
-    // Ctrl-C while waiting for an engine: the engine did nothing wrong.
-    if (interrupted()) return {kExitInterrupted, interrupted_text()};
-    return {kExitEngineError, e.what()};
-  } catch (const FunctionError& e) {
-    return {kExitFunctionError, e.what()};
-  } catch (const std::exception& e) {
-    return {kExitInternal, e.what()};
-  }
-}
-
-// What the loop did, kept after it and the functions it ran are gone.
-struct LoopFigures {
-  bool ran = false;  // the loop was set up
-  uint64_t cycles = 0;
-  int64_t sim_time_ns = 0;
-  double wall_s = 0;  // from prime() on: start-up and shutdown not counted
-};
 
 // Copies of frame-sized payloads (datapack::large_copies()) made by each process of the run:
 // the coordinator's own, and each engine's, which it prints last in its log on exit.
@@ -182,6 +122,7 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   // The loop alone, without start-up and shutdown: simulated over wall-clock time.
   j["loop_wall_s"] = loop.wall_s;
   j["real_time_factor"] = loop.wall_s > 0 ? sim_s / loop.wall_s : 0.0;
+  if (cfg.status_function && cfg.status_function->active) j["status_function_done"] = loop.done;
   j["frame_copies"] = frame_copies(cfg, file.parent_path());
   std::ofstream(file) << j.dump(2) << "\n";
 }
@@ -226,7 +167,7 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
     log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
              " is not available; using Basic");
   for (const char* key :
-       {"StatusFunction", "ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph",
+       {"ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph",
         "EventLoop", "EventLoopTimeout", "EventLoopTimestep", "ROSNode", "MQTTNode"}) {
     // An object counts when present ("ROSNode": {} starts a node with the defaults in NRP-Core);
     // an empty list asks for nothing.
@@ -237,86 +178,36 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   return kExitOk;
 }
 
-// The active functions, before any engine starts (a broken file costs no start-up).
-std::vector<loop::LoadedFunction> load_functions(const config::SimulationConfig& cfg,
-                                                 python::Interpreter& interpreter,
-                                                 python::FunctionRuntime& runtime) {
-  std::vector<loop::LoadedFunction> functions;
-  for (const auto& f : cfg.functions) {
-    if (!f.active) continue;
-    interpreter.add_path(f.file.parent_path());
-    for (auto& fn : runtime.load(f.name, f.file)) functions.push_back(std::move(fn));
-  }
-  check_functions(functions, cfg);
-  return functions;
-}
-
-// The loop, until SimulationTimeout or an interrupt. Fills `figures` however it ends.
-void run_loop(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet, RunLog& log,
-              EngineSet& engines, loop::FunctionRunner& runner,
-              const std::vector<loop::LoadedFunction>& functions, LoopFigures* figures) {
-  loop::FtiLoop fti(engines.handles(), runner, functions);
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> csv(
-      std::fopen((run_dir / "steps.csv").c_str(), "w"), &std::fclose);
-  if (csv) std::setvbuf(csv.get(), nullptr, _IOFBF, 1 << 20);
-  fti.set_step_log(csv.get());
-  if (!quiet) {
-    auto start = SteadyClock::now();
-    fti.set_progress(5.0, [&log, start, timeout = cfg.timeout_ns](int64_t sim_ns) {
-      double wall = std::chrono::duration<double>(SteadyClock::now() - start).count();
-      std::ostringstream s;
-      s.precision(1);
-      s << std::fixed << "progress: simulated " << sim_ns * 1e-9 << " s";
-      if (timeout > 0) s << " of " << timeout * 1e-9 << " s";
-      s << " (" << sim_ns * 1e-9 / wall << "x real time)";
-      log.info(s.str());
-    });
-  }
-  figures->ran = true;
-  const auto start = SteadyClock::now();
-  auto record = [&] {
-    figures->cycles = fti.cycles();
-    figures->sim_time_ns = fti.sim_time_ns();
-    figures->wall_s = std::chrono::duration<double>(SteadyClock::now() - start).count();
-  };
-  try {
-    fti.prime();
-    fti.run(cfg.timeout_ns);
-  } catch (...) {
-    record();
-    throw;
-  }
-  record();
+// The functions see what the engines see (engine_set.cpp): the run folder and the share
+// folder. Before the interpreter starts, which copies the environment into os.environ.
+void export_run_environment(const fs::path& run_dir) {
+  setenv("CONVOY_RUN_DIR", run_dir.c_str(), 1);
+  setenv("CONVOY_SHARE_DIR", share_dir().c_str(), 0);
 }
 
 // The run proper, with the interpreter up: load the functions, launch and initialize the
 // engines, run the loop; then shut the engines down, whatever happened before.
 Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet,
                     RunLog& log, LoopFigures* figures) {
-  const auto t0 = SteadyClock::now();
+  export_run_environment(run_dir);
   python::Interpreter interpreter;
-  python::FunctionRuntime runtime(cfg.argument_passing == "reference");
-  EngineSet engines(cfg, run_dir / "logs");
+  Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
   try {
-    std::vector<loop::LoadedFunction> functions = load_functions(cfg, interpreter, runtime);
-    engines.launch();
-    log.info("started " + std::to_string(engines.size()) + " engines");
-    engines.initialize(log);
-    log.info("engines initialized in " +
-             std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) + " s");
-    run_loop(cfg, run_dir, quiet, log, engines, runtime, functions, figures);
+    session.initialize(/*keep_observations=*/false);
+    session.run_to_end();
     if (interrupted()) outcome = {kExitInterrupted, interrupted_text()};
   } catch (...) {
     outcome = outcome_of(std::current_exception());
   }
+  *figures = session.figures();
   if (outcome.code == kExitInterrupted) {
     log.info(outcome.error + ": shutting the engines down (Ctrl-C again to kill them)");
     interrupt_signal().store(0);
   } else if (outcome.code != kExitOk) {
     log.error(outcome.error);
   }
-  std::string shutdown_error = engines.shut_down(outcome.code == kExitOk, log);
+  std::string shutdown_error = session.shut_down(outcome.code == kExitOk);
   if (!shutdown_error.empty()) {
     if (outcome.code == kExitOk) outcome.code = kExitEngineError;
     if (outcome.error.empty()) outcome.error = shutdown_error;
@@ -356,6 +247,44 @@ int run_simulation(const RunOptions& options) {
   const auto t0 = SteadyClock::now();
   LoopFigures figures;
   Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures);
+  const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
+  report(cfg, run_dir, log, figures, wall_s, outcome);
+  return outcome.code;
+}
+
+int serve_simulation(const RunOptions& options) {
+  install_signal_handlers(options.slave);
+  raise_file_limit();
+  const pid_t parent = options.slave ? getppid() : 0;
+  RunLog log;
+  log.quiet = options.quiet;
+  config::SimulationConfig cfg;
+  fs::path run_dir;
+  if (int code = load(options, log, &cfg, &run_dir); code != kExitOk) return code;
+
+  const auto t0 = SteadyClock::now();
+  Outcome outcome;
+  LoopFigures figures;
+  {
+    export_run_environment(run_dir);
+    python::Interpreter interpreter;
+    NrpServer server(cfg, run_dir, log);
+    try {
+      server.listen(options.server_address, options.insecure);
+      {
+        pybind11::gil_scoped_release release;  // each call takes the GIL in its gRPC thread
+        server.wait(parent);
+        server.stop_serving();
+      }
+      server.finish();
+      outcome = {server.exit_code(), server.error()};
+      figures = server.figures();
+    } catch (...) {
+      outcome = outcome_of(std::current_exception());
+      log.error(outcome.error);
+    }
+    if (outcome.code == kExitOk && interrupted()) outcome = {kExitInterrupted, interrupted_text()};
+  }
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
   report(cfg, run_dir, log, figures, wall_s, outcome);
   return outcome.code;

@@ -12,6 +12,11 @@ struct RunOptions {
   std::vector<std::string> overrides;  // "-o Key=Value"
   std::filesystem::path run_dir;       // empty: runs/<name>-<time> under $CONVOY_RUNS_DIR or cwd
   bool quiet = false;
+  // NRP-Core's server mode (-m server): serve the simulation to a client (app/nrp_server.h).
+  bool server = false;
+  std::string server_address;  // --server_address HOST:PORT
+  bool slave = false;          // --slave: started by a client; ignore Ctrl-C, end with it
+  bool insecure = false;       // --insecure: listen beyond the loopback too
 };
 
 // Exit codes of `convoy run`.
@@ -25,6 +30,8 @@ enum ExitCode {
 };
 
 int run_simulation(const RunOptions& options);
+// The server mode: serves until a client's shutdown, an interrupt or (slave) the client's exit.
+int serve_simulation(const RunOptions& options);
 
 // Directory of the running executable, and the share directory next to it.
 std::filesystem::path bin_dir();

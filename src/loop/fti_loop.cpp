@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <charconv>
+#include <stdexcept>
 
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "datapack/datapack.h"
 
 namespace convoy::loop {
 
@@ -21,8 +23,8 @@ std::string key(const std::string& engine, const std::string& name) {
 }  // namespace
 
 FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
-                 const std::vector<LoadedFunction>& functions)
-    : engines_(std::move(engines)), runner_(runner), functions_(functions) {
+                 const std::vector<LoadedFunction>& functions, const LoadedFunction* status)
+    : engines_(std::move(engines)), runner_(runner), functions_(functions), status_(status) {
   for (size_t i = 0; i < engines_.size(); ++i) {
     by_name_[engines_[i]->name()] = engines_[i];
     engines_[i]->index = i;
@@ -30,9 +32,12 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
   due_mask_.assign(engines_.size(), 0);
   for (const auto& fn : functions_) function_engine_.push_back(by_name_.at(fn.engine)->index);
   // Which datapacks each engine must hand over after its steps.
-  for (const auto& fn : functions_) {
-    for (const auto& in : fn.inputs) {
-      if (in.preprocessed) continue;
+  std::vector<const LoadedFunction*> readers;
+  for (const auto& fn : functions_) readers.push_back(&fn);
+  if (status_) readers.push_back(status_);
+  for (const LoadedFunction* fn : readers) {
+    for (const auto& in : fn->inputs) {
+      if (in.preprocessed || in.kind != InputKind::kDataPack) continue;
       auto* e = by_name_.at(in.engine);
       bool known =
           std::any_of(e->wanted.begin(), e->wanted.end(),
@@ -74,6 +79,42 @@ void FtiLoop::set_step_log(std::FILE* csv) {
   std::fprintf(csv_, "\n");
 }
 
+void FtiLoop::keep_observation(const engine::DataPack& dp, const std::string& engine) {
+  if (dp.payload_case() == engine::DataPack::PAYLOAD_NOT_SET) return;
+  observations_.push_back(dp);
+  if (dp.blobs_size() == 0) return;
+  // The blobs may sit in the engine's arena, which it reuses: the copy carries them inline.
+  const datapack::BlobReader* reader = source_.reader_for(engine);
+  datapack::View view(dp, reader ? *reader : datapack::inline_blob_reader());
+  auto& kept = observations_.back();
+  for (int i = 0; i < dp.blobs_size(); ++i) {
+    auto* blob = kept.mutable_blobs(i);
+    std::string_view bytes = view.blob(static_cast<uint32_t>(i));
+    blob->set_inline_(bytes.data(), bytes.size());
+    blob->set_in_shm(false);
+    blob->set_shm_offset(0);
+    blob->set_size(bytes.size());
+  }
+}
+
+std::vector<engine::DataPack> FtiLoop::take_observations() {
+  std::vector<engine::DataPack> out;
+  out.swap(observations_);
+  return out;
+}
+
+void FtiLoop::add_input(engine::DataPack datapack) {
+  auto it = by_name_.find(datapack.id().engine_name());
+  if (it == by_name_.end()) {
+    std::string list;
+    for (auto* e : engines_) list += (list.empty() ? "" : ", ") + e->name();
+    throw std::invalid_argument("datapack '" + datapack.id().name() + "' is for unknown engine '" +
+                                datapack.id().engine_name() + "' (engines: " + list + ")");
+  }
+  auto& pending = it->second->pending_inputs;
+  pending.insert(pending.begin(), std::move(datapack));
+}
+
 void FtiLoop::prime() {
   for (auto* e : engines_) {
     if (e->wanted.empty()) continue;
@@ -86,6 +127,7 @@ void FtiLoop::prime() {
     engine::Reply reply;
     e->finish(&reply);
     for (auto& dp : *reply.mutable_get_datapacks()->mutable_datapacks()) {
+      if (keep_observations_) keep_observation(dp, e->name());
       auto& slot = pool_[key(e->name(), dp.id().name())];
       slot.datapack.Swap(&dp);
       slot.cycle = 0;
@@ -117,6 +159,8 @@ void FtiLoop::route(std::vector<engine::DataPack>& outputs, const LoadedFunction
 }
 
 void FtiLoop::run_functions() {
+  source_.iteration = cycles_;
+  source_.time_ns = sim_time_ns_;
   runner_.begin_cycle();
   for (size_t i = 0; i < functions_.size(); ++i) {
     if (functions_[i].preprocessing && due_mask_[function_engine_[i]])
@@ -127,6 +171,11 @@ void FtiLoop::run_functions() {
     if (fn.preprocessing || !due_mask_[function_engine_[i]]) continue;
     runner_.run_transceiver(fn, source_, &outputs_);
     route(outputs_, fn);
+  }
+  if (status_) {
+    const size_t before = observations_.size();
+    done_ = runner_.run_status(*status_, source_, &observations_);
+    if (!keep_observations_) observations_.resize(before);
   }
 }
 
@@ -171,56 +220,96 @@ void FtiLoop::write_row(int64_t cycle_wall_ns) {
   std::fwrite(row_.data(), 1, row_.size(), csv_);
 }
 
+bool FtiLoop::cycle(int64_t next, int64_t bound_ns, bool stop_on_done) {
+  due_.clear();
+  while (!queue_.empty() && queue_.begin()->first == next) {
+    due_.push_back(engines_[queue_.begin()->second]);
+    queue_.erase(queue_.begin());
+  }
+  std::sort(due_.begin(), due_.end(),
+            [&](EngineHandle* a, EngineHandle* b) { return a->index < b->index; });
+  std::fill(due_mask_.begin(), due_mask_.end(), 0);
+  for (auto* e : due_) due_mask_[e->index] = 1;
+  for (auto* e : due_) {
+    e->last_compute_ns = -1;
+    if (!e->busy()) continue;
+    reply_.Clear();
+    e->finish(&reply_);
+    take_outputs(*e, reply_.mutable_step());
+    e->time_ns = next;  // the schedule, not the engine's clock, drives the loop
+  }
+  sim_time_ns_ = next;
+  run_functions();
+  if (interrupted()) return false;
+  const bool finished = stop_on_done && done_;
+  for (auto* e : due_) {
+    const int64_t ts = e->config().timestep_ns;
+    if (finished || (bound_ns > 0 && next + ts > bound_ns)) continue;
+    request_.Clear();
+    auto* step = request_.mutable_step();
+    step->set_duration_ns(ts);
+    for (auto& dp : e->pending_inputs) step->add_inputs()->Swap(&dp);
+    e->pending_inputs.clear();
+    for (const auto& id : e->wanted) *step->add_wanted() = id;
+    e->start(request_, "Step");
+    queue_.emplace(next + ts, e->index);
+  }
+  int64_t t = now_ns();
+  write_row(t - last_cycle_ns_);
+  last_cycle_ns_ = t;
+  ++cycles_;
+  if (progress_ && t - last_progress_ns_ >= progress_period_ns_) {
+    last_progress_ns_ = t;
+    progress_(sim_time_ns_);
+  }
+  return !finished;
+}
+
 void FtiLoop::run(int64_t until_ns) {
-  std::vector<EngineHandle*> due;
-  engine::Reply reply;
-  engine::Request request;
-  int64_t last_cycle_ns = now_ns();
-  int64_t last_progress_ns = last_cycle_ns;
+  last_cycle_ns_ = last_progress_ns_ = now_ns();
   while (!queue_.empty()) {
     const int64_t next = queue_.begin()->first;
     if (until_ns > 0 && next > until_ns) break;
-    due.clear();
-    while (!queue_.empty() && queue_.begin()->first == next) {
-      due.push_back(engines_[queue_.begin()->second]);
-      queue_.erase(queue_.begin());
-    }
-    std::sort(due.begin(), due.end(),
-              [&](EngineHandle* a, EngineHandle* b) { return a->index < b->index; });
-    std::fill(due_mask_.begin(), due_mask_.end(), 0);
-    for (auto* e : due) due_mask_[e->index] = 1;
-    for (auto* e : due) {
-      e->last_compute_ns = -1;
-      if (!e->busy()) continue;
-      reply.Clear();
-      e->finish(&reply);
-      take_outputs(*e, reply.mutable_step());
-      e->time_ns = next;  // the schedule, not the engine's clock, drives the loop
-    }
-    sim_time_ns_ = next;
-    run_functions();
-    if (interrupted()) break;
-    for (auto* e : due) {
-      const int64_t ts = e->config().timestep_ns;
-      if (until_ns > 0 && next + ts > until_ns) continue;
-      request.Clear();
-      auto* step = request.mutable_step();
-      step->set_duration_ns(ts);
-      for (auto& dp : e->pending_inputs) step->add_inputs()->Swap(&dp);
-      e->pending_inputs.clear();
-      for (const auto& id : e->wanted) *step->add_wanted() = id;
-      e->start(request, "Step");
-      queue_.emplace(next + ts, e->index);
-    }
-    int64_t t = now_ns();
-    write_row(t - last_cycle_ns);
-    last_cycle_ns = t;
-    ++cycles_;
-    if (progress_ && t - last_progress_ns >= progress_period_ns_) {
-      last_progress_ns = t;
-      progress_(sim_time_ns_);
-    }
+    if (!cycle(next, until_ns, /*stop_on_done=*/true)) break;
   }
+}
+
+void FtiLoop::advance(int64_t stop_ns, const std::atomic<bool>* stop) {
+  if (last_cycle_ns_ == 0) last_cycle_ns_ = last_progress_ns_ = now_ns();
+  while (!queue_.empty() && queue_.begin()->first < stop_ns) {
+    if ((stop && stop->load(std::memory_order_relaxed)) || interrupted()) return;
+    if (!cycle(queue_.begin()->first, 0, /*stop_on_done=*/false)) return;
+  }
+  sim_time_ns_ = std::max(sim_time_ns_, stop_ns);
+}
+
+void FtiLoop::reset(std::vector<engine::DataPack> inputs) {
+  engine::Reply reply;
+  for (auto* e : engines_)
+    if (e->busy()) e->finish(&reply);  // the steps in flight; their datapacks are dropped
+  for (auto* e : engines_) {
+    engine::Request request;
+    auto* set = request.mutable_set_datapacks();
+    for (auto& dp : inputs)
+      if (dp.id().engine_name() == e->name()) *set->add_datapacks() = std::move(dp);
+    if (set->datapacks_size() > 0) e->call(request, "SetDataPacks", &reply);
+  }
+  engine::Request request;
+  request.mutable_reset();
+  for (auto* e : engines_) e->start(request, "Reset");
+  for (auto* e : engines_) e->finish(&reply);
+  for (auto* e : engines_) {
+    e->pending_inputs.clear();
+    e->time_ns = 0;
+  }
+  pool_.clear();
+  queue_.clear();
+  observations_.clear();
+  done_ = false;
+  cycles_ = 0;
+  sim_time_ns_ = 0;
+  runner_.reset();
+  prime();
 }
 
 }  // namespace convoy::loop

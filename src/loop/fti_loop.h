@@ -5,8 +5,14 @@
 // functions read from them, runs the preprocessing functions then the transceiver
 // functions linked to them (config order), and restarts them with the functions' outputs.
 // Everything the loop decides depends on simulated time only, so runs are deterministic.
+//
+// After the transceiver functions of every cycle, the status function (if any) runs on the
+// datapacks it asks for; its done flag ends run(), and the data it returns collects as the
+// observations that a client of the NRP-Core server (app/nrp_server.h) receives. A client
+// steps the loop with advance() and resets it with reset().
 #pragma once
 
+#include <atomic>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -21,10 +27,10 @@ namespace convoy::loop {
 
 class FtiLoop {
  public:
-  // `engines` in config order; `functions` in config order, run by `runner`. All three must
-  // outlive the loop.
+  // `engines` in config order; `functions` in config order, run by `runner`; `status`, the
+  // status function, or null. All must outlive the loop.
   FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
-          const std::vector<LoadedFunction>& functions);
+          const std::vector<LoadedFunction>& functions, const LoadedFunction* status = nullptr);
 
   // Writes one CSV row per cycle (wall times per engine) to `csv` (may be null).
   void set_step_log(std::FILE* csv);
@@ -34,17 +40,46 @@ class FtiLoop {
     progress_ = std::move(report);
   }
 
-  // Fetches the functions' inputs from every engine (after Initialize).
+  // Fetches the functions' inputs from every engine (after Initialize). With
+  // keep_observations(), the non-empty ones are the first observations (what NRP-Core's
+  // initialize() returns to its client).
   void prime();
-  // Runs until every engine has reached `until_ns` (0: until interrupted).
+  // Runs until every engine has reached `until_ns` (0: until interrupted) or the status
+  // function returns done. Engines are not restarted past `until_ns`, nor after done.
   void run(int64_t until_ns);
+  // NRP-Core's stepping (its FTILoop::runLoop): runs the cycles due before `stop_ns`,
+  // restarting every due engine; the loop's time is then `stop_ns`. Returns early, between
+  // cycles, when `stop` is set or on an interrupt.
+  void advance(int64_t stop_ns, const std::atomic<bool>* stop = nullptr);
+  // NRP-Core's reset: waits for the steps in flight, sends each engine the datapacks of
+  // `inputs` named for it, resets the engines, forgets the pool, the pending datapacks, the
+  // observations and the done flag, and starts again at time 0 and cycle 0 with prime().
+  void reset(std::vector<engine::DataPack> inputs);
+
+  // A datapack from outside the loop (a client) for its engine's next step, before the
+  // transceiver functions' ones. Throws std::invalid_argument naming an unknown engine.
+  void add_input(engine::DataPack datapack);
+  bool has_engine(const std::string& name) const { return by_name_.count(name) > 0; }
+
+  // Collect what the status function returns (off: it is dropped each cycle).
+  void keep_observations(bool keep) { keep_observations_ = keep; }
+  // The observations collected since the last call, in order; each carries its blobs inline.
+  std::vector<engine::DataPack> take_observations();
+  // The status function's done flag from the last cycle (false without one).
+  bool done() const { return done_; }
+  bool has_status_function() const { return status_ != nullptr; }
 
   int64_t sim_time_ns() const { return sim_time_ns_; }
   uint64_t cycles() const { return cycles_; }
 
  private:
+  // One cycle at `next`: collect the due engines, run the functions, restart the engines
+  // (none past `bound_ns` when > 0, none when `stop_on_done` and the status function says
+  // done). Returns false when the loop must stop (interrupt, done).
+  bool cycle(int64_t next, int64_t bound_ns, bool stop_on_done);
   void take_outputs(EngineHandle& e, engine::StepReply* reply);
   void run_functions();
+  void keep_observation(const engine::DataPack& dp, const std::string& engine);
   void route(std::vector<engine::DataPack>& outputs, const LoadedFunction& fn);
   void write_row(int64_t cycle_wall_ns);
 
@@ -55,6 +90,7 @@ class FtiLoop {
   std::string row_;
   FunctionRunner& runner_;
   const std::vector<LoadedFunction>& functions_;
+  const LoadedFunction* status_;
   InputSource source_;
   struct Pooled {
     engine::DataPack datapack;
@@ -63,6 +99,14 @@ class FtiLoop {
   std::unordered_map<std::string, Pooled> pool_;  // "engine\0name" -> latest
   std::multimap<int64_t, size_t> queue_;          // completion time -> engine
   std::vector<engine::DataPack> outputs_;
+  std::vector<engine::DataPack> observations_;
+  bool keep_observations_ = false;
+  bool done_ = false;
+  std::vector<EngineHandle*> due_;
+  engine::Reply reply_;
+  engine::Request request_;
+  int64_t last_cycle_ns_ = 0;
+  int64_t last_progress_ns_ = 0;
   std::FILE* csv_ = nullptr;
   int64_t sim_time_ns_ = 0;
   uint64_t cycles_ = 0;

@@ -6,8 +6,9 @@
 
 namespace convoy::python {
 
-std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
-                                                  const std::filesystem::path& file) {
+// Executes `file` and returns every function it declares, status functions included.
+std::vector<LoadedFunction> FunctionRuntime::execute(const std::string& name,
+                                                     const std::filesystem::path& file) {
   std::vector<LoadedFunction> out;
   std::vector<py::object> pending;  // their callables, kept once the file has loaded
   try {
@@ -16,19 +17,28 @@ std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
     registered.attr("clear")();
     load_module_from_file(file);
     py::object pf_class = funcs.attr("_Preprocessing");
+    py::object status_class = funcs.attr("_Status");
     for (auto fn : py::list(funcs.attr("_registered"))) {
       LoadedFunction f;
       f.name = name;
       f.file = file;
       f.preprocessing = py::isinstance(fn, pf_class);
+      f.status = py::isinstance(fn, status_class);
       f.engine = fn.attr("engine_name").cast<std::string>();
       f.runner_index = callables_.size() + out.size();
       for (auto in : py::list(fn.attr("inputs"))) {
         FunctionInput fi;
         fi.keyword = in.attr("keyword").cast<std::string>();
-        fi.datapack = in.attr("id").attr("dataPackName").cast<std::string>();
-        fi.engine = in.attr("id").attr("engineName").cast<std::string>();
-        fi.preprocessed = in.attr("preprocessed").cast<bool>();
+        const std::string kind = in.attr("kind").cast<std::string>();
+        if (kind == "iteration") {
+          fi.kind = loop::InputKind::kIteration;
+        } else if (kind == "time") {
+          fi.kind = loop::InputKind::kTime;
+        } else {
+          fi.datapack = in.attr("id").attr("dataPackName").cast<std::string>();
+          fi.engine = in.attr("id").attr("engineName").cast<std::string>();
+          fi.preprocessed = in.attr("preprocessed").cast<bool>();
+        }
         f.inputs.push_back(fi);
       }
       out.push_back(std::move(f));
@@ -39,14 +49,46 @@ std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
     throw UserError(file.string() + ": error while loading function '" + name + "':\n" +
                     format_exception(e));
   }
+  for (auto& callable : pending) callables_.push_back(std::move(callable));
+  return out;
+}
+
+std::vector<LoadedFunction> FunctionRuntime::load(const std::string& name,
+                                                  const std::filesystem::path& file) {
+  std::vector<LoadedFunction> out = execute(name, file);
   if (out.empty()) {
     throw UserError(file.string() +
                     ": declares no @TransceiverFunction or "
                     "@PreprocessingFunction (function '" +
                     name + "')");
   }
-  for (auto& callable : pending) callables_.push_back(std::move(callable));
+  for (const auto& f : out) {
+    if (f.status) {
+      throw UserError(file.string() + ": declares a @StatusFunction (function '" + name +
+                      "'); a status function is configured under \"StatusFunction\", not in "
+                      "DataPackProcessingFunctions");
+    }
+  }
   return out;
+}
+
+LoadedFunction FunctionRuntime::load_status(const std::string& name,
+                                            const std::filesystem::path& file) {
+  std::vector<LoadedFunction> out = execute(name, file);
+  size_t status = 0;
+  for (const auto& f : out) {
+    if (!f.status) {
+      throw UserError(file.string() + ": the StatusFunction file declares a " +
+                      (f.preprocessing ? "@PreprocessingFunction" : "@TransceiverFunction") +
+                      "; those are configured under DataPackProcessingFunctions");
+    }
+    ++status;
+  }
+  if (status != 1) {
+    throw UserError(file.string() + ": the StatusFunction file must declare one @StatusFunction, " +
+                    "it declares " + std::to_string(status));
+  }
+  return out.front();
 }
 
 void FunctionRuntime::begin_cycle() {
@@ -55,6 +97,8 @@ void FunctionRuntime::begin_cycle() {
 
 py::object FunctionRuntime::input_object(const FunctionInput& in, const InputSource& src,
                                          const LoadedFunction& fn) {
+  if (in.kind == loop::InputKind::kIteration) return py::int_(src.iteration);
+  if (in.kind == loop::InputKind::kTime) return py::int_(src.time_ns);
   py::str key(in.engine + '\0' + in.datapack);
   if (in.preprocessed) {
     if (preprocessed_.contains(key)) {
@@ -83,6 +127,7 @@ py::object FunctionRuntime::call(const LoadedFunction& fn, const InputSource& sr
     py::dict kwargs;
     for (const auto& in : fn.inputs) kwargs[py::str(in.keyword)] = input_object(in, src, fn);
     py::object result = callables_.at(fn.runner_index)(**kwargs);
+    if (fn.status) return result;  // checked by run_status()
     if (!py::isinstance<py::list>(result) && !py::isinstance<py::tuple>(result)) {
       throw FunctionError(fn.label() + " returned " + std::string(Py_TYPE(result.ptr())->tp_name) +
                           "; it must return a list of datapacks");
@@ -137,6 +182,63 @@ void FunctionRuntime::run_preprocessing(const LoadedFunction& fn, const InputSou
                           " returned something that is not a datapack: " + format_exception(e));
     }
   }
+}
+
+bool FunctionRuntime::run_status(const LoadedFunction& fn, const InputSource& src,
+                                 std::vector<engine::DataPack>* observations) {
+  py::object result = call(fn, src);
+  const char* expected =
+      "; it must return a tuple (done, [data]): done a bool, data a (possibly empty) list of "
+      "RawData (e.g. JsonRawData) or datapacks";
+  if ((!py::isinstance<py::tuple>(result) && !py::isinstance<py::list>(result)) ||
+      py::len(result) != 2) {
+    throw FunctionError(fn.label() + " returned " + py::repr(result).cast<std::string>() +
+                        expected);
+  }
+  py::object done_obj = result[py::int_(0)];
+  py::object data = result[py::int_(1)];
+  const std::string done_type = Py_TYPE(done_obj.ptr())->tp_name;
+  if (!PyBool_Check(done_obj.ptr()) && done_type != "numpy.bool_" && done_type != "bool_") {
+    throw FunctionError(fn.label() + " returned a " + done_type + " as its done flag" + expected);
+  }
+  if (!py::isinstance<py::list>(data) && !py::isinstance<py::tuple>(data)) {
+    throw FunctionError(fn.label() + " returned a " + Py_TYPE(data.ptr())->tp_name +
+                        " as its data" + expected);
+  }
+  const bool done = PyObject_IsTrue(done_obj.ptr()) == 1;
+  static py::object* raw_class =
+      new py::object(py::module_::import("nrp_core._datapacks").attr("RawData"));
+  static py::object* datapack_class =
+      new py::object(py::module_::import("nrp_core._datapacks").attr("DataPack"));
+  for (auto item : data) {
+    const bool raw = py::isinstance(item, *raw_class);
+    if (!raw && !py::isinstance(item, *datapack_class)) {
+      throw FunctionError(fn.label() + " returned a " + Py_TYPE(item.ptr())->tp_name +
+                          " in its data" + expected);
+    }
+    py::object value = item.attr("_data");
+    if (value.is_none()) continue;  // an empty datapack: nothing to observe, as in NRP-Core
+    observations->emplace_back();
+    try {
+      auto* id = observations->back().mutable_id();
+      if (!raw) {
+        id->set_name(item.attr("_id").attr("dataPackName").cast<std::string>());
+        id->set_engine_name(item.attr("_id").attr("engineName").cast<std::string>());
+      }
+      datapack::Builder out(&observations->back(), inline_writer_);
+      data_from_python(value, out);
+    } catch (py::error_already_set& e) {
+      throw FunctionError(fn.label() + ": " + format_exception(e));
+    } catch (const std::exception& e) {
+      throw FunctionError(fn.label() + ": " + e.what());
+    }
+  }
+  return done;
+}
+
+void FunctionRuntime::reset() {
+  if (py::len(preprocessed_) > 0) preprocessed_.clear();
+  begin_cycle();
 }
 
 }  // namespace convoy::python

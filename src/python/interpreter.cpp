@@ -22,7 +22,9 @@ Interpreter::Interpreter() {
 
 Interpreter::~Interpreter() = default;
 
-void Interpreter::add_path(const std::filesystem::path& dir) {
+void Interpreter::add_path(const std::filesystem::path& dir) { add_python_path(dir); }
+
+void add_python_path(const std::filesystem::path& dir) {
   py::list path = py::module_::import("sys").attr("path");
   py::str entry(dir.string());
   if (!path.contains(entry)) path.insert(0, entry);

@@ -26,6 +26,9 @@ class Interpreter {
   std::unique_ptr<py::scoped_interpreter> guard_;
 };
 
+// Puts `dir` at the front of sys.path (once). Needs the GIL.
+void add_python_path(const std::filesystem::path& dir);
+
 // Directory holding the nrp_core package: $CONVOY_PYTHON_PATH, else the build's.
 std::filesystem::path package_dir();
 

@@ -8,6 +8,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -45,6 +46,8 @@ struct FakeEngine {
   int64_t hang_at_ns = -1;  // never answers the step that starts then
   int64_t fail_at_ns = -1;  // answers the step that starts then with an error
   bool saw_shutdown = false;
+  int resets = 0;
+  std::vector<std::string> set_before_reset;  // SetDataPacks: "<name>=<payload>"
 
   void add_outputs(const google::protobuf::RepeatedPtrField<engine::DataPackId>& ids,
                    google::protobuf::RepeatedPtrField<engine::DataPack>* out) const {
@@ -77,6 +80,14 @@ struct FakeEngine {
       time_ns += step.duration_ns();
       reply->mutable_step()->set_time_ns(time_ns);
       add_outputs(step.wanted(), reply->mutable_step()->mutable_outputs());
+    } else if (request.has_set_datapacks()) {
+      for (const auto& dp : request.set_datapacks().datapacks())
+        set_before_reset.push_back(dp.id().name() + "=" + dp.json_msgpack());
+      reply->mutable_done();
+    } else if (request.has_reset()) {
+      ++resets;
+      time_ns = 0;
+      reply->mutable_done();
     } else if (request.has_shutdown()) {
       saw_shutdown = true;
       reply->mutable_done();
@@ -123,8 +134,19 @@ class FakeRunner final : public FunctionRunner {
   std::vector<std::string> calls;  // "<ms> <function>", one "<ms> |" per cycle start
   std::vector<std::string> seen;   // "<ms> <function> <engine>/<name>=<payload> [updated]"
   std::map<std::string, std::vector<engine::DataPackId>> sends;  // by function name
+  int64_t done_at = -1;  // the status function returns done at this iteration
+  int resets = 0;
 
   void begin_cycle() override { calls.push_back(now() + " |"); }
+  bool run_status(const LoadedFunction& fn, const InputSource& src,
+                  std::vector<engine::DataPack>* observations) override {
+    record(fn, src);
+    calls.back() += "#" + std::to_string(src.iteration);
+    observations->emplace_back();
+    observations->back().set_json_msgpack("obs#" + std::to_string(src.iteration));
+    return static_cast<int64_t>(src.iteration) == done_at;
+  }
+  void reset() override { ++resets; }
   void run_preprocessing(const LoadedFunction& fn, const InputSource& src) override {
     record(fn, src);
   }
@@ -162,6 +184,12 @@ LoadedFunction tf(const std::string& name, const std::string& engine,
   return fn;
 }
 
+LoadedFunction sf(std::vector<std::pair<std::string, std::string>> inputs = {}) {
+  LoadedFunction fn = tf("status", "", std::move(inputs));
+  fn.status = true;
+  return fn;
+}
+
 LoadedFunction pf(const std::string& name, const std::string& engine,
                   std::vector<std::pair<std::string, std::string>> inputs = {}) {
   LoadedFunction fn = tf(name, engine, std::move(inputs));
@@ -196,14 +224,27 @@ class FtiLoopTest : public ::testing::Test {
     return fake;
   }
 
-  // Primes and runs the loop until `until_ns`.
-  void run(int64_t until_ns) {
+  // Makes and primes the loop.
+  void start(bool keep_observations = false) {
     std::vector<EngineHandle*> engines;
     for (auto& h : handles_) engines.push_back(h.get());
-    loop_ = std::make_unique<FtiLoop>(engines, runner_, functions_);
+    loop_ = std::make_unique<FtiLoop>(engines, runner_, functions_, status_ ? &*status_ : nullptr);
     runner_.loop = loop_.get();
+    loop_->keep_observations(keep_observations);
     loop_->prime();
+  }
+
+  // Primes and runs the loop until `until_ns`.
+  void run(int64_t until_ns) {
+    start();
     loop_->run(until_ns);
+  }
+
+  std::vector<std::string> observations() {
+    std::vector<std::string> out;
+    for (const auto& dp : loop_->take_observations())
+      out.push_back(dp.id().engine_name() + "/" + dp.id().name() + "=" + dp.json_msgpack());
+    return out;
   }
 
   // Runs and returns the EngineError the loop ends with.
@@ -225,6 +266,7 @@ class FtiLoopTest : public ::testing::Test {
   std::list<FakeEngine> fakes_;
   std::vector<std::unique_ptr<EngineHandle>> handles_;
   std::vector<LoadedFunction> functions_;
+  std::optional<LoadedFunction> status_;
   FakeRunner runner_;
   std::unique_ptr<FtiLoop> loop_;
 };
@@ -343,6 +385,119 @@ TEST_F(FtiLoopTest, AnEngineErrorReplyIsAnEngineError) {
   EXPECT_NE(std::string(e.what()).find("engine 'a' failed in Step:\nboom at 4000000"),
             std::string::npos)
       << e.what();
+}
+
+// The status function runs every cycle, after the transceiver functions, whichever engines
+// are due; a datapack is updated in the cycles its engine delivered it (NRP-Core's isUpdated()).
+TEST_F(FtiLoopTest, TheStatusFunctionRunsEveryCycleAfterTheTransceiverFunctions) {
+  add_engine("a", ms(1));
+  add_engine("b", ms(2));
+  functions_ = {tf("tf_b", "b")};
+  status_ = sf({{"a", "pos"}, {"b", "pos"}});
+  run(ms(3));
+  EXPECT_EQ(runner_.calls, (std::vector<std::string>{"0 |", "0 tf_b", "0 status#0",  //
+                                                     "1 |", "1 status#1",            //
+                                                     "2 |", "2 tf_b", "2 status#2",  //
+                                                     "3 |", "3 status#3"}));
+  EXPECT_EQ(runner_.seen, (std::vector<std::string>{
+                              "0 status a/pos=a@0 updated", "0 status b/pos=b@0 updated",  //
+                              "1 status a/pos=a@1 updated", "1 status b/pos=b@0",          //
+                              "2 status a/pos=a@2 updated", "2 status b/pos=b@2 updated",  //
+                              "3 status a/pos=a@3 updated", "3 status b/pos=b@2"}));
+  EXPECT_FALSE(loop_->done());
+}
+
+TEST_F(FtiLoopTest, DoneEndsTheRunAfterItsCycleWithoutRestartingTheEngines) {
+  auto& a = add_engine("a", ms(1));
+  auto& b = add_engine("b", ms(2));
+  status_ = sf();
+  runner_.done_at = 2;
+  run(ms(100));
+  EXPECT_TRUE(loop_->done());
+  EXPECT_EQ(loop_->cycles(), 3u);
+  EXPECT_EQ(loop_->sim_time_ns(), ms(2));
+  EXPECT_EQ(step_starts_ms(a), (std::vector<int64_t>{0, 1}));
+  EXPECT_EQ(step_starts_ms(b), (std::vector<int64_t>{0}));
+  // Nobody asked for them: nothing is kept.
+  EXPECT_TRUE(observations().empty());
+}
+
+// NRP-Core's stepping: advance() runs the cycles due before its stop time and restarts every
+// due engine; the status function's data collect until taken, done or not.
+TEST_F(FtiLoopTest, AdvanceRunsTheCyclesBeforeItsStopTime) {
+  auto& a = add_engine("a", ms(2));
+  auto& b = add_engine("b", ms(3));
+  status_ = sf({{"a", "pos"}});
+  runner_.done_at = 1;
+  start(/*keep_observations=*/true);
+  EXPECT_EQ(observations(), (std::vector<std::string>{"a/pos=a@0"}))
+      << "the datapacks fetched after Initialize come first";
+  functions_.clear();
+  loop_->advance(ms(2));
+  EXPECT_EQ(loop_->sim_time_ns(), ms(2));
+  EXPECT_EQ(loop_->cycles(), 1u);
+  EXPECT_FALSE(loop_->done());
+  loop_->advance(ms(4));  // cycles at 2 (a) and 3 (b)
+  EXPECT_EQ(loop_->cycles(), 3u);
+  EXPECT_FALSE(loop_->done()) << "done at cycle 1, not at cycle 2";
+  EXPECT_EQ(observations(), (std::vector<std::string>{"/=obs#0", "/=obs#1", "/=obs#2"}));
+  loop_->advance(ms(100));
+  EXPECT_EQ(loop_->sim_time_ns(), ms(100));
+  // Every due engine was restarted: no timeout bounds a stepped loop.
+  EXPECT_EQ(step_starts_ms(a).back(), ms(98) / ms(1));
+  EXPECT_EQ(step_starts_ms(b).back(), ms(99) / ms(1));
+  std::atomic<bool> stop{true};
+  loop_->advance(ms(200), &stop);
+  EXPECT_EQ(loop_->sim_time_ns(), ms(100)) << "a stop request runs no cycle";
+}
+
+TEST_F(FtiLoopTest, TheStatusFunctionGetsNoDatapackBeforeItsEngineHasOne) {
+  add_engine("b", ms(2)).produces = [](const std::string&, int64_t) { return false; };
+  status_ = sf({{"b", "pos"}});
+  run(ms(2));
+  EXPECT_EQ(runner_.seen, (std::vector<std::string>{"0 status b/pos=none", "2 status b/pos=none"}));
+}
+
+TEST_F(FtiLoopTest, ClientInputsGoWithTheEnginesNextStepBeforeTransceiverOutputs) {
+  auto& a = add_engine("a", ms(2));
+  add_engine("b", ms(1));
+  functions_ = {tf("tf_b", "b")};
+  runner_.sends["tf_b"] = {id("a", "cmd")};
+  start();
+  engine::DataPack dp;
+  *dp.mutable_id() = id("a", "cmd");
+  dp.set_json_msgpack("client");
+  loop_->add_input(dp);
+  loop_->advance(ms(1));  // cycle at 0: a starts with both
+  ASSERT_EQ(a.steps.size(), 1u);
+  EXPECT_EQ(a.steps[0].inputs, (std::vector<std::string>{"a/cmd=client", "a/cmd=tf_b@0"}));
+  *dp.mutable_id() = id("nobody", "cmd");
+  EXPECT_THROW(loop_->add_input(dp), std::invalid_argument);
+}
+
+TEST_F(FtiLoopTest, ResetStartsAgainAtTimeZeroAndCycleZero) {
+  auto& a = add_engine("a", ms(2));
+  auto& b = add_engine("b", ms(3));
+  status_ = sf({{"a", "pos"}});
+  start(/*keep_observations=*/true);
+  loop_->advance(ms(6));
+  observations();
+  engine::DataPack dp;
+  *dp.mutable_id() = id("b", "reset_cmd");
+  dp.set_json_msgpack("r");
+  loop_->reset({dp});
+  EXPECT_EQ(a.resets, 1);
+  EXPECT_EQ(b.resets, 1);
+  EXPECT_EQ(runner_.resets, 1);
+  EXPECT_TRUE(a.set_before_reset.empty());
+  EXPECT_EQ(b.set_before_reset, (std::vector<std::string>{"reset_cmd=r"}));
+  EXPECT_EQ(loop_->sim_time_ns(), 0);
+  EXPECT_EQ(loop_->cycles(), 0u);
+  EXPECT_EQ(observations(), (std::vector<std::string>{"a/pos=a@0"}));
+  runner_.calls.clear();
+  loop_->advance(ms(2));
+  EXPECT_EQ(runner_.calls, (std::vector<std::string>{"0 |", "0 status#0"}));
+  EXPECT_EQ(step_starts_ms(a), (std::vector<int64_t>{0, 2, 4, 0}));
 }
 
 }  // namespace

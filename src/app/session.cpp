@@ -1,0 +1,199 @@
+#include "app/session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "app/simulation.h"
+#include "core/clock.h"
+#include "core/error.h"
+#include "core/interrupt.h"
+
+namespace convoy::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Checks that every function names engines that exist, and PF inputs are their own engine's.
+void check_functions(const std::vector<const loop::LoadedFunction*>& functions,
+                     const config::SimulationConfig& cfg) {
+  std::set<std::string> engines;
+  std::string list;
+  for (const auto& e : cfg.engines) {
+    engines.insert(e.name);
+    list += (list.empty() ? "" : ", ") + e.name;
+  }
+  for (const auto* fn : functions) {
+    const char* deco = fn->status          ? "@StatusFunction"
+                       : fn->preprocessing ? "@PreprocessingFunction"
+                                           : "@TransceiverFunction";
+    if (!fn->status && !engines.count(fn->engine)) {
+      throw UserError(fn->file.string() + ": " + deco + "(\"" + fn->engine + "\") in function '" +
+                      fn->name + "' names an unknown engine (engines: " + list + ")");
+    }
+    for (const auto& in : fn->inputs) {
+      if (in.kind != loop::InputKind::kDataPack) continue;
+      if (!engines.count(in.engine)) {
+        throw UserError(fn->file.string() + ": input '" + in.keyword + "' of function '" +
+                        fn->name + "' reads datapack '" + in.datapack + "' from unknown engine '" +
+                        in.engine + "' (engines: " + list + ")");
+      }
+      if (fn->preprocessing && !in.preprocessed && in.engine != fn->engine) {
+        throw UserError(fn->file.string() + ": preprocessing function '" + fn->name +
+                        "' may only read datapacks of its engine '" + fn->engine + "', not '" +
+                        in.engine + "'");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::string interrupted_text() {
+  return "interrupted by signal " + std::to_string(interrupt_signal().load());
+}
+
+Outcome outcome_of(std::exception_ptr thrown) {
+  try {
+    std::rethrow_exception(thrown);
+  } catch (const UserError& e) {
+    return {kExitUserError, e.what()};
+  } catch (const EngineError& e) {
+    // Ctrl-C while waiting for an engine: the engine did nothing wrong.
+    if (interrupted()) return {kExitInterrupted, interrupted_text()};
+    return {kExitEngineError, e.what()};
+  } catch (const FunctionError& e) {
+    return {kExitFunctionError, e.what()};
+  } catch (const std::exception& e) {
+    return {kExitInternal, e.what()};
+  }
+}
+
+Session::Session(const config::SimulationConfig& cfg, fs::path run_dir, RunLog& log, bool quiet)
+    : cfg_(cfg),
+      run_dir_(std::move(run_dir)),
+      log_(log),
+      quiet_(quiet),
+      runtime_(cfg.argument_passing == "reference"),
+      engines_(cfg, run_dir_ / "logs") {
+  step_ns_ = std::numeric_limits<int64_t>::max();
+  for (const auto& e : cfg.engines) step_ns_ = std::min(step_ns_, e.timestep_ns);
+  if (cfg.engines.empty()) step_ns_ = cfg.timestep_ns;
+}
+
+Session::~Session() {
+  if (!shut_down_) shut_down(false);
+}
+
+void Session::initialize(bool keep_observations) {
+  if (loop_) throw std::logic_error("the simulation is already initialized");
+  const auto t0 = SteadyClock::now();
+  for (const auto& f : cfg_.functions) {
+    if (!f.active) continue;
+    python::add_python_path(f.file.parent_path());
+    for (auto& fn : runtime_.load(f.name, f.file)) functions_.push_back(std::move(fn));
+  }
+  if (cfg_.status_function && cfg_.status_function->active) {
+    const auto& f = *cfg_.status_function;
+    python::add_python_path(f.file.parent_path());
+    status_ = runtime_.load_status(f.name, f.file);
+  }
+  std::vector<const loop::LoadedFunction*> all;
+  for (const auto& fn : functions_) all.push_back(&fn);
+  if (status_) all.push_back(&*status_);
+  check_functions(all, cfg_);
+
+  engines_.launch();
+  log_.info("started " + std::to_string(engines_.size()) + " engines");
+  engines_.initialize(log_);
+  log_.info("engines initialized in " +
+            std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) + " s");
+
+  loop_ = std::make_unique<loop::FtiLoop>(engines_.handles(), runtime_, functions_,
+                                          status_ ? &*status_ : nullptr);
+  loop_->keep_observations(keep_observations);
+  csv_.reset(std::fopen((run_dir_ / "steps.csv").c_str(), "w"));
+  if (csv_) std::setvbuf(csv_.get(), nullptr, _IOFBF, 1 << 20);
+  loop_->set_step_log(csv_.get());
+  if (!quiet_) {
+    auto start = SteadyClock::now();
+    loop_->set_progress(5.0, [this, start](int64_t sim_ns) {
+      double wall = std::chrono::duration<double>(SteadyClock::now() - start).count();
+      std::ostringstream s;
+      s.precision(1);
+      s << std::fixed << "progress: simulated " << sim_ns * 1e-9 << " s";
+      if (cfg_.timeout_ns > 0) s << " of " << cfg_.timeout_ns * 1e-9 << " s";
+      s << " (" << sim_ns * 1e-9 / wall << "x real time)";
+      log_.info(s.str());
+    });
+  }
+  figures_.ran = true;
+  timed([&] { loop_->prime(); });
+}
+
+template <typename F>
+void Session::timed(F&& run) {
+  const auto start = SteadyClock::now();
+  auto record = [&] {
+    figures_.cycles = loop_->cycles();
+    figures_.sim_time_ns = loop_->sim_time_ns();
+    figures_.wall_s += std::chrono::duration<double>(SteadyClock::now() - start).count();
+    figures_.done = loop_->done();
+  };
+  try {
+    run();
+  } catch (...) {
+    record();
+    throw;
+  }
+  record();
+}
+
+void Session::run_to_end() {
+  timed([&] { loop_->run(cfg_.timeout_ns); });
+  if (loop_->done()) {
+    std::ostringstream s;
+    s << "the status function returned done at cycle " << loop_->cycles() - 1 << " (simulated "
+      << loop_->sim_time_ns() * 1e-9 << " s): run ended";
+    log_.info(s.str());
+  }
+}
+
+void Session::run_steps(uint32_t steps, const std::atomic<bool>& stop) {
+  timed([&] {
+    for (uint32_t i = 0; steps == 0 || i < steps; ++i) {
+      if (stop.load(std::memory_order_relaxed) || interrupted()) return;
+      loop_->advance(loop_->sim_time_ns() + step_ns_, &stop);
+    }
+  });
+}
+
+bool Session::timed_out() const {
+  return cfg_.timeout_ns > 0 && loop_ && loop_->sim_time_ns() >= cfg_.timeout_ns;
+}
+
+void Session::run_until_done_or_timeout(const std::atomic<bool>& stop) {
+  timed([&] {
+    while (!loop_->done() && !timed_out()) {
+      if (stop.load(std::memory_order_relaxed) || interrupted()) return;
+      loop_->advance(loop_->sim_time_ns() + step_ns_, &stop);
+    }
+  });
+}
+
+void Session::reset(std::vector<engine::DataPack> inputs) {
+  timed([&] { loop_->reset(std::move(inputs)); });
+}
+
+std::string Session::shut_down(bool clean) {
+  shut_down_ = true;
+  loop_.reset();
+  std::string error = engines_.shut_down(clean, log_);
+  if (csv_) std::fflush(csv_.get());
+  return error;
+}
+
+}  // namespace convoy::app

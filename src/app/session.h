@@ -1,0 +1,91 @@
+// One simulation from loading its functions to its engines' shutdown: the functions, the
+// engines and the loop. The standalone run (simulation.cpp) runs it to its end; the NRP-Core
+// server (nrp_server.h) steps it for a client. Every call needs the Python GIL.
+#pragma once
+
+#include <atomic>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/engine_set.h"
+#include "app/run_log.h"
+#include "config/simulation_config.h"
+#include "loop/fti_loop.h"
+#include "python/function_runtime.h"
+
+namespace convoy::app {
+
+// What the loop did, kept after it is gone.
+struct LoopFigures {
+  bool ran = false;  // the loop was set up
+  uint64_t cycles = 0;
+  int64_t sim_time_ns = 0;
+  double wall_s = 0;  // time spent running the loop: start-up and shutdown not counted
+  bool done = false;  // the status function ended the run
+};
+
+// How a run ended: its exit code (simulation.h's ExitCode) and, unless it went well, why.
+struct Outcome {
+  int code = 0;
+  std::string error;
+};
+// The outcome of a run that ended by throwing `thrown` (UserError 2, EngineError 3, or 130
+// after an interrupt, FunctionError 4, anything else 1).
+Outcome outcome_of(std::exception_ptr thrown);
+// "interrupted by signal N".
+std::string interrupted_text();
+
+class Session {
+ public:
+  // Nothing starts yet. `quiet`: no progress lines.
+  Session(const config::SimulationConfig& cfg, std::filesystem::path run_dir, RunLog& log,
+          bool quiet);
+  ~Session();
+
+  // Loads the functions (a broken file costs no start-up), launches and initializes the
+  // engines, and fetches the functions' first inputs. `keep_observations`: collect what the
+  // status function returns, for a client. Throws UserError, EngineError, FunctionError.
+  void initialize(bool keep_observations);
+  bool initialized() const { return loop_ != nullptr; }
+
+  // Standalone: runs until SimulationTimeout, the status function's done or an interrupt.
+  void run_to_end();
+  // NRP-Core's runLoop(n): n steps of the smallest EngineTimestep (0: until `stop`).
+  void run_steps(uint32_t steps, const std::atomic<bool>& stop);
+  // NRP-Core's runUntilTimeout: steps until done or SimulationTimeout (or `stop`). A done
+  // flag still set from the last call returns at once, as in NRP-Core.
+  void run_until_done_or_timeout(const std::atomic<bool>& stop);
+  bool timed_out() const;
+  void reset(std::vector<engine::DataPack> inputs);
+
+  loop::FtiLoop& loop() { return *loop_; }
+  const LoopFigures& figures() const { return figures_; }
+
+  // Shuts the engines down (see EngineSet::shut_down); returns the first error, or "".
+  std::string shut_down(bool clean);
+
+ private:
+  template <typename F>
+  void timed(F&& run);
+
+  const config::SimulationConfig& cfg_;
+  std::filesystem::path run_dir_;
+  RunLog& log_;
+  bool quiet_;
+  python::FunctionRuntime runtime_;
+  EngineSet engines_;
+  std::vector<loop::LoadedFunction> functions_;
+  std::optional<loop::LoadedFunction> status_;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> csv_{nullptr, &std::fclose};
+  std::unique_ptr<loop::FtiLoop> loop_;
+  int64_t step_ns_ = 0;  // the smallest EngineTimestep: NRP-Core's simulation timestep
+  LoopFigures figures_;
+  bool shut_down_ = false;
+};
+
+}  // namespace convoy::app
