@@ -289,11 +289,14 @@ class Client(E2ETestCase):
             if sys.argv[1] == "kill":
                 os.kill(os.getpid(), 9)   # no atexit: the server notices its client is gone
             # else: exit without shutdown(): atexit shuts the server down
-            """) % (os.path.join(REPO, "python"), free_address(), self.dir)
+            """)
         for how in ("exit", "kill"):
             with self.subTest(how=how):
-                r = subprocess.run([sys.executable, "-c", script, how], stdout=subprocess.PIPE,
+                # A fresh port each time: the first server may still hold its port while it ends.
+                code = script % (os.path.join(REPO, "python"), free_address(), self.dir)
+                r = subprocess.run([sys.executable, "-c", code, how], stdout=subprocess.PIPE,
                                    stderr=subprocess.PIPE, text=True, timeout=60)
+                self.assertTrue(r.stdout.split(), "the client script failed:\n" + r.stderr)
                 server = int(r.stdout.split()[0])
                 self.assertGone([server] + list(self.engine_pids().values()))
                 self.assertEqual(self.scan_engine_processes(), [])
