@@ -1,5 +1,6 @@
 // The protobuf datapack types every Convoy program knows. One line per type.
 #include "convoy/datapacks.pb.h"
+#include "convoy/road_users.pb.h"
 #include "datapack/nrp.h"
 #include "datapack/registry.h"
 
@@ -10,6 +11,9 @@ void register_standard_types(Registry& r) {
   r.add<data::Camera>("GazeboCameraDataPack");
   r.add<data::Joint>("GazeboJointDataPack");
   r.add<data::Link>("GazeboLinkDataPack");
+  // Road users (proto/convoy/road_users.proto, docs/road_users.md).
+  r.add<data::RoadUser>("RoadUserDataPack");
+  r.add<data::RoadUsers>("RoadUsersDataPack");
   // NRP-Core's message set (datapack/nrp.h): Dump, EngineTest, Gazebo, NrpGenericProto,
   // Wrappers. Gazebo.Camera / Joint / Link travel as the three above, whose Python classes
   // keep the names GazeboCameraDataPack... (Registry::add: a named class wins).
