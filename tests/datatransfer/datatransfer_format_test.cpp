@@ -26,12 +26,12 @@ constexpr const char* kDumpProto = R"pb(
   syntax: "proto3"
   message_type {
     name: "String"
-    field { name: "string_stream" number: 1 type: TYPE_STRING label: LABEL_OPTIONAL }
+    field { name: "string_stream" number: 5 type: TYPE_STRING label: LABEL_OPTIONAL }
   }
   message_type {
     name: "ArrayFloat"
-    field { name: "float_stream" number: 1 type: TYPE_FLOAT label: LABEL_REPEATED }
-    field { name: "dims" number: 2 type: TYPE_UINT32 label: LABEL_REPEATED }
+    field { name: "float_stream" number: 5 type: TYPE_FLOAT label: LABEL_REPEATED }
+    field { name: "dims" number: 6 type: TYPE_UINT32 label: LABEL_REPEATED }
   }
   message_type {
     name: "Mixed"

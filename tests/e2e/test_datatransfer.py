@@ -437,6 +437,13 @@ class NrpMessages(BrokerCase):
                 got[name].append(data)
         self.assertEqual([d.string_stream for d in got["tf_text"]],
                          ["tf call 1", "tf call 2", "tf call 3"])
+        # NRP-Core's field numbers (nrp-core-msgs' dump_msgs.proto): string_stream and
+        # float_stream 5, dims 6.
+        first = engine_grpc_pb2.DataPackMessage.FromString(self.sub.on(base + "/data/tf_text")[0])
+        self.assertEqual(first.data.value, b"\x2a\x09tf call 1")
+        first = engine_grpc_pb2.DataPackMessage.FromString(self.sub.on(base + "/data/tf_row")[0])
+        self.assertEqual(first.data.value,
+                         b"\x2a\x0c" + struct.pack("<3f", 0.25, -1, 1) + b"\x32\x01\x03")
         self.assertEqual([list(d.float_stream) for d in got["tf_grid"]], [[1, 2, 3, 4, 5]] * 3)
         self.assertEqual([list(d.dims) for d in got["tf_grid"]], [[3, 2]] * 3)
         self.assertEqual([d.string_stream for d in got["pg_text"]],
