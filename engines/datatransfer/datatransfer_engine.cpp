@@ -1,7 +1,6 @@
 // The data-transfer engine server: registers DataTransferEngine (datatransfer_engine.h).
 #include "datatransfer_engine.h"
 
-#include <google/protobuf/unknown_field_set.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include "config/simulation_config.h"
 #include "datapack/json.h"
 #include "datapack/nrp.h"
+#include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "dump_format.h"
 
@@ -133,40 +133,6 @@ const datapack::TypeInfo* find_type(const std::string& type) {
   } catch (const std::invalid_argument&) {
     return nullptr;
   }
-}
-
-// The serialized message of a datapack whose type this program does not know, with the large
-// bytes values that travelled as blobs put back (proto.h: a singular field was left out, an
-// element of a repeated one written empty in its place).
-std::string bytes_with_blobs(const datapack::View& dp) {
-  namespace gpb = google::protobuf;
-  const engine::ProtoPayload& payload = dp.message().proto();
-  if (payload.blob_fields_size() == 0) return payload.data();
-  gpb::UnknownFieldSet fields;
-  if (!fields.ParseFromString(payload.data())) {
-    throw std::runtime_error(dp.describe() + ": corrupt " + dp.proto_type());
-  }
-  for (const auto& bf : payload.blob_fields()) {
-    if (bf.blob() >= static_cast<uint32_t>(dp.message().blobs_size())) {
-      throw std::runtime_error(dp.describe() + ": field " + std::to_string(bf.field()) +
-                               " refers to a missing blob");
-    }
-    const std::string_view bytes = dp.blob(bf.blob());
-    std::string* target = nullptr;
-    uint32_t seen = 0;
-    for (int i = 0; i < fields.field_count() && !target; ++i) {
-      gpb::UnknownField* f = fields.mutable_field(i);
-      if (static_cast<uint32_t>(f->number()) == bf.field() &&
-          f->type() == gpb::UnknownField::TYPE_LENGTH_DELIMITED && seen++ == bf.index()) {
-        target = f->mutable_length_delimited();
-      }
-    }
-    if (!target) target = fields.AddLengthDelimited(static_cast<int>(bf.field()));
-    target->assign(bytes.data(), bytes.size());
-  }
-  std::string out;
-  fields.SerializeToString(&out);
-  return out;
 }
 
 std::string timestamp_folder() {
@@ -400,7 +366,7 @@ void DataTransferEngine::set_datapack(const datapack::View& dp) {
       warn("datapack " + quote(dump.name) + ": protobuf type " + quote(type) +
            " is unknown to this engine; its file gets the serialized message (hex)");
     }
-    unknown_bytes = bytes_with_blobs(dp);
+    unknown_bytes = datapack::proto_bytes(dp);
   }
 
   if (to_network) {
