@@ -14,6 +14,8 @@
 
 #include "config/simulation_config.h"
 #include "datapack/json.h"
+#include "datapack/nrp.h"
+#include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "dump_format.h"
 
@@ -111,6 +113,28 @@ json plain_json(const datapack::View& in, const json& value, int depth = 0) {
   return value;
 }
 
+// NRP-Core's name of a Convoy standard message ("Gazebo.Camera" for "convoy.data.Camera"),
+// "" for other types: what NRP-Core's engine would receive from the same TF.
+std::string nrp_name_of(const std::string& type) {
+  const google::protobuf::FileDescriptor* gazebo = datapack::nrp_package_file("Gazebo");
+  for (int i = 0; gazebo && i < gazebo->message_type_count(); ++i) {
+    const std::string& name = gazebo->message_type(i)->full_name();
+    if (datapack::standard_type_of(name) == type) return name;
+  }
+  return {};
+}
+
+// The registered type, or one compiled into this program; nullptr for others.
+const datapack::TypeInfo* find_type(const std::string& type) {
+  auto& registry = datapack::Registry::global();
+  if (const datapack::TypeInfo* info = registry.find(type)) return info;
+  try {
+    return &registry.add_by_name(type);
+  } catch (const std::invalid_argument&) {
+    return nullptr;
+  }
+}
+
 std::string timestamp_folder() {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
@@ -155,6 +179,18 @@ std::vector<engine::DataPackId> DataTransferEngine::initialize(const std::string
   base_ = (prefix.empty() ? "" : prefix + "/") + kTopicBase + "/" + simulation_id;
   if (std::string why = datatransfer::topic_problem(base_ + "/data"); !why.empty()) {
     throw key_error("MQTTPrefix / simulationID", why + ", got the topic " + quote(base_ + "/data"));
+  }
+
+  // NRP-Core's packages the engine takes (default "Dump"); Convoy has them all compiled in.
+  for (const auto& p : config.value("ProtobufPackages", json::array({"Dump"}))) {
+    const std::string package = p.get<std::string>();
+    if (!datapack::nrp_package_file(package)) {
+      std::string known;
+      for (const auto& k : datapack::nrp_packages()) known += (known.empty() ? "" : ", ") + k;
+      throw key_error("ProtobufPackages",
+                      "unknown package " + quote(package) + " (Convoy has " + known + ")");
+    }
+    packages_.insert(package);
   }
 
   const json& dumps = config.at("dumps");
@@ -298,78 +334,65 @@ void DataTransferEngine::set_datapack(const datapack::View& dp) {
   const bool to_network = dump.network && mqtt_ && mqtt_->connected();
   if (!to_network && !dump.file) return;
 
-  json value;  // JSON datapacks: the value with plain arrays
-  std::string type;
   if (dp.is_json()) {
-    value = plain_json(dp, datapack::read_json(dp));
-    type = std::string(datapack::kJsonType);
-  } else if (dp.is_proto()) {
-    type = dp.proto_type();
-  } else {
-    return;
-  }
-  const std::string& bytes = dp.message().proto().data();
-
-  if (to_network) {
-    if (type != dump.type) {
-      dump.type = type;
-      publish_topics();
-    }
-    std::string payload;
-    if (dp.is_json()) {
+    const json value = plain_json(dp, datapack::read_json(dp));
+    const std::string type(datapack::kJsonType);
+    if (to_network) {
       const json& out =
           stream_message_ ? datatransfer::json_datapack_message(dump.name, name_, value) : value;
-      payload = out.dump(-1, ' ', false, json::error_handler_t::replace);
-    } else {
-      payload =
-          stream_message_ ? datatransfer::datapack_message(dump.name, name_, type, bytes) : bytes;
+      publish(dump, type, out.dump(-1, ' ', false, json::error_handler_t::replace));
     }
-    if (std::string why = mqtt_->publish(dump.topic, payload, false);
-        !why.empty() && !dump.publish_warned) {
-      dump.publish_warned = true;
-      warn("datapack " + quote(dump.name) + " cannot be published to " + quote(dump.topic) + ": " +
-           why);
+    dump.type = type;
+    if (dump.file) write_line(dump, datatransfer::json_line(value, time_ns_));
+    return;
+  }
+  if (!dp.is_proto()) return;
+
+  // The message, read by the datapack library (large bytes fields from their blobs, in shared
+  // memory between local processes); Convoy's standard messages under NRP-Core's names.
+  const engine::ProtoPayload& payload = dp.message().proto();
+  std::string type = dp.proto_type();
+  if (std::string nrp = nrp_name_of(type); !nrp.empty()) type = nrp;
+  const datapack::TypeInfo* info = find_type(type);
+  std::unique_ptr<google::protobuf::Message> message;
+  std::string unknown_bytes;  // a type this program does not know: its bytes, blobs put back
+  if (info) {
+    check_package(dump, *info);
+    message.reset(info->prototype->New());
+    datapack::read_message(dp, message.get());
+  } else {
+    if (!dump.unknown_type_warned) {
+      dump.unknown_type_warned = true;
+      warn("datapack " + quote(dump.name) + ": protobuf type " + quote(type) +
+           " is unknown to this engine; its file gets the serialized message (hex)");
     }
+    unknown_bytes = datapack::proto_bytes(dp);
+  }
+
+  if (to_network) {
+    std::string serialized;
+    const std::string* bytes = &payload.data();  // already the message's bytes?
+    if (!info) {
+      bytes = &unknown_bytes;
+    } else if (type != dp.proto_type() || payload.blob_fields_size() > 0) {
+      serialized = message->SerializeAsString();
+      bytes = &serialized;
+    }
+    publish(
+        dump, type,
+        stream_message_ ? datatransfer::datapack_message(dump.name, name_, type, *bytes) : *bytes);
   }
   dump.type = type;
 
   if (!dump.file) return;
-  if (dp.is_json()) {
-    write_line(dump, datatransfer::json_line(value, time_ns_));
-    return;
-  }
-  auto& registry = datapack::Registry::global();
-  const datapack::TypeInfo* info = registry.find(type);
   if (!info) {
-    try {
-      info = &registry.add_by_name(type);
-    } catch (const std::invalid_argument&) {
-      info = nullptr;
-    }
-  }
-  if (!info) {
-    // A type this program does not know: its bytes, so that nothing is lost.
-    if (!dump.unknown_type_warned) {
-      dump.unknown_type_warned = true;
-      warn("datapack " + quote(dump.name) + ": protobuf type " + quote(type) +
-           " is unknown to this engine; its file gets the serialized bytes in hex");
-    }
     if (dump.header_type != type) {
       write_line(dump, "sim_time," + type + " (serialized, hex)");
       dump.header_type = type;
     }
-    static const char digits[] = "0123456789abcdef";
-    std::string line = datatransfer::seconds_text(time_ns_) + ",";
-    for (unsigned char c : bytes) {
-      line += digits[c >> 4];
-      line += digits[c & 15];
-    }
-    write_line(dump, line);
+    write_line(
+        dump, datatransfer::seconds_text(time_ns_) + "," + datatransfer::bytes_text(unknown_bytes));
     return;
-  }
-  std::unique_ptr<google::protobuf::Message> message(info->prototype->New());
-  if (!message->ParseFromString(bytes)) {
-    throw std::runtime_error(dp.describe() + ": the bytes do not parse as " + type);
   }
   if (dump.header_type != type) {
     if (std::string header = datatransfer::proto_header(*message->GetDescriptor());
@@ -379,6 +402,29 @@ void DataTransferEngine::set_datapack(const datapack::View& dp) {
     dump.header_type = type;
   }
   write_line(dump, datatransfer::proto_line(*message, time_ns_));
+}
+
+void DataTransferEngine::publish(Dump& dump, const std::string& type, const std::string& payload) {
+  if (type != dump.type) {
+    dump.type = type;
+    publish_topics();
+  }
+  if (std::string why = mqtt_->publish(dump.topic, payload, false);
+      !why.empty() && !dump.publish_warned) {
+    dump.publish_warned = true;
+    warn("datapack " + quote(dump.name) + " cannot be published to " + quote(dump.topic) + ": " +
+         why);
+  }
+}
+
+void DataTransferEngine::check_package(const Dump& dump, const datapack::TypeInfo& type) {
+  const std::string& package = type.descriptor->file()->package();
+  if (datapack::nrp_package_file(package) && !packages_.count(package) &&
+      warned_packages_.insert(package).second) {
+    warn("datapack " + quote(dump.name) + " has type " + type.name +
+         ", but ProtobufPackages does not list package " + quote(package) +
+         " (NRP-Core would not carry it; Convoy does)");
+  }
 }
 
 void DataTransferEngine::reset() {

@@ -1,12 +1,12 @@
 #include "dump_format.h"
 
-#include <google/protobuf/io/coded_stream.h>
-#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
-#include <google/protobuf/wire_format_lite.h>
+#include <google/protobuf/text_format.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+
+#include "nrp_protobuf/engine_grpc.pb.h"
 
 namespace convoy::datatransfer {
 
@@ -36,7 +36,10 @@ std::string shortest(T value) {
   return ec == std::errc() ? std::string(buf, end) : std::string("nan");
 }
 
-std::string hex(std::string_view bytes) {
+}  // namespace
+
+std::string bytes_text(std::string_view bytes) {
+  if (bytes.size() > kMaxBytesInFile) return "<" + std::to_string(bytes.size()) + " bytes>";
   static const char digits[] = "0123456789abcdef";
   std::string out;
   out.reserve(bytes.size() * 2);
@@ -47,6 +50,8 @@ std::string hex(std::string_view bytes) {
   return out;
 }
 
+namespace {
+
 bool is_dump_string(const gpb::Descriptor& d) {
   return d.full_name() == "Dump.String" && d.FindFieldByName("string_stream") != nullptr;
 }
@@ -56,6 +61,17 @@ bool is_dump_array_float(const gpb::Descriptor& d) {
   const gpb::FieldDescriptor* dims = d.FindFieldByName("dims");
   return d.full_name() == "Dump.ArrayFloat" && values && values->is_repeated() &&
          values->cpp_type() == gpb::FieldDescriptor::CPPTYPE_FLOAT && dims && dims->is_repeated();
+}
+
+// protobuf's one-line text form, long strings and bytes cut at kMaxBytesInFile.
+std::string short_text(const gpb::Message& m) {
+  gpb::TextFormat::Printer printer;
+  printer.SetSingleLineMode(true);
+  printer.SetTruncateStringFieldLongerThan(kMaxBytesInFile);
+  std::string out;
+  printer.PrintToString(m, &out);
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
 }
 
 // One element of a field (index < 0: a singular field).
@@ -81,11 +97,11 @@ std::string value_text(const gpb::Message& m, const gpb::FieldDescriptor* f, int
       return std::to_string(rep ? r->GetRepeatedEnumValue(m, f, index) : r->GetEnumValue(m, f));
     case gpb::FieldDescriptor::CPPTYPE_STRING: {
       std::string s = rep ? r->GetRepeatedString(m, f, index) : r->GetString(m, f);
-      return f->type() == gpb::FieldDescriptor::TYPE_BYTES ? hex(s) : s;
+      return f->type() == gpb::FieldDescriptor::TYPE_BYTES ? bytes_text(s) : s;
     }
     case gpb::FieldDescriptor::CPPTYPE_MESSAGE: {
       const gpb::Message& sub = rep ? r->GetRepeatedMessage(m, f, index) : r->GetMessage(m, f);
-      return "{" + sub.ShortDebugString() + "}";
+      return "{" + short_text(sub) + "}";
     }
   }
   return "";
@@ -165,34 +181,15 @@ std::string json_line(const nlohmann::json& value, int64_t time_ns) {
 
 std::string datapack_message(std::string_view name, std::string_view engine_name,
                              std::string_view type_name, std::string_view data) {
-  auto string_field = [](gpb::io::CodedOutputStream& out, int number, std::string_view s) {
-    out.WriteTag(gpb::internal::WireFormatLite::MakeTag(
-        number, gpb::internal::WireFormatLite::WIRETYPE_LENGTH_DELIMITED));
-    out.WriteVarint32(static_cast<uint32_t>(s.size()));
-    out.WriteRaw(s.data(), static_cast<int>(s.size()));
-  };
-  auto encode = [&](auto&& body) {
-    std::string bytes;
-    {
-      gpb::io::StringOutputStream stream(&bytes);
-      gpb::io::CodedOutputStream out(&stream);
-      body(out);
-    }
-    return bytes;
-  };
-  const std::string id = encode([&](gpb::io::CodedOutputStream& out) {
-    string_field(out, 1, name);
-    string_field(out, 2, engine_name);
-    string_field(out, 3, type_name);
-  });
-  const std::string any = encode([&](gpb::io::CodedOutputStream& out) {
-    string_field(out, 1, "type.googleapis.com/" + std::string(type_name));
-    string_field(out, 2, data);
-  });
-  return encode([&](gpb::io::CodedOutputStream& out) {
-    string_field(out, 1, id);
-    string_field(out, 2, any);
-  });
+  EngineGrpc::DataPackMessage message;
+  auto* id = message.mutable_datapackid();
+  id->set_datapackname(std::string(name));
+  id->set_datapacktype(std::string(type_name));
+  id->set_enginename(std::string(engine_name));
+  // What Any::PackFrom writes, without parsing the message again.
+  message.mutable_data()->set_type_url("type.googleapis.com/" + std::string(type_name));
+  message.mutable_data()->set_value(std::string(data));
+  return message.SerializeAsString();
 }
 
 nlohmann::json json_datapack_message(std::string_view name, std::string_view engine_name,

@@ -3,6 +3,7 @@
 #include <google/protobuf/descriptor.h>
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+#include <google/protobuf/unknown_field_set.h>
 #include <google/protobuf/wire_format.h>
 #include <google/protobuf/wire_format_lite.h>
 
@@ -134,6 +135,34 @@ void read_proto(const View& in, google::protobuf::Message* message) {
                                ", which has " + std::to_string(r->FieldSize(*message, f)));
     }
   }
+}
+
+std::string proto_bytes(const View& in) {
+  const engine::ProtoPayload& payload = in.message().proto();
+  if (payload.blob_fields_size() == 0) return payload.data();
+  pb::UnknownFieldSet fields;
+  if (!fields.ParseFromString(payload.data()))
+    throw std::runtime_error(in.describe() + ": corrupt " + in.proto_type());
+  for (const auto& bf : payload.blob_fields()) {
+    if (bf.blob() >= static_cast<uint32_t>(in.message().blobs_size()))
+      throw std::runtime_error(in.describe() + ": field " + std::to_string(bf.field()) +
+                               " refers to a missing blob");
+    const std::string_view bytes = in.blob(bf.blob());
+    std::string* target = nullptr;
+    uint32_t seen = 0;
+    for (int i = 0; i < fields.field_count() && !target; ++i) {
+      pb::UnknownField* f = fields.mutable_field(i);
+      if (static_cast<uint32_t>(f->number()) == bf.field() &&
+          f->type() == pb::UnknownField::TYPE_LENGTH_DELIMITED && seen++ == bf.index())
+        target = f->mutable_length_delimited();
+    }
+    if (!target) target = fields.AddLengthDelimited(static_cast<int>(bf.field()));
+    count_copy(bytes.size());
+    target->assign(bytes.data(), bytes.size());
+  }
+  std::string out;
+  fields.SerializeToString(&out);
+  return out;
 }
 
 }  // namespace convoy::datapack

@@ -22,6 +22,13 @@ void write_proto(Builder& out, const google::protobuf::Message& message);
 // parse, or blob references that do not fit the message.
 void read_proto(const View& in, google::protobuf::Message* message);
 
+// The serialized message of a protobuf datapack with the values that travelled as blobs put
+// back, without knowing its type (a program that has not compiled the message in): a
+// singular field's value is appended, a repeated field's element replaces the empty value
+// left in its place. Parses as read_proto's message would. Throws std::runtime_error naming
+// the datapack when the bytes do not parse or a blob is missing.
+std::string proto_bytes(const View& in);
+
 template <typename M>
 M read_proto(const View& in) {
   M m;

@@ -107,6 +107,56 @@ TEST(NrpMessages, RepeatedBytesKeepTheirOrderInline) {
   EXPECT_EQ(back.SerializeAsString(), a.SerializeAsString());
 }
 
+// proto_bytes: what a program that does not know the type (the data-transfer engine, say)
+// gets: the message's bytes with the blobs put back, parsing as the message.
+TEST(NrpMessages, ProtoBytesPutBlobsBackWithoutTheType) {
+  Shm shm;
+  NrpGenericProto::Image img;  // a singular bytes field (6) before nothing, after four others
+  img.set_height(2);
+  img.set_width(3);
+  img.set_data(pattern(100000, 8));
+  img.set_isbigendian(true);
+  NrpGenericProto::ArrayBytes a;  // large elements among small ones, and an empty one
+  a.add_array("head");
+  a.add_array(pattern(50000, 9));
+  a.add_array("");
+  a.add_array(pattern(kLargeBlobBytes, 10));
+  a.add_shape(4);
+  for (const google::protobuf::Message* m : {static_cast<google::protobuf::Message*>(&img),
+                                             static_cast<google::protobuf::Message*>(&a)}) {
+    engine::DataPack dp;
+    Builder out(&dp, shm.writer);
+    write_proto(out, *m);
+    ASSERT_GT(dp.proto().blob_fields_size(), 0);
+    const std::string bytes = proto_bytes(View(dp, shm.reader));
+    std::unique_ptr<google::protobuf::Message> back(m->New());
+    ASSERT_TRUE(back->ParseFromString(bytes));
+    EXPECT_EQ(back->SerializeAsString(), m->SerializeAsString()) << m->GetTypeName();
+  }
+  // Without blobs: the payload as it is.
+  Wrappers::BytesValue small;
+  small.set_value("abc");
+  engine::DataPack dp;
+  Builder out(&dp, shm.writer);
+  write_proto(out, small);
+  EXPECT_EQ(proto_bytes(View(dp, shm.reader)), small.SerializeAsString());
+  // A missing blob names the datapack.
+  Wrappers::BytesValue v;
+  v.set_value(pattern(100000, 11));
+  engine::DataPack big;
+  big.mutable_id()->set_name("bytes");
+  Builder bout(&big, shm.writer);
+  write_proto(bout, v);
+  big.mutable_proto()->mutable_blob_fields(0)->set_blob(5);
+  try {
+    proto_bytes(View(big, shm.reader));
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'bytes'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("missing blob"), std::string::npos) << e.what();
+  }
+}
+
 TEST(NrpMessages, BadBlobReferencesAreRefused) {
   InlineBlobWriter writer;
   Wrappers::BytesValue v;
