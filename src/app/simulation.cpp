@@ -167,8 +167,8 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
     log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
              " is not available; using Basic");
   for (const char* key :
-       {"ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph",
-        "EventLoop", "EventLoopTimeout", "EventLoopTimestep", "ROSNode", "MQTTNode"}) {
+       {"ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph", "EventLoop",
+        "EventLoopTimeout", "EventLoopTimestep", "ROSNode", "MQTTNode"}) {
     // An object counts when present ("ROSNode": {} starts a node with the defaults in NRP-Core);
     // an empty list asks for nothing.
     if (cfg->json.contains(key) && (!cfg->json[key].empty() || cfg->json[key].is_object())) {
