@@ -99,6 +99,7 @@ class SumoEngine final : public Engine {
   std::map<std::string, std::string> pending_lights_;
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
+  double sumo_s_ = 0, read_s_ = 0, write_s_ = 0;  // time spent, for the log
 };
 
 }  // namespace convoy::engines::sumo
