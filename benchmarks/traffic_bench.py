@@ -10,6 +10,8 @@ demand, written to a temporary folder:
 at a 0.1 s step (10 Hz), both with SUMO's seed 42:
   - SUMO alone: `sumo -n net -r routes --step-length 0.1 --end 600 --no-step-log --seed 42`
     (with --summary-output, one line a step, for the vehicle counts), wall time of the process;
+  - SUMO alone in-process: the same through libsumo (Debian's Python module, a loop of
+    simulationStep() with nothing read), wall time of the process, start-up included;
   - Convoy: `convoy run` of a config with the sumo engine publishing every vehicle as a
     convoy.data.RoadUsers datapack each step and a TF that reads it each step (the message is
     built, moved to the coordinator and parsed in Python), SimulationTimeout 600, wall time of
@@ -91,6 +93,28 @@ def sumo_alone(work, net, routes, end, i):
     return wall, max(running), sum(running)
 
 
+LIBSUMO_LOOP = textwrap.dedent("""\
+    import sys
+    import libsumo
+    net, routes, end = sys.argv[1], sys.argv[2], float(sys.argv[3])
+    libsumo.start(["sumo", "-n", net, "-r", routes, "--step-length", "0.1", "--no-step-log",
+                   "true", "--seed", "42"])
+    for i in range(int(round(end / 0.1))):
+        libsumo.simulationStep((i + 1) * 0.1)
+    libsumo.close()
+    """)
+
+
+def libsumo_alone(work, net, routes, end):
+    script = os.path.join(work, "libsumo_loop.py")
+    with open(script, "w") as f:
+        f.write(LIBSUMO_LOOP)
+    t0 = time.monotonic()
+    run(["/usr/bin/python3", script, net, routes, str(end)],
+        env=dict(os.environ, SUMO_HOME=SUMO_HOME))
+    return time.monotonic() - t0
+
+
 def convoy_run(work, net, routes, end, i, build):
     stats = os.path.join(work, "stats%d.json" % i)
     exp = os.path.join(work, "convoy%d" % i)
@@ -120,23 +144,29 @@ def section_sumo(args):
     work = tempfile.mkdtemp(prefix="convoy-trafficbench-")
     try:
         net, routes = make_scenario(work, args.grid, args.end)
-        alone, convoy = [], []
-        for i in range(args.runs):  # interleaved, so that both see the same machine
+        alone, inproc, convoy = [], [], []
+        for i in range(args.runs):  # interleaved, so that all see the same machine
             alone.append(sumo_alone(work, net, routes, args.end, i))
+            inproc.append(libsumo_alone(work, net, routes, args.end))
             convoy.append(convoy_run(work, net, routes, args.end, i, args.build))
-            print("  run %d: SUMO alone %.2f s (peak %d), Convoy sumo engine %.2f s (peak %d)"
-                  % (i, alone[-1][0], alone[-1][1], convoy[-1][0], convoy[-1][1]), flush=True)
+            print("  run %d: SUMO alone %.2f s (peak %d), libsumo alone %.2f s, Convoy sumo "
+                  "engine %.2f s (peak %d)" % (i, alone[-1][0], alone[-1][1], inproc[-1],
+                                               convoy[-1][0], convoy[-1][1]), flush=True)
         wa = statistics.median(w for w, _, _ in alone)
+        wl = statistics.median(inproc)
         wc = statistics.median(w for w, _, _ in convoy)
         print("sumo: grid %dx%d x 200 m, 2 lanes, randomTrips -e %d -p 0.25, 0.1 s step, %d runs"
               % (args.grid, args.grid, args.end, args.runs))
         print("  SUMO alone (sumo binary):  %.2f s wall for %d s simulated (%.1fx real time), "
               "peak %d vehicles, %.0f vehicle-steps per wall second"
               % (wa, args.end, args.end / wa, alone[0][1], alone[0][2] / wa))
+        print("  SUMO alone (libsumo):      %.2f s wall (%.1fx real time), %.0f vehicle-steps per "
+              "wall second" % (wl, args.end / wl, alone[0][2] / wl))
         print("  Convoy, sumo engine + TF:  %.2f s wall for %d s simulated (%.1fx real time), "
               "peak %d vehicles, %.0f vehicle-steps per wall second"
               % (wc, args.end, args.end / wc, convoy[0][1], convoy[0][2] / wc))
-        print("  sumo engine speed / SUMO alone: %.2fx  target >= 0.8x" % (wa / wc))
+        print("  sumo engine speed / SUMO alone (libsumo): %.2fx" % (wl / wc))
+        print("  sumo engine speed / SUMO alone (sumo binary): %.2fx  target >= 0.8x" % (wa / wc))
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
