@@ -170,6 +170,7 @@ std::vector<engine::DataPackId> SumoEngine::initialize(const std::string& name, 
   ext_users_dp_ = config.at("ExternalRoadUsersDataPack").get<std::string>();
   ext_lights_dp_ = config.at("ExternalTrafficLightsDataPack").get<std::string>();
   lights_external_ = config.at("TrafficLightsLeader").get<std::string>() == "external";
+  match_distance_ = config.at("ExternalMatchDistance").get<double>();
 
   load();
 
@@ -333,27 +334,49 @@ void SumoEngine::apply_external_users() {
     }
     const std::string sumo_id = kExternalPrefix + id;
     const double length = u.length() > 0 ? u.length() : 4.5;
+    const double c = std::cos(u.yaw()), s = std::sin(u.yaw());
+    const double front =
+        u.length() > 0 ? u.length_offset() + 0.5 * u.length() : length * (1.0 - kRearAxleFraction);
+    const double x = u.x() + front * c + offset_.x, y = u.y() + front * s + offset_.y;
+    const std::string category = u.category().empty() ? "car" : u.category();
     try {
+      // SUMO places a vehicle far from every lane off-road, where it is removed at the next
+      // step (and, added again, blocks its route's start): such a road user stays out.
+      const libsumo::TraCIRoadPosition road =
+          libsumo::Simulation::convertRoad(x, y, false, vclass_of(category));
+      const libsumo::TraCIPosition on =
+          road.edgeID.empty()
+              ? libsumo::TraCIPosition()
+              : libsumo::Simulation::convert2D(road.edgeID, road.pos, road.laneIndex);
+      const double off = road.edgeID.empty() ? 1e9 : std::hypot(on.x - x, on.y - y);
+      if (off > match_distance_) {
+        throw std::runtime_error("its front is " + std::to_string(off) +
+                                 " m from the nearest lane, more than ExternalMatchDistance " +
+                                 std::to_string(match_distance_));
+      }
       if (in == in_sumo_.end()) {
-        const std::string category = u.category().empty() ? "car" : u.category();
         libsumo::Vehicle::add(sumo_id, kExternalRoute, "convoy_" + category);
+        in = in_sumo_.emplace(id, sumo_id).first;
         libsumo::Vehicle::setLength(sumo_id, length);
         if (u.width() > 0) libsumo::Vehicle::setWidth(sumo_id, u.width());
         libsumo::Vehicle::setSpeedMode(sumo_id, 0);  // its own engine drives it
         libsumo::Vehicle::setLaneChangeMode(sumo_id, 0);
-        in = in_sumo_.emplace(id, sumo_id).first;
       }
-      const double c = std::cos(u.yaw()), s = std::sin(u.yaw());
-      const double front = u.length() > 0 ? u.length_offset() + 0.5 * u.length()
-                                          : length * (1.0 - kRearAxleFraction);
       // keepRoute 2: mapped onto the nearest lane whatever its route (as CARLA-SUMO does).
-      libsumo::Vehicle::moveToXY(sumo_id, "", -1, u.x() + front * c + offset_.x,
-                                 u.y() + front * s + offset_.y, sumo_angle_from_yaw(u.yaw()), 2);
+      libsumo::Vehicle::moveToXY(sumo_id, "", -1, x, y, sumo_angle_from_yaw(u.yaw()), 2);
       libsumo::Vehicle::setSpeed(sumo_id, std::max(0.0, u.speed()));
       libsumo::Vehicle::setSignals(sumo_id, signals_of(u.lights()));
     } catch (const std::exception& e) {
+      // Not placed: taken out again, or SUMO would insert it at its route's start.
+      if (in != in_sumo_.end()) {
+        try {
+          libsumo::Vehicle::remove(sumo_id);
+        } catch (const std::exception&) {
+        }
+        in_sumo_.erase(in);
+      }
       warn_once("place:" + id, "external road user '" + id + "' cannot be put into SUMO (" +
-                                   e.what() + "); it is left out while it stays there");
+                                   e.what() + "); it is left out of SUMO while it is so");
     }
   }
   pending_users_.clear();
@@ -469,6 +492,7 @@ void SumoEngine::get_datapack(const engine::DataPackId& id, datapack::Builder& o
 }
 
 void SumoEngine::reset() {
+  shutdown();
   tracked_.clear();
   in_sumo_.clear();
   pending_users_.clear();

@@ -15,6 +15,8 @@
 //   TrafficLightsLeader  "sumo" (SUMO runs its programs) | "external" (a datapack sets them)
 //   ExternalRoadUsersDataPack  name of the datapack of road users put into SUMO
 //                        ("external_road_users")
+//   ExternalMatchDistance  an external road user whose front is farther than this from every
+//                        lane SUMO lets its class use is left out of SUMO (m, default 5)
 //   ExternalTrafficLightsDataPack  name of the datapack setting the lights when they are led
 //                        from outside ("traffic_lights_in")
 // SUMO's step length is the EngineTimestep.
@@ -86,6 +88,7 @@ class SumoEngine final : public Engine {
   int64_t time_ns_ = 0;
   bool loaded_ = false;
   bool lights_external_ = false;
+  double match_distance_ = 5.0;
   std::string vehicles_dp_, lights_dp_, ext_users_dp_, ext_lights_dp_;
 
   std::unordered_map<std::string, TypeInfo> types_;

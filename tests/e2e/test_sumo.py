@@ -206,6 +206,17 @@ class ExternalRoadUsers(SumoCase):
         self.assertLess(last["speed"], 0.1)
         self.assertTrue(last["lights"] & 2 or last["speed"] == 0.0)
 
+    def test_external_car_off_the_network_is_warned_and_left_out(self):
+        out = self.experiment(timeout=25.0, extra_tf=OBSTACLE.format(x=X0 + 50, y=Y0 + 900))
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        log = self.read_log("sumo")  # a warning after Initialize goes to the engine's log
+        self.assertRegex(log, r"warning: sumo engine 'sumo': external road user 'ego' cannot be put")
+        self.assertEqual(log.count("cannot be put into SUMO"), 1, "warned once")
+        # Nothing of it stays in SUMO: the SUMO vehicle drives the whole road.
+        xs = [u["x"] for row in self.stream(out) for u in row["users"]]
+        self.assertGreater(max(xs), X0 + 125)
+
     def test_without_the_external_car_it_drives_past(self):
         out = self.experiment(timeout=25.0)
         r = self.run_convoy()
