@@ -47,6 +47,7 @@ XODR = """<?xml version="1.0" encoding="UTF-8"?>
 """.format(L=LENGTH, x0=X0, y0=Y0, w=LANE_W)
 
 RECORD_TF = """\
+import hashlib
 import json
 from nrp_core import *
 from nrp_core.data.nrp_protobuf import RoadUserDataPack
@@ -61,6 +62,7 @@ def record(v, tl):
     row = {{"users": [], "lights": None}}
     if not v.isEmpty():
         row["t"] = v.data.time_ns
+        row["digest"] = hashlib.sha1(v.data.SerializeToString()).hexdigest()  # every field
         row["users"] = [dict(id=u.id, category=u.category, model=u.model, absent=u.absent,
                              x=u.x, y=u.y, yaw=u.yaw, speed=u.speed, length=u.length,
                              length_offset=u.length_offset, lights=u.lights)
