@@ -87,6 +87,14 @@ OBSTACLE = """\
     out.append(u)
 """
 
+# The same obstacle as the JSON a python_json road user publishes (docs/road_users.md).
+OBSTACLE_JSON = """\
+    from nrp_core.data.nrp_json import JsonDataPack
+    out.append(JsonDataPack("external_road_users", "sumo", {{"users": [
+        {{"id": "ego", "category": "car", "x": {x}, "y": {y}, "yaw": 0.0, "length": 4.5,
+          "width": 1.8, "length_offset": 1.35}}]}}))
+"""
+
 LIGHTS = """\
     from nrp_core.data.nrp_json import JsonDataPack
     out.append(JsonDataPack("traffic_lights_in", "sumo", {{"lights": {{{tls!r}: {state!r}}}}}))
@@ -190,9 +198,9 @@ class Determinism(SumoCase):
 
 
 class ExternalRoadUsers(SumoCase):
-    def test_sumo_vehicle_stops_behind_an_external_car(self):
+    def test_sumo_vehicle_stops_behind_an_external_car(self, obstacle=OBSTACLE):
         stop_x = X0 + 120
-        out = self.experiment(timeout=25.0, extra_tf=OBSTACLE.format(x=stop_x, y=Y0 - LANE_W / 2))
+        out = self.experiment(timeout=25.0, extra_tf=obstacle.format(x=stop_x, y=Y0 - LANE_W / 2))
         r = self.run_convoy()
         self.assertExit(r, 0)
         rows = [row for row in self.stream(out) if row["users"]]
@@ -207,6 +215,9 @@ class ExternalRoadUsers(SumoCase):
         self.assertGreater(front, obstacle_rear - 15)
         self.assertLess(last["speed"], 0.1)
         self.assertTrue(last["lights"] & 2 or last["speed"] == 0.0)
+
+    def test_external_car_as_json(self):
+        self.test_sumo_vehicle_stops_behind_an_external_car(OBSTACLE_JSON)
 
     def test_external_car_off_the_network_is_warned_and_left_out(self):
         out = self.experiment(timeout=25.0, extra_tf=OBSTACLE.format(x=X0 + 50, y=Y0 + 900))
