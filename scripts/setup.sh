@@ -15,6 +15,7 @@ PACKAGES=(
   libtinyxml2-dev libjemalloc-dev libopencv-dev python3-onnx python3-opencv
   clang libfuzzer-14-dev
   python3-grpcio mosquitto libmosquitto-dev
+  sumo sumo-tools
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
