@@ -187,7 +187,14 @@ int cmd_info(const Args& args) {
   }
   print_link_gaps(net);
   const odr::Road& first = net.roads.front();
-  const odr::Route loop = odr::plan_route(net, first.id, 0, odr::Travel::kReferenceDirection);
+  odr::Route loop;
+  try {
+    loop = odr::plan_route(net, first.id, 0, odr::Travel::kReferenceDirection);
+  } catch (const std::runtime_error& e) {
+    // Maps with junctions: routes go over the lane graph (convoy-odr route).
+    std::printf("no loop followed from road %s: %s\n", first.id.c_str(), e.what());
+    return 0;
+  }
   std::string roads;
   for (const auto& leg : loop.legs) roads += (roads.empty() ? "" : " -> ") + leg.road_id;
   if (loop.closed) {
