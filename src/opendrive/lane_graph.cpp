@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -417,23 +418,41 @@ LaneIndex LaneGraph::require(const std::string& road_id, int lane_id, double s) 
   if (i == kNoLane) {
     const Road& road = net_->roads[it->second];
     const LaneSection& sec = road.sections[road.section_index(std::clamp(s, 0.0, road.length))];
-    fail("road " + road_id + " has no lane " + std::to_string(lane_id) +
-         " at s=" + std::to_string(s) + " (lanes " + std::to_string(sec.min_lane_id()) + ".." +
-         std::to_string(sec.max_lane_id()) + ", 0 is the centre)");
+    char at[32];
+    std::snprintf(at, sizeof at, "%.3f", std::clamp(s, 0.0, road.length));
+    fail("road " + road_id + " has no lane " + std::to_string(lane_id) + " at s=" + at +
+         " (lanes " + std::to_string(sec.min_lane_id()) + ".." + std::to_string(sec.max_lane_id()) +
+         ", 0 is the centre)");
   }
   return i;
 }
 
+// The lanes with this id over all sections of a road, in s order; throws without any.
+static std::vector<LaneIndex> lanes_with_id(const LaneGraph& g, const Road& road, int lane_id) {
+  std::vector<LaneIndex> out;
+  for (const LaneSection& sec : road.sections) {
+    const LaneIndex i = g.find(road.id, lane_id, sec.s + 0.5 * (sec.s_end - sec.s));
+    if (i != kNoLane && (out.empty() || out.back() != i)) out.push_back(i);
+  }
+  return out;
+}
+
 LaneIndex LaneGraph::entry_lane(const std::string& road_id, int lane_id) const {
-  LaneIndex first = require(road_id, lane_id, 0);
-  const LaneIndex last = require(road_id, lane_id, kInf);
-  return lanes_[first].forward ? first : last;
+  auto it = road_by_id_.find(road_id);
+  if (it == road_by_id_.end()) fail("no road with id '" + road_id + "'");
+  const std::vector<LaneIndex> all = lanes_with_id(*this, net_->roads[it->second], lane_id);
+  if (all.empty()) require(road_id, lane_id, 0);  // throws, naming the lanes there are
+  if (all.empty()) fail("road " + road_id + " has no lane " + std::to_string(lane_id));
+  return lanes_[all.front()].forward ? all.front() : all.back();
 }
 
 LaneIndex LaneGraph::exit_lane(const std::string& road_id, int lane_id) const {
-  LaneIndex first = require(road_id, lane_id, 0);
-  const LaneIndex last = require(road_id, lane_id, kInf);
-  return lanes_[first].forward ? last : first;
+  auto it = road_by_id_.find(road_id);
+  if (it == road_by_id_.end()) fail("no road with id '" + road_id + "'");
+  const std::vector<LaneIndex> all = lanes_with_id(*this, net_->roads[it->second], lane_id);
+  if (all.empty()) require(road_id, lane_id, 0);
+  if (all.empty()) fail("road " + road_id + " has no lane " + std::to_string(lane_id));
+  return lanes_[all.front()].forward ? all.back() : all.front();
 }
 
 std::vector<LaneIndex> LaneGraph::successors(LaneIndex lane) const {
