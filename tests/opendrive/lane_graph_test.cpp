@@ -160,6 +160,22 @@ TEST(LaneGraph, LaneChanges) {
   EXPECT_NEAR(pts[pts.size() / 2].y, -3.5, 0.1);
 }
 
+TEST(LaneGraph, PedestrianRoutesOnSidewalksEitherWay) {
+  const LaneGraph& g = test_graph();
+  RouteOptions walk;
+  walk.lane_types = {"sidewalk"};
+  walk.both_directions = true;
+  const LaneIndex sw = g.require("a", -3, 0);
+  const auto back = g.route(sw, 40, sw, 10, walk);  // against the lane's driving direction
+  ASSERT_TRUE(back);
+  ASSERT_EQ(back->segments.size(), 1u);
+  EXPECT_EQ(back->segments[0].s_from, 40);
+  EXPECT_EQ(back->segments[0].s_to, 10);
+  EXPECT_NEAR(back->length, 30, 1e-9);
+  EXPECT_FALSE(g.route(sw, 40, sw, 10));  // not for a driver (and not a driving lane)
+  EXPECT_FALSE(g.route(sw, 10, g.require("e", -2, 0), 5, walk));  // sidewalks not joined
+}
+
 TEST(LaneGraph, LeftHandTraffic) {
   std::string xml = read(kData + "/lane_graph.xodr");
   const std::string from = "<road id=\"a\" length=\"100\" junction=\"-1\">";
