@@ -540,7 +540,8 @@ std::optional<LaneRoute> LaneGraph::route(LaneIndex from, double s_from, LaneInd
     }
   };
   while (!queue.empty()) {
-    const auto [du, u] = queue.top();
+    const double du = queue.top().first;
+    const size_t u = queue.top().second;
     queue.pop();
     if (done[u] || du > dist[u]) continue;
     if (du >= best) break;
@@ -806,7 +807,7 @@ std::optional<LanePosition> LaneGraph::locate(double x, double y, std::optional<
           (std::abs(key0 - best_key0) <= 1e-9 && key1 < best_key1 - 1e-12)) {
         best_key0 = key0;
         best_key1 = key1;
-        best = LanePosition{n.index, road.id, lane.id, s, t - c.t, lane_heading, key0};
+        best = LanePosition{n.index, road.id, lane.id, s, t - c.t, t, lane_heading, key0};
       }
     }
   }

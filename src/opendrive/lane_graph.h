@@ -63,13 +63,15 @@ struct LaneNode {
 };
 
 // A position on a lane. t is lateral from the lane centre, positive to the left of the
-// road's reference direction (not of the driving direction).
+// road's reference direction (not of the driving direction); road_t is the same offset from
+// the road's reference line (what convoy.data.RoadUser's `t` holds).
 struct LanePosition {
   LaneIndex lane = kNoLane;
   std::string road_id;
   int lane_id = 0;
   double s = 0;
   double t = 0;
+  double road_t = 0;
   double heading = 0;   // of the lane's driving direction, at s (rad)
   double distance = 0;  // from the lane's borders (0 inside the lane)
 };

@@ -210,7 +210,8 @@ TEST(LaneGraph, WorldPoseAndLocateRoundTrip) {
     EXPECT_NEAR(back->t, c.t, 1e-3) << c.road;
     EXPECT_NEAR(back->distance, 0, 1e-12);
   }
-  EXPECT_FALSE(g.locate(100, 100));  // far from every road
+  EXPECT_NEAR(g.locate(220, -1.45)->road_t, -1.45, 1e-12);  // from the reference line
+  EXPECT_FALSE(g.locate(100, 100));                         // far from every road
   const auto off = g.locate(25, 9);  // 1 m beyond a's left sidewalk (5.5 m wide side)
   ASSERT_TRUE(off);
   EXPECT_EQ(off->lane_id, 2);
