@@ -360,11 +360,22 @@ void LaneGraph::collect_objects() {
         t1 = std::max(t1, t);
       }
       const size_t k = road.section_index(o.s);
+      std::array<double, 2> gap{kInf, kInf};
       for (const Lane& lane : road.sections[k].lanes) {
         if (lane.id == 0) continue;
         const LaneBorders b = road.lane_borders(k, o.s, lane.id);
         const double lo = std::min(b.inner, b.outer), hi = std::max(b.inner, b.outer);
         if (hi > t0 + 1e-6 && lo < t1 - 1e-6) cw.lanes.push_back(lane_in_section(r, k, lane.id));
+        if (lane.type != "sidewalk" || hi - lo <= 1e-9) continue;
+        const double below = t0 - hi, above = lo - t1;  // gaps to the crosswalk's ends
+        if (below >= -1e-6 && below <= 3 && (cw.ends[0] == kNoLane || below < gap[0])) {
+          cw.ends[0] = lane_in_section(r, k, lane.id);
+          gap[0] = below;
+        }
+        if (above >= -1e-6 && above <= 3 && (cw.ends[1] == kNoLane || above < gap[1])) {
+          cw.ends[1] = lane_in_section(r, k, lane.id);
+          gap[1] = above;
+        }
       }
       crosswalks_.push_back(std::move(cw));
     }

@@ -119,6 +119,9 @@ struct Crosswalk {
   double s = 0, t = 0;
   std::vector<std::array<double, 2>> polygon;  // world x, y (the outline, or the object's box)
   std::vector<LaneIndex> lanes;                // lanes of the section at s it covers
+  // The sidewalks it leads to: the nearest sidewalk lane within 3 m beyond each end of its
+  // t range (ends[0] on the -t side, ends[1] on the +t side), kNoLane where there is none.
+  std::array<LaneIndex, 2> ends{kNoLane, kNoLane};
 };
 
 struct SignalInfo {

@@ -230,6 +230,8 @@ TEST(LaneGraph, SpeedLimitsCrosswalksSidewalksSignals) {
   EXPECT_NEAR(cw.polygon[0][0], 208, 1e-12);
   EXPECT_NEAR(cw.polygon[0][1], -3.5, 1e-12);
   EXPECT_EQ(sorted(cw.lanes), sorted({g.require("e", 1, 10), g.require("e", -1, 10)}));
+  EXPECT_EQ(cw.ends[0], g.require("e", -2, 10));  // the sidewalk on the right
+  EXPECT_EQ(cw.ends[1], kNoLane);                 // none on the left
   EXPECT_EQ(sorted(g.sidewalks()),
             sorted({g.require("a", 2, 0), g.require("a", -3, 0), g.require("e", -2, 0)}));
   ASSERT_EQ(g.signals().size(), 1u);
@@ -295,6 +297,13 @@ TEST(CityMap, LightsCrosswalksSidewalksAndSpeeds) {
     }
   }
   EXPECT_EQ(g.crosswalks().size(), 8u);
+  for (const Crosswalk& cw : g.crosswalks()) {  // sidewalk to sidewalk across the carriageway
+    ASSERT_NE(cw.ends[0], kNoLane);
+    ASSERT_NE(cw.ends[1], kNoLane);
+    EXPECT_EQ(g.lane(cw.ends[0]).type, "sidewalk");
+    EXPECT_EQ(g.lane(cw.ends[1]).type, "sidewalk");
+    EXPECT_EQ(g.lane(cw.ends[0]).lane_id, -g.lane(cw.ends[1]).lane_id);
+  }
   EXPECT_EQ(g.sidewalks().size(), 14u);  // 7 roads, one each side
   EXPECT_NEAR(g.speed_limit(g.require("1", -1, 5), 5).mps, 50 / 3.6, 1e-12);
   EXPECT_NEAR(g.speed_limit(g.require("4", -1, 5), 5).mps, 30 / 3.6, 1e-12);
