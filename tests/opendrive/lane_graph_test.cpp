@@ -304,7 +304,17 @@ TEST(CityMap, LightsCrosswalksSidewalksAndSpeeds) {
     EXPECT_EQ(g.lane(cw.ends[1]).type, "sidewalk");
     EXPECT_EQ(g.lane(cw.ends[0]).lane_id, -g.lane(cw.ends[1]).lane_id);
   }
-  EXPECT_EQ(g.sidewalks().size(), 14u);  // 7 roads, one each side
+  EXPECT_EQ(g.sidewalks().size(), 22u);  // 7 roads, one each side, and 4 corners a junction
+  // A pedestrian walks from the main road's south sidewalk round the corner of junction 100
+  // into the south arm's west sidewalk (against that lane's s).
+  RouteOptions walk;
+  walk.lane_types = {"sidewalk"};
+  walk.both_directions = true;
+  const auto r = g.route(g.require("1", -3, 100), 100, g.require("5", 2, 50), 50, walk);
+  ASSERT_TRUE(r);
+  EXPECT_THAT(r->junctions, ElementsAre("100"));
+  ASSERT_EQ(r->segments.size(), 3u);
+  EXPECT_EQ(r->segments.back().s_to, 50);
   EXPECT_NEAR(g.speed_limit(g.require("1", -1, 5), 5).mps, 50 / 3.6, 1e-12);
   EXPECT_NEAR(g.speed_limit(g.require("4", -1, 5), 5).mps, 30 / 3.6, 1e-12);
   EXPECT_TRUE(g.warnings().empty());

@@ -21,7 +21,8 @@ sidewalk; side roads one driving lane of 3.5 m per direction and a 2.5 m sidewal
 traffic. Speed limits: 50 km/h on main roads, 30 km/h on side roads and in the junctions.
 
 Every junction has all movements but U-turns: straight on (lane k to lane k), left from the
-innermost lane, right from the outermost. At each arm a traffic light (dynamic signal, type
+innermost lane, right from the outermost; and sidewalks round its four corners (connecting
+roads with one sidewalk lane). At each arm a traffic light (dynamic signal, type
 1000001, validity on the arm's incoming lanes) stands before a crosswalk (<object
 type="crosswalk"> with an outline across the carriageway). Each junction has two controllers,
 switched in sequence: its main-road lights, then its side-road lights.
@@ -186,6 +187,34 @@ def build():
                     roads.append(c)
                     connections.append((len(connections), a["road"].id, cid,
                                         a["incoming"][ka - 1]))
+        # Sidewalks round the corners: from each arm's sidewalk on its incoming side to the
+        # sidewalk on the outgoing side of the arm to its right.
+        for a in info:
+            h_in = wrap(a["outward"] + math.pi)
+            for b in info:
+                if b is a or abs(wrap(b["outward"] - h_in) + math.pi / 2) > 0.3:
+                    continue
+
+                def edge(arm, heading):
+                    d = arm["n"] * LANE_WIDTH
+                    return (arm["pos"][0] + d * math.sin(heading),
+                            arm["pos"][1] - d * math.cos(heading), heading)
+                pa, pb = edge(a, h_in), edge(b, b["outward"])
+                cid = str(next_road)
+                next_road += 1
+                c = Road(cid, "J%s sidewalk %s-%s" % (jid, a["road"].id, b["road"].id), pa, [],
+                         [(-1, "sidewalk", SIDEWALK_WIDTH, None)], SIDE_KMH)
+                length, u, v, _ = hermite(pa, pb)
+                c.length = length
+                c.geoms = [(0.0, pa[0], pa[1], pa[2], "paramPoly3", length, u, v)]
+                c.junction = jid
+                c.predecessor = ("road", a["road"].id, "end" if a["at_end"] else "start")
+                c.successor = ("road", b["road"].id, "end" if b["at_end"] else "start")
+                sa = -(a["n"] + 1) if a["at_end"] else a["n"] + 1
+                sb = b["n"] + 1 if b["at_end"] else -(b["n"] + 1)
+                c.lane_links = {-1: (sa, sb)}
+                roads.append(c)
+                connections.append((len(connections), a["road"].id, cid, sa))
         # Lights and crosswalks at each arm.
         groups = {0: [], 1: []}
         for a in info:
