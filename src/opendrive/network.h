@@ -7,8 +7,9 @@
 // ids 1, 2, ... outwards, right lanes -1, -2, ... outwards. A lane's road mark lies on its
 // outer border (the centre lane's on the lane-offset line).
 //
-// Not modelled: junction connectivity (roads inside junctions load, their connections are
-// ignored), superelevation and lateral shape, lane <border> records, objects and signals.
+// Junctions, speed limits, objects (their outlines) and signals are stored as read; the lane
+// graph (lane_graph.h) turns them into connectivity. Not modelled: superelevation and lateral
+// shape, lane <border> records, <signalReference>s.
 #pragma once
 
 #include <optional>
@@ -59,6 +60,13 @@ struct RoadMark {
   std::vector<RoadMarkLine> lines;  // explicit <type><line> definitions, if any
 };
 
+// A speed limit from s on: road <type><speed> or lane <speed>, converted to m/s. max_mps is
+// +infinity for "no limit" and NaN for "undefined".
+struct SpeedRecord {
+  double start = 0;  // road s
+  double max_mps = 0;
+};
+
 struct Lane {
   int id = 0;
   std::string type = "none";  // driving, sidewalk, border, shoulder, median, none, ...
@@ -67,6 +75,7 @@ struct Lane {
   std::vector<RoadMark> road_marks;
   std::optional<int> predecessor;  // lane link ids, if given
   std::optional<int> successor;
+  std::vector<SpeedRecord> speeds;  // <speed> records, starts are road s
 };
 
 struct LaneSection {
@@ -96,6 +105,49 @@ struct LaneBorders {
   double outer_slope = 0;
 };
 
+// One corner of an object's <outline>: <cornerRoad s t> (road = true) or <cornerLocal u v>
+// (road = false, in the object's frame: origin at (s, t), u along hdg relative to the road).
+struct OutlineCorner {
+  bool road = true;
+  double a = 0;  // s or u
+  double b = 0;  // t or v
+};
+
+// An <object> of a road (crosswalks, poles, buildings, ...).
+struct RoadObject {
+  std::string id;
+  std::string name;
+  std::string type;  // crosswalk, pole, building, ...
+  double s = 0;
+  double t = 0;
+  double z_offset = 0;
+  double hdg = 0;  // relative to the road's reference heading
+  double length = 0;
+  double width = 0;
+  double height = 0;
+  std::string orientation;             // +, - or none
+  std::vector<OutlineCorner> outline;  // the first <outline>'s corners, if any
+};
+
+// A <signal> of a road. Traffic lights are dynamic signals of type 1000001 (OpenDRIVE's
+// catalogue; 1000002 is a pedestrian light).
+struct Signal {
+  std::string id;
+  std::string name;
+  double s = 0;
+  double t = 0;
+  double z_offset = 0;
+  double h_offset = 0;
+  bool dynamic = false;
+  std::string orientation;  // "+": valid for traffic along s, "-": against, "none": both
+  std::string country;
+  std::string type;
+  std::string subtype;
+  double value = 0;  // NaN when not given
+  std::string unit;
+  std::vector<std::pair<int, int>> validity;  // <validity fromLane toLane>; empty = all lanes
+};
+
 class Road {
  public:
   std::string id;
@@ -108,7 +160,10 @@ class Road {
   std::vector<Geometry> plan_view;  // sorted by s
   std::vector<CubicRecord> elevation_profile;
   std::vector<CubicRecord> lane_offsets;
-  std::vector<LaneSection> sections;  // sorted by s
+  std::vector<LaneSection> sections;      // sorted by s
+  std::vector<SpeedRecord> speed_limits;  // from <type s><speed>, sorted by s
+  std::vector<RoadObject> objects;
+  std::vector<Signal> signals;
 
   // Reference line pose at s (clamped to [0, length]).
   Pose2 reference(double s) const;
@@ -144,13 +199,42 @@ struct Header {
   double north = 0, south = 0, east = 0, west = 0;
 };
 
+// <junction><connection>: incoming road -> connecting road (a road inside the junction),
+// entered at its contactPoint; lane_links are the <laneLink from to> pairs.
+struct JunctionConnection {
+  std::string id;
+  std::string incoming_road;
+  std::string connecting_road;  // or, in a direct junction, the linkedRoad
+  std::string contact_point;    // start or end (of the connecting road)
+  std::vector<std::pair<int, int>> lane_links;
+  int line = 0;  // in the file, for messages
+};
+
+struct Junction {
+  std::string id;
+  std::string name;
+  std::vector<JunctionConnection> connections;
+  std::vector<std::string> controllers;  // ids of the <controller>s it names, in sequence order
+  int line = 0;
+};
+
+// A top-level <controller>: signals switched together.
+struct Controller {
+  std::string id;
+  std::string name;
+  std::vector<std::string> signal_ids;  // <control signalId>
+};
+
 struct Network {
   std::string source;  // the file name given to load(), for messages
   Header header;
-  std::vector<Road> roads;            // in file order
+  std::vector<Road> roads;          // in file order
+  std::vector<Junction> junctions;  // in file order
+  std::vector<Controller> controllers;
   std::vector<std::string> warnings;  // non-fatal findings, "file: road 3: ..."
 
   const Road* find_road(const std::string& id) const;
+  const Junction* find_junction(const std::string& id) const;
   // Throws std::runtime_error naming the source file for an unknown id.
   const Road& road(const std::string& id) const;
   // Sum of all road lengths.

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -95,6 +96,10 @@ class Reader {
   LaneSection read_section(const XMLElement* e, const std::string& where);
   Lane read_lane(const XMLElement* e, int side, double section_s, const std::string& where);
   RoadMark read_road_mark(const XMLElement* e, double section_s, const std::string& where);
+  double read_speed(const XMLElement* e, const std::string& where);
+  RoadObject read_object(const XMLElement* e, const std::string& where);
+  Signal read_signal(const XMLElement* e, const std::string& where);
+  Junction read_junction(const XMLElement* e);
 
   struct PendingLink {
     const XMLElement* element;
@@ -121,6 +126,20 @@ Network Reader::read(const tinyxml2::XMLDocument& doc) {
     net_.roads.push_back(std::move(road));
   });
   if (net_.roads.empty()) fail(root, "", "no <road> elements");
+  for_each_child(root, "junction", [&](const XMLElement* e) {
+    Junction j = read_junction(e);
+    if (net_.find_junction(j.id)) fail(e, "junction " + j.id, "duplicate junction id");
+    net_.junctions.push_back(std::move(j));
+  });
+  for_each_child(root, "controller", [&](const XMLElement* e) {
+    Controller c;
+    c.id = text(e, "id", "controller");
+    c.name = text_or(e, "name", "");
+    for_each_child(e, "control", [&](const XMLElement* ce) {
+      c.signal_ids.push_back(text(ce, "signalId", "controller " + c.id + " control"));
+    });
+    net_.controllers.push_back(std::move(c));
+  });
   for (const PendingLink& link : links_) {
     if (!net_.find_road(link.target)) {
       fail(link.element, link.where, "links to unknown road '" + link.target + "'");
@@ -193,6 +212,28 @@ Road Reader::read_road(const XMLElement* e, size_t index) {
     net_.warnings.push_back(source_ + ": " + where +
                             ": planView ends at s=" + std::to_string(last.s + last.length) +
                             ", road length is " + std::to_string(road.length));
+  }
+
+  for_each_child(e, "type", [&](const XMLElement* te) {
+    const std::string twhere = where + " type";
+    if (const XMLElement* sp = te->FirstChildElement("speed")) {
+      road.speed_limits.push_back(
+          {number_or(te, "s", 0, twhere), read_speed(sp, twhere + " speed")});
+    }
+  });
+  std::stable_sort(road.speed_limits.begin(), road.speed_limits.end(),
+                   [](const SpeedRecord& a, const SpeedRecord& b) { return a.start < b.start; });
+  if (const XMLElement* objects = e->FirstChildElement("objects")) {
+    int o = 0;
+    for_each_child(objects, "object", [&](const XMLElement* oe) {
+      road.objects.push_back(read_object(oe, where + " object " + std::to_string(o++)));
+    });
+  }
+  if (const XMLElement* signals = e->FirstChildElement("signals")) {
+    int g = 0;
+    for_each_child(signals, "signal", [&](const XMLElement* se) {
+      road.signals.push_back(read_signal(se, where + " signal " + std::to_string(g++)));
+    });
   }
 
   road.elevation_profile =
@@ -363,6 +404,12 @@ Lane Reader::read_lane(const XMLElement* e, int side, double section_s,
     fail(border, where, "lane <border> records are not supported; use <width>");
   }
   lane.widths = read_records(e, "width", "sOffset", section_s, where);
+  for_each_child(e, "speed", [&](const XMLElement* se) {
+    lane.speeds.push_back({section_s + number_or(se, "sOffset", 0, where + " speed"),
+                           read_speed(se, where + " speed")});
+  });
+  std::stable_sort(lane.speeds.begin(), lane.speeds.end(),
+                   [](const SpeedRecord& a, const SpeedRecord& b) { return a.start < b.start; });
   if (lane.id != 0 && lane.widths.empty()) {
     net_.warnings.push_back(source_ + ": " + where + ": no <width>, taken as 0");
   }
@@ -398,6 +445,111 @@ RoadMark Reader::read_road_mark(const XMLElement* e, double section_s, const std
     });
   }
   return mark;
+}
+
+double Reader::read_speed(const XMLElement* e, const std::string& where) {
+  const std::string max = text(e, "max", where);
+  if (max == "no limit") return std::numeric_limits<double>::infinity();
+  if (max == "undefined") return std::numeric_limits<double>::quiet_NaN();
+  const double v = to_number(e, "max", max, where);
+  if (v < 0) fail(e, where, "negative speed");
+  const std::string unit = text_or(e, "unit", "m/s");
+  if (unit == "m/s") return v;
+  if (unit == "km/h") return v / 3.6;
+  if (unit == "mph") return v * 0.44704;
+  fail(e, where, "unit must be m/s, km/h or mph, got '" + unit + "'");
+}
+
+RoadObject Reader::read_object(const XMLElement* e, const std::string& where) {
+  RoadObject o;
+  o.id = text_or(e, "id", "");
+  o.name = text_or(e, "name", "");
+  o.type = text_or(e, "type", "none");
+  o.s = number(e, "s", where);
+  o.t = number(e, "t", where);
+  o.z_offset = number_or(e, "zOffset", 0, where);
+  o.hdg = number_or(e, "hdg", 0, where);
+  o.length = number_or(e, "length", 0, where);
+  o.width = number_or(e, "width", 0, where);
+  o.height = number_or(e, "height", 0, where);
+  o.orientation = text_or(e, "orientation", "none");
+  const XMLElement* outline = e->FirstChildElement("outline");
+  if (!outline) {
+    if (const XMLElement* outlines = e->FirstChildElement("outlines")) {
+      outline = outlines->FirstChildElement("outline");
+    }
+  }
+  if (outline) {
+    for (const XMLElement* c = outline->FirstChildElement(); c; c = c->NextSiblingElement()) {
+      const std::string name = c->Name();
+      if (name == "cornerRoad") {
+        o.outline.push_back({true, number(c, "s", where), number(c, "t", where)});
+      } else if (name == "cornerLocal") {
+        o.outline.push_back({false, number(c, "u", where), number(c, "v", where)});
+      }
+    }
+  }
+  return o;
+}
+
+Signal Reader::read_signal(const XMLElement* e, const std::string& where) {
+  Signal g;
+  g.id = text(e, "id", where);
+  g.name = text_or(e, "name", "");
+  g.s = number(e, "s", where);
+  g.t = number(e, "t", where);
+  g.z_offset = number_or(e, "zOffset", 0, where);
+  g.h_offset = number_or(e, "hOffset", 0, where);
+  g.dynamic = text_or(e, "dynamic", "no") == "yes";
+  g.orientation = text_or(e, "orientation", "none");
+  g.country = text_or(e, "country", "");
+  g.type = text_or(e, "type", "-1");
+  g.subtype = text_or(e, "subtype", "-1");
+  g.value = number_or(e, "value", std::numeric_limits<double>::quiet_NaN(), where);
+  g.unit = text_or(e, "unit", "");
+  for_each_child(e, "validity", [&](const XMLElement* v) {
+    g.validity.emplace_back(integer(v, "fromLane", where + " validity"),
+                            integer(v, "toLane", where + " validity"));
+  });
+  return g;
+}
+
+Junction Reader::read_junction(const XMLElement* e) {
+  Junction j;
+  j.id = text(e, "id", "junction");
+  j.name = text_or(e, "name", "");
+  j.line = e->GetLineNum();
+  const std::string where = "junction " + j.id;
+  for_each_child(e, "connection", [&](const XMLElement* ce) {
+    JunctionConnection c;
+    c.id = text_or(ce, "id", std::to_string(j.connections.size()));
+    const std::string cwhere = where + " connection " + c.id;
+    c.incoming_road = text(ce, "incomingRoad", cwhere);
+    // A direct junction (1.7) names the road it leads to as linkedRoad.
+    const char* linked = ce->Attribute("linkedRoad");
+    c.connecting_road = linked && !ce->Attribute("connectingRoad")
+                            ? std::string(linked)
+                            : text(ce, "connectingRoad", cwhere);
+    c.contact_point = text_or(ce, "contactPoint", "start");
+    if (c.contact_point != "start" && c.contact_point != "end") {
+      fail(ce, cwhere, "contactPoint must be start or end, got '" + c.contact_point + "'");
+    }
+    c.line = ce->GetLineNum();
+    for_each_child(ce, "laneLink", [&](const XMLElement* le) {
+      c.lane_links.emplace_back(integer(le, "from", cwhere + " laneLink"),
+                                integer(le, "to", cwhere + " laneLink"));
+    });
+    j.connections.push_back(std::move(c));
+  });
+  std::vector<std::pair<double, std::string>> controllers;
+  for_each_child(e, "controller", [&](const XMLElement* ce) {
+    controllers.emplace_back(number_or(ce, "sequence", 0, where + " controller"),
+                             text(ce, "id", where + " controller"));
+  });
+  std::stable_sort(controllers.begin(), controllers.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& c : controllers) j.controllers.push_back(std::move(c.second));
+  return j;
 }
 
 }  // namespace

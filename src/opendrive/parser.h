@@ -3,7 +3,9 @@
 // Read: header (with geoReference), roads (id, name, length, junction, rule, road links),
 // planView geometries (line, arc, spiral, poly3, paramPoly3), elevationProfile, laneOffset,
 // lane sections with lanes (id, type, level, lane links, width records, road marks with
-// optional explicit <type><line> definitions). Other elements are ignored.
+// optional explicit <type><line> definitions, speed), road <type><speed>, objects (with their
+// outline), signals (with validity), junctions (connections, lane links, controllers) and
+// top-level controllers. Other elements are ignored.
 //
 // Every error is a std::runtime_error whose message names the file, the line and the element:
 //   parkring.xodr:57: road 3 geometry 2: unknown geometry type 'foo'

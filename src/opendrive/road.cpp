@@ -134,6 +134,13 @@ const Road* Network::find_road(const std::string& id) const {
   return nullptr;
 }
 
+const Junction* Network::find_junction(const std::string& id) const {
+  for (const Junction& j : junctions) {
+    if (j.id == id) return &j;
+  }
+  return nullptr;
+}
+
 const Road& Network::road(const std::string& id) const {
   if (const Road* r = find_road(id)) return *r;
   throw std::runtime_error(source + ": no road with id '" + id + "'");

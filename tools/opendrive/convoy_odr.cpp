@@ -6,19 +6,27 @@
 //   convoy-odr mesh FILE OUTDIR [--curb-height 0.12]
 //                                            OUTDIR/road.obj, road.mtl, road.sdf
 //   convoy-odr bounds FILE                   JSON bounding box
+//   convoy-odr route FILE --from ROAD:LANE --to ROAD:LANE [--ds D --out FILE]
+//                                            shortest route over the lane graph (through
+//                                            junctions, with lane changes); CSV waypoints
+//                                            with --out
 //
 // Exit status: 0 done, 1 output could not be written, 2 bad command line or bad input file.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "opendrive/lane_graph.h"
 #include "opendrive/mesh_io.h"
 #include "opendrive/parser.h"
 #include "opendrive/road_mesh.h"
@@ -34,7 +42,9 @@ constexpr const char* kUsage =
     "       convoy-odr waypoints FILE --lane ID [--ds 2.0] [--road ID]\n"
     "                            [--direction driving|reference] [--out FILE]\n"
     "       convoy-odr mesh FILE OUTDIR [--curb-height 0.12]\n"
-    "       convoy-odr bounds FILE\n";
+    "       convoy-odr bounds FILE\n"
+    "       convoy-odr route FILE --from ROAD:LANE --to ROAD:LANE [--ds 2.0] [--out FILE]\n"
+    "                            [--no-lane-changes 1]\n";
 
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -177,7 +187,14 @@ int cmd_info(const Args& args) {
   }
   print_link_gaps(net);
   const odr::Road& first = net.roads.front();
-  const odr::Route loop = odr::plan_route(net, first.id, 0, odr::Travel::kReferenceDirection);
+  odr::Route loop;
+  try {
+    loop = odr::plan_route(net, first.id, 0, odr::Travel::kReferenceDirection);
+  } catch (const std::runtime_error& e) {
+    // Maps with junctions: routes go over the lane graph (convoy-odr route).
+    std::printf("no loop followed from road %s: %s\n", first.id.c_str(), e.what());
+    return 0;
+  }
   std::string roads;
   for (const auto& leg : loop.legs) roads += (roads.empty() ? "" : " -> ") + leg.road_id;
   if (loop.closed) {
@@ -265,6 +282,96 @@ int cmd_bounds(const Args& args) {
   return 0;
 }
 
+// "ROAD:LANE" (the road id may itself contain ':'; the lane is after the last one).
+std::pair<std::string, int> road_lane(const std::string& option, const std::string& text) {
+  const size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) {
+    throw UsageError("--" + option + " must be ROAD:LANE, got '" + text + "'");
+  }
+  const std::string lane = text.substr(colon + 1);
+  char* end = nullptr;
+  const long id = std::strtol(lane.c_str(), &end, 10);
+  if (lane.empty() || *end != '\0') {
+    throw UsageError("--" + option + ": lane must be an integer, got '" + lane + "'");
+  }
+  return {text.substr(0, colon), static_cast<int>(id)};
+}
+
+int cmd_route(const Args& args) {
+  const odr::Network net = load(args.positional[0]);
+  if (!args.options.count("from")) throw UsageError("route: --from ROAD:LANE is required");
+  if (!args.options.count("to")) throw UsageError("route: --to ROAD:LANE is required");
+  const auto [from_road, from_lane] = road_lane("from", args.option("from", ""));
+  const auto [to_road, to_lane] = road_lane("to", args.option("to", ""));
+  const double ds = args.number("ds", 2.0);
+  if (!(ds > 0)) throw UsageError("--ds must be > 0");
+  odr::RouteOptions options;
+  options.lane_changes = args.number("no-lane-changes", 0) == 0;
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  std::optional<odr::LaneGraph> graph;
+  std::optional<odr::LaneRoute> route;
+  double build_ms = 0, route_us = 0;
+  try {
+    graph.emplace(net);
+    build_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    for (const auto& w : graph->warnings()) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    for (const auto& [road, lane, what] :
+         {std::tuple{from_road, from_lane, "--from"}, std::tuple{to_road, to_lane, "--to"}}) {
+      try {
+        const odr::LaneIndex i = graph->entry_lane(road, lane);
+        if (!graph->lane(i).drivable()) {
+          throw InputError(std::string(what) + " " + road + ":" + std::to_string(lane) +
+                           ": lane is of type '" + graph->lane(i).type + "', not driving");
+        }
+      } catch (const InputError&) {
+        throw;
+      } catch (const std::runtime_error& e) {
+        throw InputError(std::string(what) + ": " + e.what());
+      }
+    }
+    const auto t1 = Clock::now();
+    route = graph->route(from_road, from_lane, to_road, to_lane, options);
+    route_us = std::chrono::duration<double, std::micro>(Clock::now() - t1).count();
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+  if (!route) {
+    throw InputError(net.source + ": no route from road " + from_road + " lane " +
+                     std::to_string(from_lane) + " to road " + to_road + " lane " +
+                     std::to_string(to_lane) +
+                     (options.lane_changes ? "" : " without lane changes"));
+  }
+  std::string junctions;
+  for (const std::string& j : route->junctions) junctions += (junctions.empty() ? "" : ", ") + j;
+  std::printf("route %s:%d -> %s:%d: %.3f m, %zu segment(s), %d lane change(s), junctions: %s\n",
+              from_road.c_str(), from_lane, to_road.c_str(), to_lane, route->length,
+              route->segments.size(), route->lane_changes,
+              junctions.empty() ? "none" : junctions.c_str());
+  for (const odr::RouteSegment& g : route->segments) {
+    std::printf("  %s road %s lane %d s %.3f -> %.3f%s\n",
+                g.lane_change ? (g.change_direction > 0 ? "change left ->" : "change right ->")
+                              : "             ",
+                g.road_id.c_str(), g.lane_id, g.s_from, g.s_to,
+                g.junction == "-1" ? "" : (" (junction " + g.junction + ")").c_str());
+  }
+  std::fprintf(stderr, "lane graph: %zu lanes built in %.3f ms, route found in %.1f us\n",
+               graph->lanes().size(), build_ms, route_us);
+  const std::string out = args.option("out", "");
+  if (!out.empty()) {
+    const std::vector<odr::Pose2> points = graph->sample(*route, ds);
+    std::FILE* f = std::fopen(out.c_str(), "w");
+    if (!f) throw OutputError(out + ": cannot write");
+    std::fprintf(f, "x,y,heading\n");
+    for (const odr::Pose2& p : points) std::fprintf(f, "%.4f,%.4f,%.6f\n", p.x, p.y, p.heading);
+    if (std::fclose(f) != 0) throw OutputError(out + ": write failed");
+    std::fprintf(stderr, "%zu waypoints written to %s\n", points.size(), out.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -281,6 +388,10 @@ int main(int argc, char** argv) {
     }
     if (cmd == "mesh") return cmd_mesh(parse_args(argc, argv, 2, {"curb-height"}, 2));
     if (cmd == "bounds") return cmd_bounds(parse_args(argc, argv, 2, {}, 1));
+    if (cmd == "route") {
+      return cmd_route(
+          parse_args(argc, argv, 2, {"from", "to", "ds", "out", "no-lane-changes"}, 1));
+    }
     throw UsageError("unknown command '" + cmd + "'");
   } catch (const UsageError& e) {
     std::fprintf(stderr, "convoy-odr: %s\n%s", e.what(), kUsage);
