@@ -255,7 +255,7 @@ void NrpServer::check_engine(const engine::DataPack& dp) const {
 }
 
 void NrpServer::take_trajectory(::NrpCore::Trajectory* out) {
-  uint32_t index = 0;
+  int32_t index = 0;
   for (const auto& dp : session_->loop().take_observations()) {
     auto* item = dp.payload_case() == engine::DataPack::kJsonMsgpack
                      ? out->add_jsontrajectorymessages()
