@@ -149,9 +149,9 @@ class Client(E2ETestCase):
             self.assertEqual(js["it"], it)
             self.assertIsInstance(i32, wrappers_pb2.Int32Value)
             self.assertEqual(i32.value, it)
-            # convoy.data.Link: a type this Python did not know; its descriptors come from
-            # the server
-            self.assertEqual(link.DESCRIPTOR.full_name, "convoy.data.Link")
+            # Gazebo.Link (NRP-Core's name of the standard link, as NRP-Core's client expects):
+            # a type this Python did not know; its descriptors come from the server
+            self.assertEqual(link.DESCRIPTOR.full_name, "Gazebo.Link")
             self.assertEqual(list(link.position), [it, 0, 0.5])
         # a protobuf datapack from the client reaches the engine as its message
         nrp.set_proto_datapack("action", "counter", wrappers_pb2.Int32Value(value=3))
