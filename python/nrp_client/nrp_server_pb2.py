@@ -14,7 +14,7 @@ _sym_db = _symbol_database.Default()
 from google.protobuf import any_pb2 as google_dot_protobuf_dot_any__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\x17\x63onvoy/nrp_server.proto\x12\x07NrpCore\x1a\x19google/protobuf/any.proto\"\x0e\n\x0c\x45mptyMessage\"9\n\x0fSimStateMessage\x12\x14\n\x0c\x63urrentState\x18\x01 \x01(\t\x12\x10\n\x08\x65rrorMsg\x18\x02 \x01(\t\"\x1b\n\x0bJsonMessage\x12\x0c\n\x04\x64\x61ta\x18\x01 \x01(\t\"T\n\x12\x44\x61taPackIdentifier\x12\x14\n\x0c\x64\x61taPackName\x18\x01 \x01(\t\x12\x14\n\x0c\x64\x61taPackType\x18\x02 \x01(\t\x12\x12\n\nengineName\x18\x03 \x01(\t\"f\n\x0f\x44\x61taPackMessage\x12/\n\ndataPackId\x18\x01 \x01(\x0b\x32\x1b.NrpCore.DataPackIdentifier\x12\"\n\x04\x64\x61ta\x18\x02 \x01(\x0b\x32\x14.google.protobuf.Any\"n\n\tDataPacks\x12/\n\rjsonDataPacks\x18\x01 \x03(\x0b\x32\x18.NrpCore.DataPackMessage\x12\x30\n\x0eprotoDataPacks\x18\x02 \x03(\x0b\x32\x18.NrpCore.DataPackMessage\"J\n\x11TrajectoryMessage\x12\x11\n\tdataIndex\x18\x01 \x01(\r\x12\"\n\x04\x64\x61ta\x18\x02 \x01(\x0b\x32\x14.google.protobuf.Any\"\x85\x01\n\nTrajectory\x12:\n\x16jsonTrajectoryMessages\x18\x01 \x03(\x0b\x32\x1a.NrpCore.TrajectoryMessage\x12;\n\x17protoTrajectoryMessages\x18\x02 \x03(\x0b\x32\x1a.NrpCore.TrajectoryMessage\"N\n\x0eRunLoopMessage\x12\x15\n\rnumIterations\x18\x01 \x01(\x05\x12%\n\tdataPacks\x18\x02 \x01(\x0b\x32\x12.NrpCore.DataPacks\"5\n\x0cResetMessage\x12%\n\tdataPacks\x18\x01 \x01(\x0b\x32\x12.NrpCore.DataPacks\"6\n\x08Response\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\"i\n\x12InitializeResponse\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\x12\'\n\ntrajectory\x18\x02 \x01(\x0b\x32\x13.NrpCore.Trajectory\"\x8d\x01\n\x0fRunLoopResponse\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\x12\x10\n\x08\x64oneFlag\x18\x02 \x01(\x08\x12\x13\n\x0btimeoutFlag\x18\x03 \x01(\x08\x12\'\n\ntrajectory\x18\x04 \x01(\x0b\x32\x13.NrpCore.Trajectory\"d\n\rResetResponse\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\x12\'\n\ntrajectory\x18\x02 \x01(\x0b\x32\x13.NrpCore.Trajectory\"\x1f\n\x0bTypeRequest\x12\x10\n\x08typeName\x18\x01 \x01(\t\",\n\x0fTypeDescription\x12\x19\n\x11\x66ileDescriptorSet\x18\x01 \x01(\x0c\x32\xb1\x03\n\x07NrpCore\x12@\n\ninitialize\x12\x15.NrpCore.EmptyMessage\x1a\x1b.NrpCore.InitializeResponse\x12<\n\x07runLoop\x12\x17.NrpCore.RunLoopMessage\x1a\x18.NrpCore.RunLoopResponse\x12\x42\n\x0frunUntilTimeout\x12\x15.NrpCore.EmptyMessage\x1a\x18.NrpCore.RunLoopResponse\x12\x34\n\x08stopLoop\x12\x15.NrpCore.EmptyMessage\x1a\x11.NrpCore.Response\x12\x36\n\x05reset\x12\x15.NrpCore.ResetMessage\x1a\x16.NrpCore.ResetResponse\x12\x34\n\x08shutdown\x12\x15.NrpCore.EmptyMessage\x1a\x11.NrpCore.Response\x12>\n\x0c\x64\x65scribeType\x12\x14.NrpCore.TypeRequest\x1a\x18.NrpCore.TypeDescriptionb\x06proto3')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\x17\x63onvoy/nrp_server.proto\x12\x07NrpCore\x1a\x19google/protobuf/any.proto\"\x0e\n\x0c\x45mptyMessage\"9\n\x0fSimStateMessage\x12\x14\n\x0c\x63urrentState\x18\x01 \x01(\t\x12\x10\n\x08\x65rrorMsg\x18\x02 \x01(\t\"\x1b\n\x0bJsonMessage\x12\x0c\n\x04\x64\x61ta\x18\x01 \x01(\t\"T\n\x12\x44\x61taPackIdentifier\x12\x14\n\x0c\x64\x61taPackName\x18\x01 \x01(\t\x12\x14\n\x0c\x64\x61taPackType\x18\x02 \x01(\t\x12\x12\n\nengineName\x18\x03 \x01(\t\"f\n\x0f\x44\x61taPackMessage\x12/\n\ndataPackId\x18\x01 \x01(\x0b\x32\x1b.NrpCore.DataPackIdentifier\x12\"\n\x04\x64\x61ta\x18\x02 \x01(\x0b\x32\x14.google.protobuf.Any\"t\n\tDataPacks\x12/\n\rjsonDataPacks\x18\x02 \x03(\x0b\x32\x18.NrpCore.DataPackMessage\x12\x30\n\x0eprotoDataPacks\x18\x03 \x03(\x0b\x32\x18.NrpCore.DataPackMessageJ\x04\x08\x01\x10\x02\"J\n\x11TrajectoryMessage\x12\x11\n\tdataIndex\x18\x01 \x01(\x05\x12\"\n\x04\x64\x61ta\x18\x02 \x01(\x0b\x32\x14.google.protobuf.Any\"\x85\x01\n\nTrajectory\x12:\n\x16jsonTrajectoryMessages\x18\x01 \x03(\x0b\x32\x1a.NrpCore.TrajectoryMessage\x12;\n\x17protoTrajectoryMessages\x18\x02 \x03(\x0b\x32\x1a.NrpCore.TrajectoryMessage\"N\n\x0eRunLoopMessage\x12\x15\n\rnumIterations\x18\x01 \x01(\x05\x12%\n\tdataPacks\x18\x02 \x01(\x0b\x32\x12.NrpCore.DataPacks\"5\n\x0cResetMessage\x12%\n\tdataPacks\x18\x01 \x01(\x0b\x32\x12.NrpCore.DataPacks\"6\n\x08Response\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\"i\n\x12InitializeResponse\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\x12\'\n\ntrajectory\x18\x02 \x01(\x0b\x32\x13.NrpCore.Trajectory\"\x8d\x01\n\x0fRunLoopResponse\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\x12\x10\n\x08\x64oneFlag\x18\x02 \x01(\x08\x12\x13\n\x0btimeoutFlag\x18\x03 \x01(\x08\x12\'\n\ntrajectory\x18\x04 \x01(\x0b\x32\x13.NrpCore.Trajectory\"d\n\rResetResponse\x12*\n\x08simState\x18\x01 \x01(\x0b\x32\x18.NrpCore.SimStateMessage\x12\'\n\ntrajectory\x18\x02 \x01(\x0b\x32\x13.NrpCore.Trajectory\"\x1f\n\x0bTypeRequest\x12\x10\n\x08typeName\x18\x01 \x01(\t\",\n\x0fTypeDescription\x12\x19\n\x11\x66ileDescriptorSet\x18\x01 \x01(\x0c\x32\xb1\x03\n\x07NrpCore\x12@\n\ninitialize\x12\x15.NrpCore.EmptyMessage\x1a\x1b.NrpCore.InitializeResponse\x12<\n\x07runLoop\x12\x17.NrpCore.RunLoopMessage\x1a\x18.NrpCore.RunLoopResponse\x12\x42\n\x0frunUntilTimeout\x12\x15.NrpCore.EmptyMessage\x1a\x18.NrpCore.RunLoopResponse\x12\x34\n\x08stopLoop\x12\x15.NrpCore.EmptyMessage\x1a\x11.NrpCore.Response\x12\x36\n\x05reset\x12\x15.NrpCore.ResetMessage\x1a\x16.NrpCore.ResetResponse\x12\x34\n\x08shutdown\x12\x15.NrpCore.EmptyMessage\x1a\x11.NrpCore.Response\x12>\n\x0c\x64\x65scribeType\x12\x14.NrpCore.TypeRequest\x1a\x18.NrpCore.TypeDescriptionb\x06proto3')
 
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, globals())
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'convoy.nrp_server_pb2', globals())
@@ -32,27 +32,27 @@ if _descriptor._USE_C_DESCRIPTORS == False:
   _DATAPACKMESSAGE._serialized_start=253
   _DATAPACKMESSAGE._serialized_end=355
   _DATAPACKS._serialized_start=357
-  _DATAPACKS._serialized_end=467
-  _TRAJECTORYMESSAGE._serialized_start=469
-  _TRAJECTORYMESSAGE._serialized_end=543
-  _TRAJECTORY._serialized_start=546
-  _TRAJECTORY._serialized_end=679
-  _RUNLOOPMESSAGE._serialized_start=681
-  _RUNLOOPMESSAGE._serialized_end=759
-  _RESETMESSAGE._serialized_start=761
-  _RESETMESSAGE._serialized_end=814
-  _RESPONSE._serialized_start=816
-  _RESPONSE._serialized_end=870
-  _INITIALIZERESPONSE._serialized_start=872
-  _INITIALIZERESPONSE._serialized_end=977
-  _RUNLOOPRESPONSE._serialized_start=980
-  _RUNLOOPRESPONSE._serialized_end=1121
-  _RESETRESPONSE._serialized_start=1123
-  _RESETRESPONSE._serialized_end=1223
-  _TYPEREQUEST._serialized_start=1225
-  _TYPEREQUEST._serialized_end=1256
-  _TYPEDESCRIPTION._serialized_start=1258
-  _TYPEDESCRIPTION._serialized_end=1302
-  _NRPCORE._serialized_start=1305
-  _NRPCORE._serialized_end=1738
+  _DATAPACKS._serialized_end=473
+  _TRAJECTORYMESSAGE._serialized_start=475
+  _TRAJECTORYMESSAGE._serialized_end=549
+  _TRAJECTORY._serialized_start=552
+  _TRAJECTORY._serialized_end=685
+  _RUNLOOPMESSAGE._serialized_start=687
+  _RUNLOOPMESSAGE._serialized_end=765
+  _RESETMESSAGE._serialized_start=767
+  _RESETMESSAGE._serialized_end=820
+  _RESPONSE._serialized_start=822
+  _RESPONSE._serialized_end=876
+  _INITIALIZERESPONSE._serialized_start=878
+  _INITIALIZERESPONSE._serialized_end=983
+  _RUNLOOPRESPONSE._serialized_start=986
+  _RUNLOOPRESPONSE._serialized_end=1127
+  _RESETRESPONSE._serialized_start=1129
+  _RESETRESPONSE._serialized_end=1229
+  _TYPEREQUEST._serialized_start=1231
+  _TYPEREQUEST._serialized_end=1262
+  _TYPEDESCRIPTION._serialized_start=1264
+  _TYPEDESCRIPTION._serialized_end=1308
+  _NRPCORE._serialized_start=1311
+  _NRPCORE._serialized_end=1744
 # @@protoc_insertion_point(module_scope)

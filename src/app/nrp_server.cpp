@@ -15,6 +15,7 @@
 #include "datapack/camera.h"
 #include "datapack/json.h"
 #include "datapack/registry.h"
+#include "nrp_protobuf/gazebo.pb.h"
 #include "transport/grpc_security.h"
 
 namespace convoy::app {
@@ -71,7 +72,9 @@ std::vector<engine::DataPack> from_client(const ::NrpCore::DataPacks& in) {
 }
 
 // A datapack whose blobs are inline as a self-contained message for the client: JSON as text,
-// a camera frame with its pixels in image_data, any other protobuf message as it is.
+// Convoy's standard camera, joint and link under NRP-Core's names (Gazebo.Camera / Joint /
+// Link, the messages of NRP-Core's GazeboCameraDataPack...), so that NRP-Core's own client
+// decodes them, any other protobuf message as it is.
 void to_client(const engine::DataPack& dp, ::NrpCore::TrajectoryMessage* out) {
   datapack::View view(dp, datapack::inline_blob_reader());
   auto* any = out->mutable_data();
@@ -82,17 +85,22 @@ void to_client(const engine::DataPack& dp, ::NrpCore::TrajectoryMessage* out) {
     return;
   }
   const std::string& type = view.proto_type();
-  any->set_type_url(std::string(kTypeUrlPrefix) + type);
-  if (type == datapack::type_name<data::Camera>() && dp.blobs_size() > 0) {
+  if (type == datapack::type_name<data::Camera>()) {
     const datapack::CameraImage image = datapack::read_camera(view);
-    data::Camera camera;
-    camera.set_image_height(image.height);
-    camera.set_image_width(image.width);
-    camera.set_image_depth(image.depth);
-    camera.set_image_data(image.pixels.data(), image.pixels.size());
-    camera.SerializeToString(any->mutable_value());
+    Gazebo::Camera camera;
+    camera.set_imageheight(image.height);
+    camera.set_imagewidth(image.width);
+    camera.set_imagedepth(image.depth);
+    camera.set_imagedata(image.pixels.data(), image.pixels.size());
+    any->PackFrom(camera);
     return;
   }
+  // Joint and Link: the same field numbers and types in both packages (datapack/nrp.h).
+  std::string_view nrp_type = type;
+  if (type == datapack::type_name<data::Joint>())
+    nrp_type = Gazebo::Joint::descriptor()->full_name();
+  if (type == datapack::type_name<data::Link>()) nrp_type = Gazebo::Link::descriptor()->full_name();
+  any->set_type_url(std::string(kTypeUrlPrefix) + std::string(nrp_type));
   any->set_value(dp.proto().data());
 }
 
@@ -255,7 +263,7 @@ void NrpServer::check_engine(const engine::DataPack& dp) const {
 }
 
 void NrpServer::take_trajectory(::NrpCore::Trajectory* out) {
-  uint32_t index = 0;
+  int32_t index = 0;
   for (const auto& dp : session_->loop().take_observations()) {
     auto* item = dp.payload_case() == engine::DataPack::kJsonMsgpack
                      ? out->add_jsontrajectorymessages()

@@ -6,6 +6,7 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <type_traits>
 
 #include "convoy/datapacks.pb.h"
 #include "datapack/camera.h"
@@ -13,6 +14,7 @@
 #include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "nrp_protobuf/dump.pb.h"
+#include "nrp_protobuf/enginetest.pb.h"
 #include "nrp_protobuf/gazebo.pb.h"
 #include "nrp_protobuf/nrpgenericproto.pb.h"
 #include "nrp_protobuf/wrappers.pb.h"
@@ -250,12 +252,13 @@ TEST(NrpMessages, PackagesAreRegisteredAndMatchTheEngineSchema) {
   const Registry& r = Registry::global();
   for (const char* type : {"Dump.String", "Dump.ArrayFloat", "EngineTest.TestPayload",
                            "Wrappers.BoolValue", "Wrappers.BytesValue", "NrpGenericProto.Image",
-                           "NrpGenericProto.ArrayInt32", "Gazebo.Camera"})
+                           "NrpGenericProto.ArrayInt32", "Gazebo.Camera", "Gazebo.Model"})
     EXPECT_NE(r.find(type), nullptr) << type;
   EXPECT_EQ(r.require("Dump.String").python_class, "DumpStringDataPack");
   EXPECT_EQ(r.require("NrpGenericProto.ArraySInt64").python_class,
             "NrpGenericProtoArraySInt64DataPack");
   EXPECT_EQ(r.require("EngineTest.TestPayload").python_class, "EngineTestTestPayloadDataPack");
+  EXPECT_EQ(r.require("Gazebo.Model").python_class, "GazeboModelDataPack");
   EXPECT_TRUE(r.require("convoy.data.Camera").named_class);
   EXPECT_FALSE(r.require("Gazebo.Camera").named_class);
   EXPECT_EQ(standard_type_of("Gazebo.Camera"), "convoy.data.Camera");
@@ -268,6 +271,52 @@ TEST(NrpMessages, PackagesAreRegisteredAndMatchTheEngineSchema) {
   const auto names =
       schema["properties"]["ProtobufPackages"]["items"]["enum"].get<std::vector<std::string>>();
   EXPECT_EQ(names, nrp_packages());
+}
+
+// The bytes NRP-Core 1.4 writes for these messages (nrp-core-msgs' .proto files, encoded by
+// hand): the same field numbers, wire types and enum values.
+std::string bytes(std::initializer_list<int> b) {
+  std::string s;
+  for (int c : b) s.push_back(static_cast<char>(c));
+  return s;
+}
+
+TEST(NrpMessages, WireFormatIsNrpCore14s) {
+  EngineTest::TestPayload payload;
+  static_assert(std::is_same_v<decltype(payload.integer()), uint32_t>);
+  payload.set_integer(41);
+  payload.set_str("ab");
+  EXPECT_EQ(payload.SerializeAsString(), bytes({0x08, 41, 0x12, 2, 'a', 'b'}));
+
+  NrpGenericProto::Image img;
+  img.set_height(2);
+  img.set_width(3);
+  img.set_step(9);
+  img.set_type(NrpGenericProto::BGR16);
+  img.set_isbigendian(true);
+  img.set_data("x");
+  EXPECT_EQ(img.SerializeAsString(),
+            bytes({0x08, 2, 0x10, 3, 0x18, 9, 0x20, 5, 0x28, 1, 0x32, 1, 'x'}));
+  EXPECT_EQ(NrpGenericProto::OTHER, 0);
+  EXPECT_EQ(NrpGenericProto::MONO8, 7);
+  EXPECT_EQ(NrpGenericProto::MONO16, 8);
+  EXPECT_EQ(NrpGenericProto::BAYER_GRBG16, 16);
+  EXPECT_EQ(NrpGenericProto::IMAGE_TYPE_MAX, 16);
+
+  NrpGenericProto::ArraySInt32 a;
+  a.add_array(-1);
+  a.add_shape(1);
+  EXPECT_EQ(a.SerializeAsString(), bytes({0x0a, 1, 1, 0x12, 1, 1}));  // zigzag -1 = 1
+
+  Gazebo::Model model;
+  model.add_position(1.0f);
+  model.add_angularvelocity(1.0f);
+  EXPECT_EQ(model.SerializeAsString(),
+            bytes({0x0a, 4, 0, 0, 0x80, 0x3f, 0x22, 4, 0, 0, 0x80, 0x3f}));
+
+  Wrappers::FloatValue f;
+  f.set_value(1.0f);
+  EXPECT_EQ(f.SerializeAsString(), bytes({0x0d, 0, 0, 0x80, 0x3f}));
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ COUNTER = engine_script("counter", initialize="""
 STATUS = textwrap.dedent("""\
     from nrp_core import *
     from nrp_core.data.nrp_json import JsonRawData
-    from nrp_core.data.nrp_protobuf import GazeboLinkDataPack
+    import numpy as np
+    from nrp_core.data.nrp_protobuf import GazeboCameraDataPack, GazeboLinkDataPack
     from google.protobuf import wrappers_pb2
 
     @EngineDataPack(keyword='obs', id=DataPackIdentifier('obs', 'counter'))
@@ -60,6 +61,10 @@ STATUS = textwrap.dedent("""\
             link = GazeboLinkDataPack("link", "counter")
             link.data.pos = [it, obs.data["x"], 0.5]
             data.append(link)
+            cam = GazeboCameraDataPack("cam", "counter")  # 48 KiB: its pixels in a blob
+            cam.data.image_height, cam.data.image_width, cam.data.image_depth = 128, 128, 3
+            cam.data.image_data = (np.arange(128 * 128 * 3) % 251).astype(np.uint8) + it
+            data.append(cam)
         return DONE, data
     """)
 
@@ -143,16 +148,20 @@ class Client(E2ETestCase):
         nrp.initialize()
         done, data = nrp.run_loop(2)
         self.assertTrue(done)
-        self.assertEqual(len(data), 6)
+        self.assertEqual(len(data), 8)
         for it in range(2):
-            js, i32, link = data[3 * it:3 * it + 3]
+            js, i32, link, cam = data[4 * it:4 * it + 4]
             self.assertEqual(js["it"], it)
             self.assertIsInstance(i32, wrappers_pb2.Int32Value)
             self.assertEqual(i32.value, it)
-            # convoy.data.Link: a type this Python did not know; its descriptors come from
-            # the server
-            self.assertEqual(link.DESCRIPTOR.full_name, "convoy.data.Link")
+            # Gazebo.Link and Gazebo.Camera (NRP-Core's names and layouts of the standard link
+            # and camera, as NRP-Core's client expects): types this Python did not know; their
+            # descriptors come from the server
+            self.assertEqual(link.DESCRIPTOR.full_name, "Gazebo.Link")
             self.assertEqual(list(link.position), [it, 0, 0.5])
+            self.assertEqual(cam.DESCRIPTOR.full_name, "Gazebo.Camera")
+            self.assertEqual((cam.imageHeight, cam.imageWidth, cam.imageDepth), (128, 128, 3))
+            self.assertEqual(cam.imageData, bytes((i % 251 + it) for i in range(128 * 128 * 3)))
         # a protobuf datapack from the client reaches the engine as its message
         nrp.set_proto_datapack("action", "counter", wrappers_pb2.Int32Value(value=3))
         nrp.run_loop(2)

@@ -55,7 +55,7 @@ SPEC = textwrap.dedent('''\
         "ArrayUInt64": (([2**64 - 1], [1]), ([15, 16], [2])),
     }
     IMAGE = ((2, 3, 9, nrpgenericproto_pb2.RGB8, True, bytes(range(18))),
-             (3, 1, 3, nrpgenericproto_pb2.IMAGE_TYPE.BGR8, False, bytes(range(9, 0, -1))))
+             (3, 1, 3, nrpgenericproto_pb2.IMAGE_TYPE.BGR16, False, bytes(range(9, 0, -1))))
     DUMP_STRING = ("abc", "abc!")
     DUMP_FLOATS = (([1.0, 2.0, 3.0, 4.0], [2, 2]), ([5.0], [1]))
     TEST_PAYLOAD = (41, 42)
