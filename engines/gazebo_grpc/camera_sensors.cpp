@@ -33,15 +33,6 @@ render::Material to_material(const Material& m) {
 
 }  // namespace
 
-std::string CameraSensors::class_of(const std::string& model_name) {
-  std::string s = model_name;
-  auto scope = s.rfind("::");
-  if (scope != std::string::npos) s = s.substr(scope + 2);
-  while (!s.empty() && std::isdigit(static_cast<unsigned char>(s.back()))) s.pop_back();
-  while (!s.empty() && (s.back() == '_' || s.back() == '-')) s.pop_back();
-  return s.empty() ? model_name : s;
-}
-
 CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed)
     : physics_(physics), rng_(seed) {
   for (const auto& model : desc.models)
@@ -100,7 +91,7 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
   for (const auto& model : desc.models) {
     ++model_id;
     model_names_.push_back(model.name);
-    model_classes_.push_back(class_of(model.name));
+    model_classes_.push_back(class_of(model));
     // The ground gets no box: a model that shows only planes, or a static one that collides
     // only as planes (a road mesh on a ground plane).
     bool visual_planes = true, collision_planes = true, collides = false;

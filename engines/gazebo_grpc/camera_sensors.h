@@ -43,10 +43,6 @@ class CameraSensors {
   // and the camera's own.
   void boxes_datapack(size_t i, datapack::Builder& out);
 
-  // The object class of a model: its <convoy:class> element if any, else its name without
-  // a trailing number ("pedestrian_3" -> "pedestrian").
-  static std::string class_of(const std::string& model_name);
-
  private:
   struct Camera {
     const CameraDesc* desc = nullptr;
