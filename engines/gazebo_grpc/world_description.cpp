@@ -438,6 +438,18 @@ bool is_known_class(const std::string& cls) {
   return std::find(k.begin(), k.end(), cls) != k.end();
 }
 
+bool is_ground(const ModelDesc& model) {
+  bool visual_planes = true, collision_planes = true, collides = false;
+  for (const auto& link : model.links) {
+    for (const auto& v : link.visuals) visual_planes &= v.shape.kind == Shape::kPlane;
+    for (const auto& c : link.collisions) {
+      collides = true;
+      collision_planes &= c.shape.kind == Shape::kPlane;
+    }
+  }
+  return visual_planes || (model.is_static && collides && collision_planes);
+}
+
 std::string class_of_name(const std::string& model_name) {
   std::string s = model_name;
   auto scope = s.rfind("::");

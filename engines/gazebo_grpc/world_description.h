@@ -134,6 +134,10 @@ inline std::string class_of(const ModelDesc& m) {
   return m.cls.empty() ? class_of_name(m.name) : m.cls;
 }
 
+// The ground: a model that shows only planes, or a static one that collides only as planes
+// (a road mesh on a ground plane). It has no ground truth and makes no collision records.
+bool is_ground(const ModelDesc& m);
+
 // A model added by the engine config (GazeboSDFModels).
 struct ModelInsert {
   std::string name;
