@@ -19,6 +19,7 @@
 // position controller, its velocity for a velocity controller; a non-zero effort is added
 // as a feed-forward effort.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -37,6 +38,7 @@
 #include "engine/engine.h"
 #include "joint_pid.h"
 #include "physics_world.h"
+#include "world_cache.h"
 #include "world_description.h"
 
 namespace convoy::engines {
@@ -84,7 +86,13 @@ class GazeboEngine final : public Engine {
     actor_timeout_ = config.value("ActorTimeout", 1.0);
     actor_table_ = config.value("ActorModels", std::string());
     rng_.seed(seed_);
-    desc_ = world::load_world(file, extra);
+    const auto t0 = std::chrono::steady_clock::now();
+    world::CacheResult cache;
+    desc_ = world::load_world_cached(file, extra, &cache);
+    std::fprintf(stderr, "convoy: engine '%s': world %s loaded in %.3f s (cache: %s, %s)\n",
+                 name.c_str(), file.filename().c_str(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                 world::to_string(cache), world::cache_dir().c_str());
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
     cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
 

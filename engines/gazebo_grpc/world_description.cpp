@@ -253,6 +253,7 @@ class Loader {
     ModelDesc md;
     md.name = name;
     md.is_static = m->Static();
+    if (auto e = m->Element(); e && !e->FilePath().empty()) md.source = fs::absolute(e->FilePath());
     for (uint64_t i = 0; i < m->LinkCount(); ++i) {
       const sdf::Link* l = m->LinkByIndex(i);
       LinkDesc ld;

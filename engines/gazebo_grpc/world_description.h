@@ -96,6 +96,7 @@ struct ModelDesc {
   //   <plugin name="convoy_class" filename="convoy_class"><class>car</class></plugin>
   // ("" if none: then class_of_name()).
   std::string cls;
+  std::filesystem::path source;  // the SDF file it was read from
   bool is_static = false;
   std::vector<LinkDesc> links;
   std::vector<JointDesc> joints;
