@@ -457,11 +457,17 @@ class GazeboEngine final : public Engine {
 
   void record_contacts() {
     physics_->contact_pairs(&pairs_);
+    // By name, not by address: records of one step come in the same order in every run.
+    found_.clear();
     for (const auto& [sa, sb] : pairs_) {
       auto ea = entity_.find(sa), eb = entity_.find(sb);
       if (ea == entity_.end() || eb == entity_.end()) continue;  // the ground
-      note_contact(sa, sb, ea->second, eb->second);
+      found_.push_back({sa, sb, &ea->second, &eb->second});
     }
+    std::sort(found_.begin(), found_.end(), [](const Found& x, const Found& y) {
+      return std::minmax(x.a->name, x.b->name) < std::minmax(y.a->name, y.b->name);
+    });
+    for (const auto& f : found_) note_contact(f.ka, f.kb, *f.a, *f.b);
   }
 
   // Actors do not collide with each other in the physics (they are immobile there): their
@@ -586,6 +592,11 @@ class GazeboEngine final : public Engine {
   std::unordered_map<const void*, Entity> entity_;
   std::map<std::pair<const void*, const void*>, double> contacts_;  // -> last touched
   std::vector<std::pair<const dart::dynamics::Skeleton*, const dart::dynamics::Skeleton*>> pairs_;
+  struct Found {
+    const void *ka, *kb;
+    const Entity *a, *b;
+  };
+  std::vector<Found> found_;
   nlohmann::json collisions_ = nlohmann::json::array();
   std::vector<Ego> egos_;
   std::set<std::string> warned_models_;

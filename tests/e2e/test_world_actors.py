@@ -248,5 +248,29 @@ class Actors(unittest.TestCase):
         self.assertIn("unknown key 'speeed'", r.stderr)
 
 
+class WorldCache(unittest.TestCase):
+    def test_the_second_start_reads_the_parsed_world_from_the_cache(self):
+        ex = Experiment(self)
+        shutil.copy(WORLD, os.path.join(ex.dir, "world.sdf"))
+        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo",
+                           "GazeboWorldFile": "world.sdf", "EngineTimestep": 0.02})
+        old = os.environ.get("CONVOY_CACHE_DIR")
+        os.environ["CONVOY_CACHE_DIR"] = os.path.join(ex.dir, "cache")
+        try:
+            logs = []
+            for i in range(2):
+                ex.run(0.1, run_name="run%d" % i)
+                with open(os.path.join(ex.dir, "run%d" % i, "logs", "gazebo.log")) as f:
+                    logs.append(f.read())
+        finally:
+            if old is None:
+                del os.environ["CONVOY_CACHE_DIR"]
+            else:
+                os.environ["CONVOY_CACHE_DIR"] = old
+        self.assertIn("(cache: miss", logs[0])
+        self.assertIn("(cache: hit", logs[1])
+        self.assertTrue(os.listdir(os.path.join(ex.dir, "cache", "world")))
+
+
 if __name__ == "__main__":
     unittest.main()
