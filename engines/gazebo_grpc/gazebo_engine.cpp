@@ -187,7 +187,10 @@ class GazeboEngine final : public Engine {
     pending_.clear();
     contacts_.clear();
     collisions_ = nlohmann::json::array();
-    for (auto& e : egos_) e.speed = 0;
+    for (auto& e : egos_) {
+      e.speed = 0;
+      e.speed_ns = -1;
+    }
     build_entities();
     cameras_->update(0.0);
   }
