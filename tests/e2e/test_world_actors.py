@@ -187,6 +187,10 @@ class Actors(unittest.TestCase):
             """, drive=8.0)
         ex.run(2.5)
         recs = self.records(ex)
+        # Deterministic: a second run gives the same records.
+        os.remove(os.path.join(ex.dir, "record.jsonl"))
+        ex.run(2.5, run_name="again")
+        self.assertEqual(self.records(ex), recs)
         collisions = recs[-1]["collisions"]
         by_pair = {(c["a"], c["b"]): c for c in collisions}
         self.assertEqual(len(collisions), 2, collisions)
