@@ -302,8 +302,8 @@ class GazeboEngine final : public Engine {
         return true;
       }
       if (dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
-        for (const auto& u : datapack::read_proto<data::RoadUsers>(dp).users())
-          pending_.emplace_back(dp_name, u);
+        const auto users = datapack::read_proto<data::RoadUsers>(dp);  // (kept alive)
+        for (const auto& u : users.users()) pending_.emplace_back(dp_name, u);
         return true;
       }
     } catch (const std::exception& e) {

@@ -251,6 +251,34 @@ class Actors(unittest.TestCase):
         self.assertIn("datapack 'road_users'", r.stderr)
         self.assertIn("unknown key 'speeed'", r.stderr)
 
+    def test_protobuf_road_users_from_a_tf(self):
+        # RoadUserDataPack and RoadUsersDataPack, built in a TF, under any names.
+        ex = self.experiment("""\
+            def users(t):
+                return []
+            """)
+        ex.function("proto_users", textwrap.dedent("""\
+            from nrp_core import *
+            from nrp_core.data.nrp_protobuf import RoadUserDataPack, RoadUsersDataPack
+
+            @TransceiverFunction("gazebo")
+            def proto_users():
+                one = RoadUserDataPack("lead_vehicle", "gazebo")
+                one.data.id = "agent/lead"
+                one.data.category = "truck"
+                one.data.x = 10.0
+                many = RoadUsersDataPack("crowd", "gazebo")
+                u = many.data.users.add()
+                u.id = "agent/walker"
+                u.category = "pedestrian"
+                u.x = 12.0
+                u.y = -2.0
+                return [one, many]
+            """))
+        ex.run(0.2)
+        boxes = {b["model"]: b["class"] for b in self.records(ex)[-1]["boxes"]}
+        self.assertEqual(boxes, {"agent/lead": "truck", "agent/walker": "pedestrian"})
+
 
 class WorldCache(unittest.TestCase):
     def test_the_second_start_reads_the_parsed_world_from_the_cache(self):
