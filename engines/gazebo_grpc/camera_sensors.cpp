@@ -33,15 +33,6 @@ render::Material to_material(const Material& m) {
 
 }  // namespace
 
-std::string CameraSensors::class_of(const std::string& model_name) {
-  std::string s = model_name;
-  auto scope = s.rfind("::");
-  if (scope != std::string::npos) s = s.substr(scope + 2);
-  while (!s.empty() && std::isdigit(static_cast<unsigned char>(s.back()))) s.pop_back();
-  while (!s.empty() && (s.back() == '_' || s.back() == '-')) s.pop_back();
-  return s.empty() ? model_name : s;
-}
-
 CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed)
     : physics_(physics), rng_(seed) {
   for (const auto& model : desc.models)
@@ -100,19 +91,9 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
   for (const auto& model : desc.models) {
     ++model_id;
     model_names_.push_back(model.name);
-    model_classes_.push_back(class_of(model.name));
-    // The ground gets no box: a model that shows only planes, or a static one that collides
-    // only as planes (a road mesh on a ground plane).
-    bool visual_planes = true, collision_planes = true, collides = false;
-    for (const auto& link : model.links) {
-      for (const auto& v : link.visuals) visual_planes &= v.shape.kind == Shape::kPlane;
-      for (const auto& c : link.collisions) {
-        collides = true;
-        collision_planes &= c.shape.kind == Shape::kPlane;
-      }
-    }
-    bool ground = visual_planes || (model.is_static && collides && collision_planes);
-    uint32_t label = ground ? 0 : model_id;
+    model_classes_.push_back(class_of(model));
+    // The ground gets no box.
+    uint32_t label = is_ground(model) ? 0 : model_id;
     for (auto& cam : cameras_) {
       for (const auto& link : model.links)
         for (const auto& c : link.cameras)
@@ -120,70 +101,100 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
     }
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
-      for (const auto& v : link.visuals) {
-        std::vector<std::pair<render::MeshLevels, render::Material>> parts;
-        auto one = [](render::MeshData m) { return render::MeshLevels{{std::move(m)}, {0.0f}}; };
-        Eigen::Isometry3d offset = v.pose;
-        render::Material material = to_material(v.material);
-        switch (v.shape.kind) {
-          case Shape::kBox:
-            parts.emplace_back(
-                one(render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z())),
-                material);
-            break;
-          case Shape::kCylinder: {
-            // Tessellation grows with size: thin posts need few segments.
-            int segments = std::clamp(static_cast<int>(12 + 20 * v.shape.size.x()), 12, 32);
-            parts.emplace_back(
-                render::cylinder_levels(v.shape.size.x(), v.shape.size.z(), segments), material);
-            break;
-          }
-          case Shape::kSphere: {
-            int stacks = std::clamp(static_cast<int>(8 + 2 * v.shape.size.x()), 8, 16);
-            parts.emplace_back(render::sphere_levels(v.shape.size.x(), stacks, 2 * stacks),
-                               material);
-            break;
-          }
-          case Shape::kPlane: {
-            double sx = v.shape.size.x() > 0 ? v.shape.size.x() : 1000;
-            double sy = v.shape.size.y() > 0 ? v.shape.size.y() : 1000;
-            Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-            t.linear() =
-                Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), v.shape.normal)
-                    .toRotationMatrix();
-            offset = offset * t;
-            parts.emplace_back(one(render::make_plane(sx, sy)), material);
-            break;
-          }
-          case Shape::kMesh:
-            for (auto& part : render::load_mesh(
-                     v.shape.mesh.string(),
-                     {static_cast<float>(v.shape.scale.x()), static_cast<float>(v.shape.scale.y()),
-                      static_cast<float>(v.shape.scale.z())})) {
-              int texture =
-                  part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
-              render::Material m = v.material.has_material ? material : part.material(texture);
-              if (v.material.has_material && texture >= 0) m.texture = texture;
-              parts.emplace_back(one(std::move(part.mesh)), m);
-            }
-            break;
-        }
-        if (!v.material.texture.empty()) {
-          int texture = scene_.add_texture_file(v.material.texture.string());
-          for (auto& p : parts) p.second.texture = texture;
-        }
-        for (auto& [mesh, mat] : parts) {
-          int mesh_index = scene_.add_mesh_levels(mesh);
-          render::Pose world = to_pose(link.pose * offset);
-          int inst = scene_.add_instance(mesh_index, mat, world, label,
-                                         label ? static_cast<uint32_t>(model_id) : 0);
-          tracked.instances.push_back(inst);
-          tracked.offsets.push_back(to_pose(offset));
-        }
-      }
+      add_visuals(link, link.pose, label, &tracked);
       if (!model.is_static && !tracked.instances.empty()) tracked_.push_back(std::move(tracked));
     }
   }
+}
+
+void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& placement,
+                                uint32_t label, Tracked* tracked) {
+  for (const auto& v : link.visuals) {
+    std::vector<std::pair<render::MeshLevels, render::Material>> parts;
+    auto one = [](render::MeshData m) { return render::MeshLevels{{std::move(m)}, {0.0f}}; };
+    Eigen::Isometry3d offset = v.pose;
+    render::Material material = to_material(v.material);
+    switch (v.shape.kind) {
+      case Shape::kBox:
+        parts.emplace_back(
+            one(render::make_box(v.shape.size.x(), v.shape.size.y(), v.shape.size.z())), material);
+        break;
+      case Shape::kCylinder: {
+        // Tessellation grows with size: thin posts need few segments.
+        int segments = std::clamp(static_cast<int>(12 + 20 * v.shape.size.x()), 12, 32);
+        parts.emplace_back(render::cylinder_levels(v.shape.size.x(), v.shape.size.z(), segments),
+                           material);
+        break;
+      }
+      case Shape::kSphere: {
+        int stacks = std::clamp(static_cast<int>(8 + 2 * v.shape.size.x()), 8, 16);
+        parts.emplace_back(render::sphere_levels(v.shape.size.x(), stacks, 2 * stacks), material);
+        break;
+      }
+      case Shape::kPlane: {
+        double sx = v.shape.size.x() > 0 ? v.shape.size.x() : 1000;
+        double sy = v.shape.size.y() > 0 ? v.shape.size.y() : 1000;
+        Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+        t.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), v.shape.normal)
+                         .toRotationMatrix();
+        offset = offset * t;
+        parts.emplace_back(one(render::make_plane(sx, sy)), material);
+        break;
+      }
+      case Shape::kMesh:
+        for (auto& part :
+             render::load_mesh(v.shape.mesh.string(), {static_cast<float>(v.shape.scale.x()),
+                                                       static_cast<float>(v.shape.scale.y()),
+                                                       static_cast<float>(v.shape.scale.z())})) {
+          int texture = part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
+          render::Material m = v.material.has_material ? material : part.material(texture);
+          if (v.material.has_material && texture >= 0) m.texture = texture;
+          parts.emplace_back(one(std::move(part.mesh)), m);
+        }
+        break;
+    }
+    if (!v.material.texture.empty()) {
+      int texture = scene_.add_texture_file(v.material.texture.string());
+      for (auto& p : parts) p.second.texture = texture;
+    }
+    for (auto& [mesh, mat] : parts) {
+      int mesh_index = scene_.add_mesh_levels(mesh);
+      render::Pose world = to_pose(placement * offset);
+      int inst = scene_.add_instance(mesh_index, mat, world, label, label);
+      tracked->instances.push_back(inst);
+      tracked->offsets.push_back(to_pose(offset));
+    }
+  }
+}
+
+int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls) {
+  if (cameras_.empty()) return -1;
+  model_names_.push_back(model.name);
+  model_classes_.push_back(cls);
+  const auto label = static_cast<uint32_t>(model_names_.size());
+  Actor actor;
+  for (const auto& link : model.links) {
+    Tracked tracked{-1, {}, {}};
+    add_visuals(link, link.pose, label, &tracked);
+    actor.instances.insert(actor.instances.end(), tracked.instances.begin(),
+                           tracked.instances.end());
+    actor.offsets.insert(actor.offsets.end(), tracked.offsets.begin(), tracked.offsets.end());
+    actor.link_poses.insert(actor.link_poses.end(), tracked.instances.size(), link.pose);
+  }
+  actors_.push_back(std::move(actor));
+  return static_cast<int>(actors_.size() - 1);
+}
+
+void CameraSensors::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
+  if (actor < 0) return;
+  const Actor& a = actors_[actor];
+  for (size_t k = 0; k < a.instances.size(); ++k)
+    scene_.set_pose(a.instances[k], render::compose(to_pose(pose * a.link_poses[k]), a.offsets[k]));
+}
+
+void CameraSensors::set_actor_visible(int actor, bool visible) {
+  if (actor < 0) return;
+  for (int inst : actors_[actor].instances) scene_.set_visible(inst, visible);
 }
 
 void CameraSensors::update(double t) {

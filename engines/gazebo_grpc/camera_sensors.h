@@ -33,6 +33,12 @@ class CameraSensors {
   // renders the current view), and depth images and boxes, which cost extra passes, only
   // once they have been asked for: a world whose cameras nobody reads costs no rendering.
 
+  // Actors: models added while running (road users), each one ground-truth instance of class
+  // `cls`; link poses in the actor's frame. Returns its index (-1: the world has no camera).
+  int add_actor(const ModelDesc& model, const std::string& cls);
+  void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
+  void set_actor_visible(int actor, bool visible);
+
   // The latest frame as a convoy.data.Camera datapack.
   void image_datapack(size_t i, datapack::Builder& out);
   // The latest depth image (metres, float32, H x W) as a JSON datapack
@@ -42,10 +48,6 @@ class CameraSensors {
   // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}: every visible model but the ground
   // and the camera's own.
   void boxes_datapack(size_t i, datapack::Builder& out);
-
-  // The object class of a model: its <convoy:class> element if any, else its name without
-  // a trailing number ("pedestrian_3" -> "pedestrian").
-  static std::string class_of(const std::string& model_name);
 
  private:
   struct Camera {
@@ -68,7 +70,16 @@ class CameraSensors {
     std::vector<int> instances;  // scene instances of this link's visuals
     std::vector<render::Pose> offsets;
   };
+  struct Actor {
+    std::vector<int> instances;
+    std::vector<render::Pose> offsets;          // each instance in its link's frame
+    std::vector<Eigen::Isometry3d> link_poses;  // its link in the actor's frame
+  };
   void build_scene(const WorldDesc& desc);
+  // Adds the scene instances of a link's visuals, the link placed at `placement`, labelled
+  // `label` (0: no ground truth), into `tracked`.
+  void add_visuals(const LinkDesc& link, const Eigen::Isometry3d& placement, uint32_t label,
+                   Tracked* tracked);
   void render(Camera& cam);
   void first_render(Camera& cam);  // on the first request: render now, schedule the next
   void draw_noise(Camera& cam);
@@ -80,6 +91,7 @@ class CameraSensors {
   render::Scene scene_;
   std::vector<Camera> cameras_;
   std::vector<Tracked> tracked_;
+  std::vector<Actor> actors_;
   std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
   std::mt19937_64 rng_;
   double now_ = 0;  // simulated time of the last update()

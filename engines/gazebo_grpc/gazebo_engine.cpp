@@ -10,21 +10,35 @@
 //   ...::depth   JSON {"width", "height", "depth": float32 ndarray (metres)}
 //   ...::boxes   JSON {"width", "height", "boxes": [{"model", "class", "instance", "x_min",
 //                "y_min", "x_max", "y_max", "pixels"}]}: ground truth of visible models
+//   <model>::road_user  RoadUserDataPack, read: each ego model's state (EgoModels)
+//   collisions          JSON list of {"t", "a", "b", "class_a", "class_b",
+//                       "relative_speed_mps"}: every contact so far, each once when it starts
+// RoadUser / RoadUsers datapacks sent to the engine under any name (protobuf, or JSON dicts
+// with RoadUser's keys) pose actors: one per road-user id (docs/architecture.md, Actors).
 // A joint datapack sent to the engine sets the joint's PID target: its position for a
 // position controller, its velocity for a velocity controller; a non-zero effort is added
 // as a feed-forward effort.
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <map>
 #include <memory>
 #include <random>
+#include <set>
 #include <unordered_map>
 
+#include "actors.h"
 #include "camera_sensors.h"
 #include "convoy/datapacks.pb.h"
+#include "convoy/road_users.pb.h"
+#include "datapack/json.h"
 #include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "engine/engine.h"
 #include "joint_pid.h"
 #include "physics_world.h"
+#include "world_cache.h"
 #include "world_description.h"
 
 namespace convoy::engines {
@@ -69,8 +83,16 @@ class GazeboEngine final : public Engine {
       extra.push_back(insert);
     }
     seed_ = config.value("GazeboRNGSeed", 0u);
+    actor_timeout_ = config.value("ActorTimeout", 1.0);
+    actor_table_ = config.value("ActorModels", std::string());
     rng_.seed(seed_);
-    desc_ = world::load_world(file, extra);
+    const auto t0 = std::chrono::steady_clock::now();
+    world::CacheResult cache;
+    desc_ = world::load_world_cached(file, extra, &cache);
+    std::fprintf(stderr, "convoy: engine '%s': world %s loaded in %.3f s (cache: %s, %s)\n",
+                 name.c_str(), file.filename().c_str(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                 world::to_string(cache), world::cache_dir().c_str());
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
     cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
 
@@ -121,6 +143,24 @@ class GazeboEngine final : public Engine {
         add(base + "::boxes", "json");
       }
     }
+    // Ego models: those named, else every model with a joint controller plugin.
+    std::vector<std::string> egos;
+    if (config.contains("EgoModels")) {
+      egos = config["EgoModels"].get<std::vector<std::string>>();
+    } else {
+      for (const auto& model : desc_.models)
+        if (!model.is_static && !model.joint_plugins.empty()) egos.push_back(model.name);
+    }
+    for (const auto& ego_name : egos) {
+      auto it = std::find_if(desc_.models.begin(), desc_.models.end(),
+                             [&](const auto& m) { return m.name == ego_name; });
+      if (it == desc_.models.end() || it->links.empty())
+        throw std::runtime_error("EgoModels: no model '" + ego_name + "' with a link in the world");
+      egos_.push_back(make_ego(*it));
+      add(ego_name + "::road_user", datapack::type_name<data::RoadUser>());
+    }
+    add("collisions", "json");
+    build_entities();
     cameras_->update(0.0);
     return ids;
   }
@@ -141,6 +181,17 @@ class GazeboEngine final : public Engine {
     time_ns_ = 0;
     physics_steps_ = 0;
     sent_frames_.clear();
+    actors_.clear();
+    offsets_.clear();
+    actor_by_id_.clear();
+    pending_.clear();
+    contacts_.clear();
+    collisions_ = nlohmann::json::array();
+    for (auto& e : egos_) {
+      e.speed = 0;
+      e.speed_ns = -1;
+    }
+    build_entities();
     cameras_->update(0.0);
   }
 
@@ -152,6 +203,7 @@ class GazeboEngine final : public Engine {
     const int64_t dt_ns = std::max<int64_t>(1, std::llround(dt * 1e9));
     const int64_t n = (time_ns_ + dt_ns / 2) / dt_ns - physics_steps_;
     physics_steps_ += n;
+    apply_road_users();
     for (int64_t k = 0; k < n; ++k) {
       for (auto& c : controllers_) {
         auto s = physics_->joint_state(c.joint);
@@ -159,13 +211,16 @@ class GazeboEngine final : public Engine {
         physics_->set_joint_effort(c.joint, c.pid.update(error, dt) + c.feed_forward);
       }
       physics_->step();
+      record_contacts();
     }
+    record_actor_overlaps();
     cameras_->update(static_cast<double>(time_ns_) * 1e-9);
     return time_ns_;
   }
 
   void set_datapack(const datapack::View& dp) override {
     auto it = joint_dps_.find(dp.id().name());
+    if (it == joint_dps_.end() && take_road_users(dp)) return;
     if (it == joint_dps_.end()) {
       throw std::runtime_error("engine '" + name_ + "' has no writable datapack '" +
                                dp.id().name() + "' (joint datapacks are <joint plugin>::<joint>)");
@@ -186,6 +241,16 @@ class GazeboEngine final : public Engine {
   }
 
   void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
+    if (id.name() == "collisions") {
+      datapack::write_json(out, collisions_);
+      return;
+    }
+    for (auto& e : egos_) {
+      if (id.name() == e.datapack) {
+        datapack::write_proto(out, ego_state(e));
+        return;
+      }
+    }
     if (auto it = camera_dps_.find(id.name()); it != camera_dps_.end()) {
       auto [index, kind] = it->second;
       if (kind == kImage)
@@ -220,6 +285,325 @@ class GazeboEngine final : public Engine {
   }
 
  private:
+  // --- Road users as actors ---------------------------------------------------------------
+
+  // A RoadUser / RoadUsers datapack (protobuf or JSON): its users wait for the next step.
+  bool take_road_users(const datapack::View& dp) {
+    const std::string& dp_name = dp.id().name();
+    auto where = [&] { return "engine '" + name_ + "': datapack '" + dp_name + "': "; };
+    try {
+      if (dp.is_json()) {
+        for (auto& u : world::road_users_from_json(datapack::read_json(dp)))
+          pending_.emplace_back(dp_name, std::move(u));
+        return true;
+      }
+      if (dp.proto_type() == datapack::type_name<data::RoadUser>()) {
+        pending_.emplace_back(dp_name, datapack::read_proto<data::RoadUser>(dp));
+        return true;
+      }
+      if (dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
+        const auto users = datapack::read_proto<data::RoadUsers>(dp);  // (kept alive)
+        for (const auto& u : users.users()) pending_.emplace_back(dp_name, u);
+        return true;
+      }
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where() + e.what());
+    }
+    return false;
+  }
+
+  struct ActorState {
+    std::string id, category, cls;
+    int physics = -1, camera = -1;
+    bool present = false;
+    int64_t last_seen_ns = 0;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the model's frame
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d half = Eigen::Vector3d::Zero();  // half the box, about the model's frame
+  };
+
+  static bool is_road_user_class(const std::string& c) {
+    return c == "car" || c == "truck" || c == "bus" || c == "pedestrian" || c == "cyclist";
+  }
+
+  ActorState& actor_for(const std::string& dp_name, const data::RoadUser& u) {
+    auto where = [&] {
+      return "engine '" + name_ + "': datapack '" + dp_name + "': road user '" + u.id() + "': ";
+    };
+    if (u.id().empty()) throw std::runtime_error(where() + "no id");
+    if (!u.category().empty() && !is_road_user_class(u.category()))
+      throw std::runtime_error(where() + "category '" + u.category() +
+                               "' is not one of car, truck, bus, pedestrian, cyclist");
+    if (auto it = actor_by_id_.find(u.id()); it != actor_by_id_.end()) {
+      ActorState& a = actors_[it->second];
+      if (!u.category().empty() && u.category() != a.category)
+        throw std::runtime_error(where() + "was '" + a.category + "', now '" + u.category() +
+                                 "': an id cannot change its category");
+      return a;
+    }
+    if (!library_) library_ = std::make_unique<world::ActorLibrary>(actor_table_);
+    const world::ActorModel* am;
+    try {
+      am = &library_->find(u.model(), u.category());
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where() + e.what());
+    }
+    if (!u.model().empty() && am->key != u.model() && warned_models_.insert(u.model()).second) {
+      std::fprintf(stderr,
+                   "convoy: warning: engine '%s': datapack '%s': actor model '%s' is not in %s; "
+                   "category '%s' uses '%s'\n",
+                   name_.c_str(), dp_name.c_str(), u.model().c_str(),
+                   library_->table().string().c_str(), u.category().c_str(), am->key.c_str());
+    }
+    ActorState a;
+    a.id = u.id();
+    a.category = u.category().empty() ? am->cls : u.category();
+    a.cls = a.category;
+    Eigen::Vector3d scale(u.length() > 0 ? u.length() / am->size.x() : 1,
+                          u.width() > 0 ? u.width() / am->size.y() : 1,
+                          u.height() > 0 ? u.height() / am->size.z() : 1);
+    world::ModelDesc model = world::scaled(am->desc, scale);
+    model.name = u.id();
+    a.half = 0.5 * am->size.cwiseProduct(scale);
+    a.physics = physics_->add_actor(u.id(), model);
+    a.camera = cameras_->add_actor(model, a.cls);
+    offsets_.push_back(am->length_offset * scale.x());
+    actors_.push_back(std::move(a));
+    actor_by_id_[u.id()] = actors_.size() - 1;
+    entity_[physics_->actor_skeleton(actors_.back().physics)] = {
+        u.id(), actors_.back().cls, nullptr, static_cast<int>(actors_.size() - 1)};
+    return actors_.back();
+  }
+
+  void set_present(ActorState& a, bool present) {
+    if (a.present == present) return;
+    a.present = present;
+    physics_->set_actor_present(a.physics, present);
+    cameras_->set_actor_visible(a.camera, present);
+  }
+
+  // Poses the actors from the road users received since the last step; removes those gone
+  // (absent, or not heard of for ActorTimeout).
+  void apply_road_users() {
+    for (const auto& [dp_name, u] : pending_) {
+      if (u.absent()) {
+        if (auto it = actor_by_id_.find(u.id()); it != actor_by_id_.end())
+          set_present(actors_[it->second], false);
+        continue;
+      }
+      ActorState& a = actor_for(dp_name, u);
+      const size_t index = actor_by_id_[u.id()];
+      double offset = u.length() > 0 ? u.length_offset() : offsets_[index];
+      Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+      shift.translation().x() = offset;
+      a.pose = world::road_user_pose(u) * shift;
+      a.velocity = (u.vx() != 0 || u.vy() != 0) ? Eigen::Vector3d(u.vx(), u.vy(), 0)
+                                                : Eigen::Vector3d(u.speed() * std::cos(u.yaw()),
+                                                                  u.speed() * std::sin(u.yaw()), 0);
+      a.last_seen_ns = time_ns_;
+      physics_->set_actor_pose(a.physics, a.pose);
+      cameras_->set_actor_pose(a.camera, a.pose);
+      set_present(a, true);
+    }
+    pending_.clear();
+    if (actor_timeout_ > 0) {
+      const auto timeout_ns = static_cast<int64_t>(actor_timeout_ * 1e9);
+      for (auto& a : actors_)
+        if (a.present && time_ns_ - a.last_seen_ns > timeout_ns) set_present(a, false);
+    }
+  }
+
+  // --- Collisions ---------------------------------------------------------------------------
+
+  struct Entity {
+    std::string name, cls;
+    const dart::dynamics::Skeleton* skeleton;  // a world model's (its velocity), or null
+    int actor;                                 // or an actor's index, or -1
+  };
+
+  void build_entities() {
+    entity_.clear();
+    for (const auto& m : desc_.models) {
+      if (world::is_ground(m)) continue;
+      if (const auto* skel = physics_->model_skeleton(m.name))
+        entity_[skel] = {m.name, world::class_of(m), m.is_static ? nullptr : skel, -1};
+    }
+  }
+
+  Eigen::Vector3d velocity_of(const Entity& e) const {
+    if (e.actor >= 0) return actors_[e.actor].velocity;
+    if (e.skeleton && e.skeleton->getNumBodyNodes() > 0)
+      return e.skeleton->getRootBodyNode()->getLinearVelocity();
+    return Eigen::Vector3d::Zero();
+  }
+
+  // A contact between two entities counts as new when they have not touched for this long:
+  // bodies resting against each other make and break contact from step to step.
+  static constexpr double kContactGap = 0.5;
+
+  void note_contact(const void* a_key, const void* b_key, const Entity& a, const Entity& b) {
+    const double t = physics_->time();
+    auto key = std::make_pair(a_key, b_key);
+    auto it = contacts_.find(key);
+    const bool fresh = it == contacts_.end() || t - it->second > kContactGap;
+    contacts_[key] = t;
+    if (!fresh) return;
+    const Entity& first = a.name <= b.name ? a : b;
+    const Entity& second = a.name <= b.name ? b : a;
+    collisions_.push_back({{"t", static_cast<double>(time_ns_) * 1e-9},
+                           {"a", first.name},
+                           {"b", second.name},
+                           {"class_a", first.cls},
+                           {"class_b", second.cls},
+                           {"relative_speed_mps", (velocity_of(a) - velocity_of(b)).norm()}});
+  }
+
+  void record_contacts() {
+    physics_->contact_pairs(&pairs_);
+    // By name, not by address: records of one step come in the same order in every run.
+    found_.clear();
+    for (const auto& [sa, sb] : pairs_) {
+      auto ea = entity_.find(sa), eb = entity_.find(sb);
+      if (ea == entity_.end() || eb == entity_.end()) continue;  // the ground
+      found_.push_back({sa, sb, &ea->second, &eb->second});
+    }
+    std::sort(found_.begin(), found_.end(), [](const Found& x, const Found& y) {
+      return std::minmax(x.a->name, x.b->name) < std::minmax(y.a->name, y.b->name);
+    });
+    for (const auto& f : found_) note_contact(f.ka, f.kb, *f.a, *f.b);
+  }
+
+  // Actors do not collide with each other in the physics (they are immobile there): their
+  // boxes are compared here, once per engine step.
+  void record_actor_overlaps() {
+    for (size_t i = 0; i < actors_.size(); ++i) {
+      const ActorState& a = actors_[i];
+      if (!a.present) continue;
+      for (size_t j = i + 1; j < actors_.size(); ++j) {
+        const ActorState& b = actors_[j];
+        if (!b.present || !boxes_overlap(a, b)) continue;
+        const auto* ka = physics_->actor_skeleton(a.physics);
+        const auto* kb = physics_->actor_skeleton(b.physics);
+        note_contact(ka, kb, entity_.at(ka), entity_.at(kb));
+      }
+    }
+  }
+
+  // Separating axes of two boxes yawed about z, plus their heights.
+  static bool boxes_overlap(const ActorState& a, const ActorState& b) {
+    const Eigen::Vector3d ca = a.pose * Eigen::Vector3d(0, 0, a.half.z());
+    const Eigen::Vector3d cb = b.pose * Eigen::Vector3d(0, 0, b.half.z());
+    if (std::abs(ca.z() - cb.z()) > a.half.z() + b.half.z()) return false;
+    const Eigen::Vector2d d = (cb - ca).head<2>();
+    if (d.norm() > a.half.head<2>().norm() + b.half.head<2>().norm()) return false;
+    const Eigen::Vector2d axes[4] = {a.pose.linear().col(0).head<2>().normalized(),
+                                     a.pose.linear().col(1).head<2>().normalized(),
+                                     b.pose.linear().col(0).head<2>().normalized(),
+                                     b.pose.linear().col(1).head<2>().normalized()};
+    auto radius = [&](const ActorState& s, int first, const Eigen::Vector2d& axis) {
+      return s.half.x() * std::abs(axes[first].dot(axis)) +
+             s.half.y() * std::abs(axes[first + 1].dot(axis));
+    };
+    for (const auto& axis : axes) {
+      if (std::abs(d.dot(axis)) > radius(a, 0, axis) + radius(b, 2, axis)) return false;
+    }
+    return true;
+  }
+
+  // --- The ego's state ------------------------------------------------------------------------
+
+  struct Ego {
+    std::string name, cls, datapack;
+    int link = -1;  // the model's first link: the reference point
+    double length = 0, width = 0, height = 0, length_offset = 0;
+    double speed = 0;  // at the last report, for the acceleration
+    int64_t speed_ns = -1;
+  };
+
+  Ego make_ego(const world::ModelDesc& m) {
+    Ego e;
+    e.name = m.name;
+    e.cls = world::class_of(m);
+    e.datapack = m.name + "::road_user";
+    e.link = physics_->link_index(m.links.front().name);
+    // The box of its collision shapes, in the reference link's frame as loaded.
+    const Eigen::Isometry3d ref_inv = m.links.front().pose.inverse();
+    Eigen::AlignedBox3d box;
+    for (const auto& l : m.links) {
+      for (const auto& c : l.collisions) {
+        Eigen::Vector3d h = 0.5 * c.shape.size;
+        if (c.shape.kind == world::Shape::kCylinder)
+          h = {c.shape.size.x(), c.shape.size.x(), 0.5 * c.shape.size.z()};
+        if (c.shape.kind == world::Shape::kPlane || c.shape.kind == world::Shape::kMesh) continue;
+        const Eigen::Isometry3d t = ref_inv * l.pose * c.pose;
+        for (int k = 0; k < 8; ++k)
+          box.extend(t * Eigen::Vector3d((k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(),
+                                         (k & 4) ? h.z() : -h.z()));
+      }
+    }
+    if (!box.isEmpty()) {
+      e.length = box.sizes().x();
+      e.width = box.sizes().y();
+      e.height = box.sizes().z();
+      e.length_offset = box.center().x();
+    }
+    return e;
+  }
+
+  data::RoadUser ego_state(Ego& e) {
+    data::RoadUser u;
+    auto s = physics_->link_state(e.link);
+    const Eigen::Matrix3d r = s.rotation.toRotationMatrix();
+    const double yaw = std::atan2(r(1, 0), r(0, 0));
+    const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
+    const double roll = std::atan2(r(2, 1), r(2, 2));
+    u.set_id(e.name);
+    u.set_category(e.cls);
+    u.set_model(e.name);
+    u.set_x(s.position.x());
+    u.set_y(s.position.y());
+    u.set_z(s.position.z());
+    u.set_yaw(yaw);
+    u.set_pitch(pitch);
+    u.set_roll(roll);
+    const double speed = s.linear_velocity.dot(r.col(0));
+    u.set_speed(speed);
+    if (e.speed_ns >= 0 && time_ns_ > e.speed_ns)
+      u.set_acceleration((speed - e.speed) / (static_cast<double>(time_ns_ - e.speed_ns) * 1e-9));
+    if (time_ns_ != e.speed_ns) {
+      e.speed = speed;
+      e.speed_ns = time_ns_;
+    }
+    u.set_yaw_rate(s.angular_velocity.z());
+    u.set_vx(s.linear_velocity.x());
+    u.set_vy(s.linear_velocity.y());
+    u.set_length(e.length);
+    u.set_width(e.width);
+    u.set_height(e.height);
+    u.set_length_offset(e.length_offset);
+    u.set_time_ns(time_ns_);
+    return u;
+  }
+
+  double actor_timeout_ = 1.0;
+  std::string actor_table_;
+  std::unique_ptr<world::ActorLibrary> library_;
+  std::vector<std::pair<std::string, data::RoadUser>> pending_;  // datapack name, state
+  std::vector<ActorState> actors_;
+  std::vector<double> offsets_;  // by actor: its box centre ahead of the reference point
+  std::unordered_map<std::string, size_t> actor_by_id_;
+  std::unordered_map<const void*, Entity> entity_;
+  std::map<std::pair<const void*, const void*>, double> contacts_;  // -> last touched
+  std::vector<std::pair<const dart::dynamics::Skeleton*, const dart::dynamics::Skeleton*>> pairs_;
+  struct Found {
+    const void *ka, *kb;
+    const Entity *a, *b;
+  };
+  std::vector<Found> found_;
+  nlohmann::json collisions_ = nlohmann::json::array();
+  std::vector<Ego> egos_;
+  std::set<std::string> warned_models_;
+
   struct Controller {
     int joint;
     bool velocity;

@@ -397,6 +397,7 @@ void PhysicsWorld::add_skeleton(const dd::SkeletonPtr& skel, const ModelDesc& mo
   // it every step. gate_scenery() enters it into collision detection while a moving body is
   // near.
   const bool scenery = is_scenery(model);
+  skeleton_by_model_[model.name] = skel;
   if (scenery)
     scenery_.push_back({skel, {}, false});
   else
@@ -446,6 +447,66 @@ void PhysicsWorld::step() {
   }
   if (steps_++ % gate_every_ == 0) gate_scenery();
   world_->step();
+}
+
+int PhysicsWorld::add_actor(const std::string& name, const ModelDesc& model) {
+  auto skel = dd::Skeleton::create("actor:" + name);
+  dd::FreeJoint::Properties jp;
+  jp.mName = "actor:" + name;
+  auto [joint, body] = skel->createJointAndBodyNodePair<dd::FreeJoint>(nullptr, jp);
+  (void)joint;
+  for (const auto& l : model.links) {
+    for (const auto& c : l.collisions) {
+      Eigen::Isometry3d shape_offset = c.pose;
+      auto shape = make_shape(c.shape, &shape_offset);
+      auto* node = body->createShapeNodeWith<dd::CollisionAspect, dd::DynamicsAspect>(
+          shape, l.name + "::" + c.name);
+      node->setRelativeTransform(l.pose * shape_offset);
+      node->getDynamicsAspect()->setFrictionCoeff(c.mu);
+    }
+  }
+  skel->setMobile(false);
+  actors_.push_back({skel, false});
+  return static_cast<int>(actors_.size() - 1);
+}
+
+void PhysicsWorld::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
+  auto& skel = actors_[actor].skeleton;
+  skel->getRootJoint()->setPositions(dd::FreeJoint::convertToPositions(pose));
+}
+
+void PhysicsWorld::set_actor_present(int actor, bool present) {
+  Actor& a = actors_[actor];
+  if (a.present == present) return;
+  if (present)
+    world_->addSkeleton(a.skeleton);
+  else
+    world_->removeSkeleton(a.skeleton);
+  a.present = present;
+}
+
+const dd::Skeleton* PhysicsWorld::model_skeleton(const std::string& model) const {
+  auto it = skeleton_by_model_.find(model);
+  return it == skeleton_by_model_.end() ? nullptr : it->second.get();
+}
+
+void PhysicsWorld::contact_pairs(
+    std::vector<std::pair<const dd::Skeleton*, const dd::Skeleton*>>* out) const {
+  out->clear();
+  const auto& result = world_->getLastCollisionResult();
+  for (const auto& c : result.getContacts()) {
+    auto skeleton_of = [](const dart::collision::CollisionObject* o) -> const dd::Skeleton* {
+      const auto* node = dynamic_cast<const dd::ShapeNode*>(o->getShapeFrame());
+      return node ? node->getSkeleton().get() : nullptr;
+    };
+    const dd::Skeleton* a = skeleton_of(c.collisionObject1);
+    const dd::Skeleton* b = skeleton_of(c.collisionObject2);
+    if (!a || !b || a == b) continue;
+    if (b < a) std::swap(a, b);
+    out->emplace_back(a, b);
+  }
+  std::sort(out->begin(), out->end());
+  out->erase(std::unique(out->begin(), out->end()), out->end());
 }
 
 int PhysicsWorld::joint_index(const std::string& name) const {

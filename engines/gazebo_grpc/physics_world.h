@@ -51,6 +51,24 @@ class PhysicsWorld {
 
   dart::simulation::WorldPtr dart_world() const { return world_; }
 
+  // Actors: road users posed from outside. Each is one immobile body on a free joint with
+  // the collision shapes of `model` (link poses in the actor's frame): the physically
+  // simulated models collide with it; it does not move in response. Returns its index.
+  int add_actor(const std::string& name, const ModelDesc& model);
+  void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
+  // In the world (colliding) or not.
+  void set_actor_present(int actor, bool present);
+
+  // The skeleton of a world model (null if it has none) or of an actor.
+  const dart::dynamics::Skeleton* model_skeleton(const std::string& model) const;
+  const dart::dynamics::Skeleton* actor_skeleton(int actor) const {
+    return actors_[actor].skeleton.get();
+  }
+  // The pairs of skeletons in contact after the last step, each pair once (in either order).
+  void contact_pairs(
+      std::vector<std::pair<const dart::dynamics::Skeleton*, const dart::dynamics::Skeleton*>>* out)
+      const;
+
  private:
   struct JointRef {
     std::string name;
@@ -102,6 +120,12 @@ class PhysicsWorld {
     bool at_origin;  // offset is the identity
   };
   std::vector<LinkRef> links_;
+  struct Actor {
+    dart::dynamics::SkeletonPtr skeleton;
+    bool present = false;
+  };
+  std::vector<Actor> actors_;
+  std::unordered_map<std::string, dart::dynamics::SkeletonPtr> skeleton_by_model_;
   std::vector<std::string> link_names_;
   std::unordered_map<std::string, int> link_by_name_;
 };

@@ -1,5 +1,7 @@
 #include "world_description.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -230,6 +232,15 @@ class Loader {
           pids.push_back(pid);
         }
         model->joint_plugins.emplace_back(name, std::move(pids));
+      } else if (filename == "convoy_class") {
+        std::string cls = p->HasElement("class") ? p->Get<std::string>("class") : "";
+        if (!is_known_class(cls)) {
+          std::string all;
+          for (const auto& c : known_classes()) all += (all.empty() ? "" : ", ") + c;
+          throw std::runtime_error(file_.string() + ": " + where + ": <class> '" + cls +
+                                   "' is not one of " + all);
+        }
+        model->cls = cls;
       } else if (filename.find("LinkController") != std::string::npos ||
                  filename.find("LinkPlugin") != std::string::npos) {
         model->link_plugins.push_back(name);
@@ -242,6 +253,7 @@ class Loader {
     ModelDesc md;
     md.name = name;
     md.is_static = m->Static();
+    if (auto e = m->Element(); e && !e->FilePath().empty()) md.source = fs::absolute(e->FilePath());
     for (uint64_t i = 0; i < m->LinkCount(); ++i) {
       const sdf::Link* l = m->LinkByIndex(i);
       LinkDesc ld;
@@ -415,6 +427,53 @@ class Loader {
 
 }  // namespace
 
+const std::vector<std::string>& known_classes() {
+  static const std::vector<std::string> classes = {
+      "car",   "truck", "bus",           "pedestrian", "cyclist", "building", "tree",
+      "shrub", "pole",  "traffic_light", "sign",       "barrier", "other"};
+  return classes;
+}
+
+bool is_known_class(const std::string& cls) {
+  const auto& k = known_classes();
+  return std::find(k.begin(), k.end(), cls) != k.end();
+}
+
+bool is_ground(const ModelDesc& model) {
+  bool visual_planes = true, collision_planes = true, collides = false;
+  for (const auto& link : model.links) {
+    for (const auto& v : link.visuals) visual_planes &= v.shape.kind == Shape::kPlane;
+    for (const auto& c : link.collisions) {
+      collides = true;
+      collision_planes &= c.shape.kind == Shape::kPlane;
+    }
+  }
+  return visual_planes || (model.is_static && collides && collision_planes);
+}
+
+std::string class_of_name(const std::string& model_name) {
+  std::string s = model_name;
+  auto scope = s.rfind("::");
+  if (scope != std::string::npos) s = s.substr(scope + 2);
+  while (!s.empty() && std::isdigit(static_cast<unsigned char>(s.back()))) s.pop_back();
+  while (!s.empty() && (s.back() == '_' || s.back() == '-')) s.pop_back();
+  return s.empty() ? model_name : s;
+}
+
+std::vector<ModelDesc> load_model(const fs::path& file, const std::string& name,
+                                  const Eigen::Isometry3d& pose) {
+  fs::path mf = fs::absolute(file);
+  if (!fs::exists(mf)) throw std::runtime_error(mf.string() + ": model file not found");
+  Loader model_loader(mf);
+  sdf::Root mroot;
+  auto merrors = load_sdf(mroot, mf, model_loader.config());
+  if (!merrors.empty()) throw std::runtime_error(format_errors(merrors, mf));
+  if (!mroot.Model()) throw std::runtime_error(mf.string() + ": no <model> in the file");
+  WorldDesc w;
+  model_loader.model(mroot.Model(), pose, name.empty() ? mroot.Model()->Name() : name, &w);
+  return std::move(w.models);
+}
+
 WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& extra) {
   fs::path file = fs::absolute(file_in);
   if (!fs::exists(file)) throw std::runtime_error(file.string() + ": world file not found");
@@ -469,15 +528,8 @@ WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& ex
     loader.model(m, to_eigen(mp), m->Name(), &world);
   }
   for (const auto& insert : extra) {
-    fs::path mf = fs::absolute(insert.file);
-    if (!fs::exists(mf)) throw std::runtime_error(mf.string() + ": model file not found");
-    Loader model_loader(mf);
-    sdf::Root mroot;
-    auto merrors = load_sdf(mroot, mf, model_loader.config());
-    if (!merrors.empty()) throw std::runtime_error(format_errors(merrors, mf));
-    if (!mroot.Model()) throw std::runtime_error(mf.string() + ": no <model> in the file");
-    model_loader.model(mroot.Model(), insert.pose,
-                       insert.name.empty() ? mroot.Model()->Name() : insert.name, &world);
+    for (auto& m : load_model(insert.file, insert.name, insert.pose))
+      world.models.push_back(std::move(m));
   }
   return world;
 }

@@ -92,6 +92,11 @@ struct PidDesc {
 
 struct ModelDesc {
   std::string name;
+  // Ground-truth class, from the model's annotation
+  //   <plugin name="convoy_class" filename="convoy_class"><class>car</class></plugin>
+  // ("" if none: then class_of_name()).
+  std::string cls;
+  std::filesystem::path source;  // the SDF file it was read from
   bool is_static = false;
   std::vector<LinkDesc> links;
   std::vector<JointDesc> joints;
@@ -118,6 +123,22 @@ struct WorldDesc {
   std::vector<LightDesc> lights;
 };
 
+// The fixed class set of all ground truth: road users (car, truck, bus, pedestrian,
+// cyclist) and scenery (building, tree, shrub, pole, sign, traffic_light, barrier, other).
+const std::vector<std::string>& known_classes();
+bool is_known_class(const std::string& cls);
+// The class of a model without an annotation: its name without a trailing number
+// ("building_3" -> "building"), kept for worlds written before annotations.
+std::string class_of_name(const std::string& model_name);
+// A model's class: its annotation, else class_of_name().
+inline std::string class_of(const ModelDesc& m) {
+  return m.cls.empty() ? class_of_name(m.name) : m.cls;
+}
+
+// The ground: a model that shows only planes, or a static one that collides only as planes
+// (a road mesh on a ground plane). It has no ground truth and makes no collision records.
+bool is_ground(const ModelDesc& m);
+
 // A model added by the engine config (GazeboSDFModels).
 struct ModelInsert {
   std::string name;
@@ -130,5 +151,10 @@ struct ModelInsert {
 // (and in its models/ folder), and in the build's share/convoy/models. Throws
 // std::runtime_error("<file>: <element>: <problem>").
 WorldDesc load_world(const std::filesystem::path& file, const std::vector<ModelInsert>& extra = {});
+
+// Loads one SDF file's <model> as `name` (its own name if empty) at `pose`, its nested
+// models after it; for actors added while running. Throws like load_world.
+std::vector<ModelDesc> load_model(const std::filesystem::path& file, const std::string& name,
+                                  const Eigen::Isometry3d& pose);
 
 }  // namespace convoy::world

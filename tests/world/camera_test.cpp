@@ -150,10 +150,31 @@ TEST_F(CameraTest, DepthImageGivesTheDistanceToTheCube) {
   EXPECT_NEAR(centre, 3.5, 0.01);
 }
 
-TEST(CameraClass, ClassComesFromTheModelName) {
-  EXPECT_EQ(CameraSensors::class_of("pedestrian_3"), "pedestrian");
-  EXPECT_EQ(CameraSensors::class_of("car12"), "car");
-  EXPECT_EQ(CameraSensors::class_of("world::bus"), "bus");
+TEST(CameraClass, WithoutAnAnnotationTheClassIsTheNameStem) {
+  EXPECT_EQ(class_of_name("pedestrian_3"), "pedestrian");
+  EXPECT_EQ(class_of_name("car12"), "car");
+  EXPECT_EQ(class_of_name("world::bus"), "bus");
+}
+
+TEST(CameraClass, ClassComesFromTheModelNotItsName) {
+  WorldDesc desc = load_world(kData + "/class_world.sdf");
+  ASSERT_EQ(desc.models.size(), 3u);
+  EXPECT_EQ(desc.models[0].name, "hatchback_3");
+  EXPECT_EQ(class_of(desc.models[0]), "car");
+  EXPECT_EQ(class_of(desc.models[1]), "pedestrian");  // named "alice"
+  EXPECT_EQ(class_of(desc.models[2]), "building");    // no annotation: building_7
+}
+
+TEST(CameraClass, AnUnknownClassIsAnErrorNamingFileAndModel) {
+  try {
+    load_world(kData + "/bad_class_world.sdf");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    std::string m = e.what();
+    EXPECT_NE(m.find("bad_class_world.sdf"), std::string::npos) << m;
+    EXPECT_NE(m.find("model 'hatchback_1'"), std::string::npos) << m;
+    EXPECT_NE(m.find("'hatchback' is not one of car"), std::string::npos) << m;
+  }
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 """Writes experiments/autonomous_driving/parkring_world.sdf: the Parkring road (the model the
 build makes from parkring.xodr), the smart car at the start of lane -1, and roadside content
 made by the project: buildings, trees and shrubs, parked cars, a bus and pedestrians, each a
-model of its own (its name, minus a trailing number, is its class for ground truth).
+model of its own, its ground-truth class annotated in it (a convoy_class plugin).
 
   /usr/bin/python3 tools/assets/make_parkring_world.py build/share/convoy/models/parkring_road/waypoints_lane-1.csv
 
@@ -58,12 +58,14 @@ def box(x, y, z):
     return "<box><size>%.2f %.2f %.2f</size></box>" % (x, y, z)
 
 
-def model(name, x, y, yaw, visuals, collision=None):
+def model(name, cls, x, y, yaw, visuals, collision=None):
     col = ""
     if collision:
         col = "        <collision name='c'><pose>%s</pose><geometry>%s</geometry></collision>\n" % collision
     return ("    <model name='%s'>\n      <static>true</static>\n      <pose>%.2f %.2f 0 0 0 %.3f</pose>\n"
-            "      <link name='link'>\n%s%s      </link>\n    </model>\n" % (name, x, y, yaw, col, "".join(visuals)))
+            "      <link name='link'>\n%s%s      </link>\n"
+            "      <plugin name='convoy_class' filename='convoy_class'><class>%s</class></plugin>\n"
+            "    </model>\n" % (name, x, y, yaw, col, "".join(visuals), cls))
 
 
 def main():
@@ -86,7 +88,7 @@ def main():
         n = counts.get(kind, 0)
         counts[kind] = n + 1
         placed.append((x, y, r))
-        out.append(model("%s_%d" % (kind, n), x, y, yaw, visuals, collision))
+        out.append(model("%s_%d" % (kind, n), kind, x, y, yaw, visuals, collision))
 
     def at(i, offset):  # offset > 0: right of lane -1
         x, y, h = lane[i % len(lane)]

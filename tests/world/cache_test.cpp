@@ -1,0 +1,117 @@
+// The parsed-world cache (world_cache.h): a hit gives the same description as parsing, a
+// changed included file or a corrupt entry is rebuilt, and the format round-trips.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "world_cache.h"
+
+namespace convoy::world {
+namespace {
+
+namespace fs = std::filesystem;
+
+void write(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+}
+
+std::string model_sdf(double size) {
+  return "<?xml version='1.0'?><sdf version='1.7'><model name='crate'><static>true</static>"
+         "<link name='link'><collision name='c'><geometry><box><size>" +
+         std::to_string(size) +
+         " 1 1</size></box></geometry></collision>"
+         "<visual name='v'><geometry><box><size>1 1 1</size></box></geometry></visual></link>"
+         "<plugin name='convoy_class' filename='convoy_class'><class>other</class></plugin>"
+         "</model></sdf>";
+}
+
+class CacheTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("convoy-cache-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    setenv("CONVOY_CACHE_DIR", (dir_ / "cache").c_str(), 1);
+    write(
+        dir_ / "models" / "crate" / "model.config",
+        "<?xml version='1.0'?><model><name>crate</name><sdf version='1.7'>model.sdf</sdf></model>");
+    write(dir_ / "models" / "crate" / "model.sdf", model_sdf(2.0));
+    world_ = dir_ / "world.sdf";
+    write(
+        world_,
+        "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
+        "<include><uri>model://crate</uri><name>crate_1</name><pose>1 2 0 0 0 0.5</pose></include>"
+        "<model name='ball'><link name='link'><inertial><mass>2</mass></inertial>"
+        "<collision name='c'><geometry><sphere><radius>0.5</radius></sphere></geometry></collision>"
+        "</link></model></world></sdf>");
+  }
+  void TearDown() override {
+    unsetenv("CONVOY_CACHE_DIR");
+    fs::remove_all(dir_);
+  }
+  fs::path dir_, world_;
+};
+
+TEST_F(CacheTest, AHitGivesTheSameDescriptionAsParsing) {
+  CacheResult r;
+  WorldDesc first = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kMiss);
+  WorldDesc second = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kHit);
+  const std::string parsed = serialize_world(load_world(world_));
+  EXPECT_EQ(serialize_world(first), parsed);
+  EXPECT_EQ(serialize_world(second), parsed);
+  ASSERT_EQ(second.models.size(), 2u);
+  EXPECT_EQ(second.models[0].name, "crate_1");
+  EXPECT_EQ(second.models[0].cls, "other");
+  EXPECT_DOUBLE_EQ(second.models[0].links[0].collisions[0].shape.size.x(), 2.0);
+  EXPECT_NEAR(second.models[0].links[0].pose.translation().y(), 2.0, 1e-12);
+  EXPECT_DOUBLE_EQ(second.models[1].links[0].mass, 2.0);
+}
+
+TEST_F(CacheTest, AChangedIncludedFileIsRebuilt) {
+  CacheResult r;
+  load_world_cached(world_, {}, &r);
+  ASSERT_EQ(r, CacheResult::kMiss);
+  write(dir_ / "models" / "crate" / "model.sdf", model_sdf(3.0));
+  WorldDesc d = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kStale);
+  EXPECT_DOUBLE_EQ(d.models[0].links[0].collisions[0].shape.size.x(), 3.0);
+  load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kHit);
+}
+
+TEST_F(CacheTest, ACorruptEntryIsIgnoredAndRebuilt) {
+  CacheResult r;
+  load_world_cached(world_, {}, &r);
+  ASSERT_EQ(r, CacheResult::kMiss);
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir_ / "cache" / "world")) {
+    ++entries;
+    // Keep the header (dependencies) intact, cut the description short.
+    fs::resize_file(e.path(), fs::file_size(e.path()) - 40);
+  }
+  ASSERT_EQ(entries, 1);
+  WorldDesc d = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kCorrupt);
+  EXPECT_EQ(serialize_world(d), serialize_world(load_world(world_)));
+  load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kHit);
+  EXPECT_THROW(deserialize_world("CVWDESC2garbage"), std::runtime_error);
+}
+
+TEST_F(CacheTest, OffDisablesIt) {
+  setenv("CONVOY_CACHE_DIR", "off", 1);
+  CacheResult r;
+  load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kDisabled);
+  EXPECT_FALSE(fs::exists(dir_ / "cache"));
+}
+
+}  // namespace
+}  // namespace convoy::world
