@@ -72,6 +72,11 @@ struct Path {
   std::vector<double> arc;  // arc length at each pose
   odr::LaneRoute route;
   std::vector<std::pair<double, std::string>> stops;  // (arc of stop line, signal id)
+  struct Crossing {
+    std::string junction;
+    double enter = 0, exit = 0;  // arcs
+  };
+  std::vector<Crossing> crossings;  // junctions crossed, in order
   double length() const { return arc.empty() ? 0 : arc.back(); }
   // Pose at arc length a (clamped).
   odr::Pose2 at(double a) const {
@@ -152,6 +157,10 @@ class VehicleAgent final : public Engine {
   // The leader ahead on `path` from arc `me` (my front bumper's arc): (gap, speed).
   std::pair<double, double> leader_on(const Path& path, double my_arc, size_t cursor) const;
   void consider_lane_change();
+  // Gap to the entry of the next junction when it must wait there (first come by arrival
+  // time, ties by id; anyone inside blocks), else +inf.
+  double junction_wait(double my_front, const Snapshot* snap) const;
+  bool red_for(odr::LaneIndex lane, const Snapshot* snap) const;
   const Snapshot* perceived() const;
 
   std::string name_;
@@ -159,7 +168,7 @@ class VehicleAgent final : public Engine {
   std::unique_ptr<odr::LaneGraph> graph_;
   Idm idm_;
   double limit_factor_ = 0, max_decel_ = 9, politeness_ = 0.3, threshold_ = 0.2, b_safe_ = 4;
-  bool lane_changes_ = true;
+  bool lane_changes_ = true, yielding_ = true;
   double reaction_s_ = 0, radius_ = 100, start_s_ = 0, initial_speed_ = 0;
   double length_ = 4.5, width_ = 1.8, height_ = 1.5, wheelbase_ = 2.7, rear_overhang_ = 0.9;
   std::string model_, category_;
@@ -278,6 +287,22 @@ Path VehicleAgent::make_path(const odr::LaneRoute& route) const {
     }
   }
   std::sort(p.stops.begin(), p.stops.end());
+  // Junction crossings: runs of segments in one junction, from the first one's start to the
+  // last one's end.
+  const auto& segs = route.segments;
+  for (size_t i = 0; i < segs.size();) {
+    if (segs[i].junction == "-1") {
+      ++i;
+      continue;
+    }
+    size_t j = i;
+    while (j + 1 < segs.size() && segs[j + 1].junction == segs[i].junction) ++j;
+    const odr::WorldPose a = graph_->world_pose(segs[i].road_id, segs[i].lane_id, segs[i].s_from);
+    const odr::WorldPose b = graph_->world_pose(segs[j].road_id, segs[j].lane_id, segs[j].s_to);
+    const auto pa = p.project(a.x, a.y), pb = p.project(b.x, b.y);
+    p.crossings.push_back({segs[i].junction, std::max(0.0, pa.arc), pb.arc});
+    i = j + 1;
+  }
   return p;
 }
 
@@ -305,6 +330,7 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   threshold_ = config.at("threshold").get<double>();
   b_safe_ = config.at("b_safe").get<double>();
   lane_changes_ = config.at("LaneChanges").get<bool>();
+  yielding_ = config.at("JunctionYielding").get<bool>();
   reaction_s_ = config.at("ReactionTime").get<double>();
   radius_ = config.at("NeighbourRadius").get<double>();
   start_s_ = config.at("StartS").get<double>();
@@ -511,6 +537,77 @@ void VehicleAgent::consider_lane_change() {
   }
 }
 
+namespace {
+// Time to cover d m from speed v accelerating at a up to v0.
+double eta(double d, double v, double a, double v0) {
+  if (d <= 0) return 0;
+  v = std::max(v, 0.0);
+  const double t_up = std::max(v0 - v, 0.0) / a;
+  const double d_up = v * t_up + 0.5 * a * t_up * t_up;
+  if (d <= d_up) return (-v + std::sqrt(v * v + 2 * a * d)) / a;
+  return t_up + (d - d_up) / std::max(v0, 0.1);
+}
+}  // namespace
+
+bool VehicleAgent::red_for(odr::LaneIndex lane, const Snapshot* snap) const {
+  if (!snap || !snap->lights) return false;
+  const json& sig = snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
+  for (const auto& info : graph_->signals()) {
+    if (!info.traffic_light || !info.signal) continue;
+    if (std::find(info.lanes.begin(), info.lanes.end(), lane) == info.lanes.end()) continue;
+    auto it = sig.find(info.signal->id);
+    if (it != sig.end() && it->is_string() && *it != "green" && *it != "off") return true;
+  }
+  return false;
+}
+
+double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const {
+  const Path::Crossing* next = nullptr;
+  for (const auto& c : path_.crossings) {
+    if (c.exit > my_front - length_) {
+      next = &c;
+      break;
+    }
+  }
+  if (!next) return INFINITY;
+  const double g = next->enter - my_front;
+  if (g < 0 || g > radius_) return INFINITY;            // inside already, or far
+  if (g < v_ * v_ / (2 * max_decel_)) return INFINITY;  // cannot stop before it: committed
+  if (!snap || !snap->neighbours) return INFINITY;
+  const double my_eta = eta(g, v_, idm_.a, idm_.v0);
+  const size_t lo = cursor_ > 40 ? cursor_ - 40 : 0;
+  for (const auto& u : snap->neighbours->users()) {
+    if (u.absent() || u.id() == name_) continue;
+    if (std::hypot(u.x() - x_, u.y() - y_) > radius_) continue;
+    // On my own path (a leader or follower): IDM's business.
+    const auto pr = path_.project(u.x(), u.y(), lo);
+    if (std::isfinite(pr.d2) && std::abs(pr.lateral) < 1.2 &&
+        std::abs(std::remainder(u.yaw() - path_.at(pr.arc).heading, 2 * M_PI)) < 0.5)
+      continue;
+    const auto loc = graph_->locate(u.x(), u.y(), u.yaw());
+    if (!loc) continue;
+    const odr::LaneNode& ln = graph_->lane(loc->lane);
+    const double u_front = u.length_offset() + 0.5 * u.length();
+    if (ln.junction == next->junction) {
+      // Inside; blocking unless its back has nearly left (it is leaving).
+      return std::max(g, 0.0);
+    }
+    // Approaching: its lane leads into the junction.
+    bool leads = false;
+    for (odr::LaneIndex nx : graph_->successors(loc->lane)) {
+      if (graph_->lane(nx).junction == next->junction) leads = true;
+    }
+    if (!leads) continue;
+    if (red_for(loc->lane, snap)) continue;  // it waits at its light
+    const double remaining = (ln.forward ? ln.s1 - loc->s : loc->s - ln.s0) - u_front;
+    if (remaining < 0) return std::max(g, 0.0);  // its front is in
+    const double other_eta = eta(remaining, u.speed(), idm_.a, idm_.v0);
+    if (other_eta < my_eta - 0.05 || (other_eta <= my_eta + 0.05 && u.id() < name_))
+      return std::max(g, 0.0);
+  }
+  return INFINITY;
+}
+
 int64_t VehicleAgent::step(int64_t duration_ns) {
   const double dt = duration_ns * 1e-9;
   time_ns_ += duration_ns;
@@ -542,6 +639,13 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
         vl = 0;
       }
       break;  // only the next light counts
+    }
+  }
+  if (yielding_) {
+    const double g = junction_wait(my_front, snap);
+    if (g < gap) {
+      gap = g;
+      vl = 0;
     }
   }
   double acc = idm_.accel(v_, gap, vl, v0);

@@ -300,3 +300,78 @@ class BadInput(AgentCase):
     def test_unreadable_map(self):
         self.write("broken.xodr", "<OpenDRIVE><road")
         self.bad({"Map": "broken.xodr"}, "Map", "broken.xodr")
+
+
+CITY = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                    "experiments", "city_traffic", "city.xodr")
+
+MULTI_TF = """\
+import json
+from nrp_core import *
+from convoy_traffic.neighbours import neighbour_datapacks, road_users
+
+_out = open({out!r}, "a")
+
+{decorators}
+@TransceiverFunction({first!r})
+def neighbours({args}):
+    dps = [{args}]
+    users = road_users(dps)
+    _out.write(json.dumps({{u.id: dict(x=u.x, y=u.y, road=u.road, lane=u.lane, speed=u.speed,
+                                       absent=u.absent) for u in users}}, sort_keys=True) + "\\n")
+    _out.flush()
+    return neighbour_datapacks(dps, agents={agents!r}, radius=120.0)
+"""
+
+
+class Junction(AgentCase):
+    def junction_roads(self, junction):
+        import xml.etree.ElementTree as ET
+        return {r.get("id") for r in ET.parse(CITY).getroot().iter("road")
+                if r.get("junction") == junction}
+
+    def crossing(self, yielding):
+        # Two cars 86 m from junction 100 at the same speed: one straight east (road 1 ->
+        # 2), one north (road 5 -> 4); their paths cross inside the junction.
+        agents = {"a": {"Route": {"from": "1:-1", "to": "2:-1"}, "StartS": 150.0},
+                  "b": {"Route": {"from": "5:-1", "to": "4:-1"}, "StartS": 50.0}}
+        engines = []
+        for name, extra in sorted(agents.items()):
+            e = {"EngineType": "vehicle_agent", "EngineName": name, "EngineTimestep": 0.05,
+                 "Map": CITY, "InitialSpeed": 10.0, "v0": 10.0, "LaneChanges": False,
+                 "JunctionYielding": yielding}
+            e.update(extra)
+            engines.append(e)
+        out = os.path.join(self.dir, "stream.jsonl")
+        names = sorted(agents)
+        decorators = "\n".join(
+            '@EngineDataPack(keyword="%s", id=DataPackIdentifier("state", "%s"))' % (n, n)
+            for n in names)
+        self.write("tf.py", MULTI_TF.format(out=out, decorators=decorators, first=names[0],
+                                            args=", ".join(names), agents=names))
+        self.write_config({"SimulationName": "junction", "SimulationTimeout": 30.0,
+                           "EngineConfigs": engines,
+                           "DataPackProcessingFunctions": [{"Name": "neighbours",
+                                                            "FileName": "tf.py"}]})
+        self.assertExit(self.run_convoy(timeout=120), 0)
+        inside = self.junction_roads("100")
+        both = []
+        passed = {n: False for n in names}
+        for row in self.stream(out):
+            ins = [n for n in names if n in row and not row[n]["absent"]
+                   and row[n]["road"] in inside]
+            for n in ins:
+                passed[n] = True
+            if len(ins) > 1:
+                both.append(row)
+        return both, passed
+
+    def test_crossing_paths_never_share_the_junction(self):
+        both, passed = self.crossing(True)
+        self.assertEqual(both, [], "both cars inside junction 100 at once")
+        self.assertEqual(passed, {"a": True, "b": True}, "both crossed the junction")
+
+    def test_without_yielding_they_would_meet(self):
+        # The scenario is a real conflict: without yielding both are inside at once.
+        both, _ = self.crossing(False)
+        self.assertTrue(both)
