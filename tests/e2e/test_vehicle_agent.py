@@ -375,3 +375,26 @@ class Junction(AgentCase):
         # The scenario is a real conflict: without yielding both are inside at once.
         both, _ = self.crossing(False)
         self.assertTrue(both)
+
+
+class Example(AgentCase):
+    def test_the_example_runs(self):
+        import shutil
+        src = os.path.join(os.path.dirname(CITY), "..", "vehicle_agents")
+        for f in ("simulation_config.json", "lights.py", "neighbours_tf.py"):
+            shutil.copy(os.path.join(src, f), self.dir)
+        with open(os.path.join(self.dir, "simulation_config.json")) as f:
+            cfg = json.load(f)
+        cfg["SimulationTimeout"] = 30.0
+        for e in cfg["EngineConfigs"]:
+            if e["EngineType"] == "vehicle_agent":
+                e["Map"] = CITY
+        self.write_config(cfg)
+        r = self.run_convoy(timeout=120)
+        self.assertExit(r, 0)
+        last = [line for line in r.stdout.splitlines() if line.startswith("t=")][-1]
+        self.assertIn("t= 30.0 s", last)
+        # Every car reported, and some have finished their routes by then.
+        for i in range(8):
+            self.assertIn("car_%d " % i, last)
+        self.assertIn("(gone)", last)
