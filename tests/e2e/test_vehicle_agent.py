@@ -385,7 +385,7 @@ class Example(AgentCase):
             shutil.copy(os.path.join(src, f), self.dir)
         with open(os.path.join(self.dir, "simulation_config.json")) as f:
             cfg = json.load(f)
-        cfg["SimulationTimeout"] = 30.0
+        cfg["SimulationTimeout"] = 45.0
         for e in cfg["EngineConfigs"]:
             if e["EngineType"] == "vehicle_agent":
                 e["Map"] = CITY
@@ -393,7 +393,7 @@ class Example(AgentCase):
         r = self.run_convoy(timeout=120)
         self.assertExit(r, 0)
         last = [line for line in r.stdout.splitlines() if line.startswith("t=")][-1]
-        self.assertIn("t= 30.0 s", last)
+        self.assertIn("t= 45.0 s", last)
         # Every car reported, and some have finished their routes by then.
         for i in range(8):
             self.assertIn("car_%d " % i, last)
