@@ -212,6 +212,47 @@ std::pair<std::string, int> VehicleAgent::parse_lane(const std::string& key, con
 
 odr::LaneRoute VehicleAgent::pick_route(const json& config, uint64_t seed) const {
   const json& r = config.at("Route");
+  const json& pos = config.at("Position");
+  if (!pos.is_object()) fail("Position", "expected {\"x\": ..., \"y\": ...}");
+  if (!pos.empty()) {
+    // Placed at a world point: on a driving lane there, routed to Route.to.
+    if (!pos.contains("x") || !pos.contains("y") || !pos["x"].is_number() || !pos["y"].is_number())
+      fail("Position", "expected numbers \"x\" and \"y\"");
+    const double x = pos["x"].get<double>(), y = pos["y"].get<double>();
+    std::optional<double> heading;
+    if (pos.contains("yaw")) heading = pos["yaw"].get<double>();
+    char where[96];
+    std::snprintf(where, sizeof where, "(%.2f, %.2f)", x, y);
+    const auto loc = graph_->locate(x, y, heading, 50.0);
+    if (!loc || loc->distance > 0 || !graph_->lane(loc->lane).drivable()) {
+      std::string near = "no road within 50 m";
+      if (loc) {
+        char d[160];
+        std::snprintf(d, sizeof d, "nearest lane %s:%d (%s) %.2f m away", loc->road_id.c_str(),
+                      loc->lane_id, graph_->lane(loc->lane).type.c_str(), loc->distance);
+        near = d;
+      }
+      fail("Position", std::string("placed off-road: ") + where + " is not on a driving lane of " +
+                           net_->source + " (" + near + ")");
+    }
+    if (r.contains("from")) fail("Route.from", "give Route.from or Position, not both");
+    if (!r.contains("to")) fail("Route.to", "needed with Position (where to drive)");
+    const auto [tr, tl] = parse_lane("Route.to", r["to"]);
+    if (!net_->find_road(tr)) fail("Route.to", "road " + tr + " is not in the map " + net_->source);
+    odr::LaneIndex dest = odr::kNoLane;
+    try {
+      dest = graph_->exit_lane(tr, tl);
+    } catch (const std::exception& e) {
+      fail("Route.to", e.what());
+    }
+    const odr::LaneNode& dn = graph_->lane(dest);
+    auto route = graph_->route(loc->lane, loc->s, dest, dn.forward ? dn.s1 : dn.s0);
+    if (!route) {
+      fail("Route", std::string("no route from ") + where + " (" + loc->road_id + ":" +
+                        std::to_string(loc->lane_id) + ") to " + r["to"].get<std::string>());
+    }
+    return *route;
+  }
   if (r.is_object() && (r.contains("from") || r.contains("to"))) {
     if (!r.contains("from") || !r.contains("to")) fail("Route", "give both \"from\" and \"to\"");
     for (const auto& [k, v] : r.items()) {

@@ -294,6 +294,20 @@ class BadInput(AgentCase):
     def test_placed_off_the_route(self):
         self.bad({"StartS": 5000.0}, "StartS", "off its route")
 
+    def test_placed_off_road(self):
+        # 30 m north of the road (its lanes span y = -7 .. 3.5).
+        self.bad({"Route": {"to": "1:-1"}, "Position": {"x": 100.0, "y": 30.0}},
+                 "Position", "off-road", "(100.00, 30.00)")
+
+    def test_placed_on_the_road_by_position(self):
+        out = self.experiment(agent={"Route": {"to": "1:-1"}, "Position": {"x": 100.0, "y": -1.9},
+                                     "InitialSpeed": 10.0, "LaneChanges": False}, timeout=2.0)
+        self.assertExit(self.run_convoy(), 0)
+        cars = [row["car"] for row in self.stream(out) if "car" in row]
+        self.assertAlmostEqual(cars[0]["x"], 100.0, delta=0.5)
+        self.assertAlmostEqual(cars[0]["y"], -1.75, delta=0.01)
+        self.assertGreater(cars[-1]["x"], 115.0)
+
     def test_bad_lane_syntax(self):
         self.bad({"Route": {"from": "main", "to": "1:-1"}}, "Route.from", "ROAD:LANE")
 
