@@ -308,6 +308,12 @@ class BadInput(AgentCase):
         self.assertAlmostEqual(cars[0]["y"], -1.75, delta=0.01)
         self.assertGreater(cars[-1]["x"], 115.0)
 
+    def test_unknown_key_warns_by_name(self):
+        self.experiment(agent={"Politeness": 0.5}, timeout=0.5)  # the key is "politeness"
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        self.assertRegex(r.stderr, r"(?i)warning.*Politeness")
+
     def test_bad_lane_syntax(self):
         self.bad({"Route": {"from": "main", "to": "1:-1"}}, "Route.from", "ROAD:LANE")
 
