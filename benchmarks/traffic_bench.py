@@ -18,6 +18,16 @@ at a 0.1 s step (10 Hz), both with SUMO's seed 42:
     the process (start-up included, as for SUMO alone).
 Prints each side's wall time (median of --runs), the ratio of speeds (target >= 0.8x SUMO
 alone), the peak number of vehicles and vehicle-steps per wall second.
+
+Section "agents": N `vehicle_agent` engines (one process each) on the city map
+(experiments/city_traffic/city.xodr), routes drawn from their seeds, stepping at 100 Hz
+(EngineTimestep 0.01) for --agent-end simulated seconds, with one TF building every agent's
+neighbour view (python/convoy_traffic/neighbours.py, radius 100 m) each step. For N in
+--agents it prints the real-time factor of the loop (summary.json's real_time_factor: simulated
+time / loop wall time, start-up excluded; median of --runs), and last the largest N at >= 1x:
+`participants at real time: N`.
+
+  --sections sumo,agents   which sections to run (default both)
 """
 import argparse
 import json
@@ -171,6 +181,73 @@ def section_sumo(args):
         shutil.rmtree(work, ignore_errors=True)
 
 
+AGENT_TF = textwrap.dedent("""\
+    from nrp_core import *
+    from convoy_traffic.neighbours import neighbour_datapacks
+
+    AGENTS = {agents!r}
+
+    {decorators}
+    @TransceiverFunction({first!r})
+    def neighbours(**states):
+        return neighbour_datapacks(list(states.values()), agents=AGENTS, radius=100.0)
+    """)
+
+
+def agents_run(work, n, end, i, build):
+    exp = os.path.join(work, "agents%d_%d" % (n, i))
+    os.makedirs(exp)
+    names = ["car_%d" % k for k in range(n)]
+    decorators = "\n".join('@EngineDataPack(keyword=%r, id=DataPackIdentifier("state", %r))'
+                           % (a, a) for a in names)
+    with open(os.path.join(exp, "tf.py"), "w") as f:
+        f.write(AGENT_TF.format(agents=names, decorators=decorators, first=names[0]))
+    city = os.path.join(REPO, "experiments", "city_traffic", "city.xodr")
+    engines = [{"EngineType": "vehicle_agent", "EngineName": a, "EngineTimestep": 0.01,
+                "Map": city, "Seed": k, "StartS": float(k % 7) * 12.0, "InitialSpeed": 8.0,
+                "ReactionTime": 0.2} for k, a in enumerate(names)]
+    with open(os.path.join(exp, "simulation_config.json"), "w") as f:
+        json.dump({"SimulationName": "traffic_bench_agents", "SimulationTimeout": end,
+                   "EngineConfigs": engines,
+                   "DataPackProcessingFunctions": [{"Name": "neighbours", "FileName": "tf.py"}]},
+                  f)
+    run_dir = os.path.join(exp, "run")
+    t0 = time.monotonic()
+    run([os.path.join(build, "bin", "convoy"), "run", "-q", "-c",
+         os.path.join(exp, "simulation_config.json"), "--run-dir", run_dir])
+    wall = time.monotonic() - t0
+    with open(os.path.join(run_dir, "summary.json")) as f:
+        summary = json.load(f)
+    shutil.rmtree(exp, ignore_errors=True)
+    return summary["real_time_factor"], wall
+
+
+def section_agents(args):
+    if not os.path.exists(os.path.join(args.build, "bin", "convoy-engine-vehicle_agent")):
+        print("agents: convoy-engine-vehicle_agent is not built")
+        return
+    work = tempfile.mkdtemp(prefix="convoy-trafficbench-agents-")
+    best = 0
+    try:
+        print("agents: vehicle_agent processes at 100 Hz on the city map, neighbour views by one "
+              "TF, %g s simulated, %d run(s) each" % (args.agent_end, args.runs))
+        for n in [int(x) for x in args.agents.split(",")]:
+            rtfs, walls = [], []
+            for i in range(args.runs):
+                rtf, wall = agents_run(work, n, args.agent_end, i, args.build)
+                rtfs.append(rtf)
+                walls.append(wall)
+            rtf = statistics.median(rtfs)
+            print("  N = %3d: real-time factor %.2fx (runs: %s; wall with start-up %.1f s)"
+                  % (n, rtf, ", ".join("%.2f" % r for r in rtfs), statistics.median(walls)),
+                  flush=True)
+            if rtf >= 1.0:
+                best = max(best, n)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print("participants at real time: %d" % best)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -178,8 +255,16 @@ def main():
     ap.add_argument("--end", type=int, default=600, help="simulated seconds")
     ap.add_argument("--grid", type=int, default=10, help="junctions per side of the grid")
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
+    ap.add_argument("--sections", default="sumo,agents")
+    ap.add_argument("--agents", default="8,16,32,64,128", help="agent counts, comma-separated")
+    ap.add_argument("--agent-end", type=float, default=10.0,
+                    help="simulated seconds of each agents run")
     args = ap.parse_args()
-    section_sumo(args)
+    sections = args.sections.split(",")
+    if "sumo" in sections:
+        section_sumo(args)
+    if "agents" in sections:
+        section_agents(args)
 
 
 if __name__ == "__main__":

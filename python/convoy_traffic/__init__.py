@@ -1,0 +1,1 @@
+"""Helpers for road-user experiments, importable in transceiver functions."""

@@ -1,0 +1,117 @@
+"""Each agent's view of its neighbours, built in a transceiver function.
+
+Road users see each other only through their inputs (docs/road_users.md). A TF gathers every
+participant's state (RoadUser datapacks of agents, a RoadUsers datapack of a crowd engine such
+as sumo, or a python_json road user's JSON) and gives each agent the road users within a radius
+of it as a convoy.data.RoadUsers datapack (name "neighbours" by default):
+
+    from convoy_traffic.neighbours import neighbour_datapacks
+
+    @EngineDataPack(keyword="a", id=DataPackIdentifier("state", "car_a"))
+    @EngineDataPack(keyword="b", id=DataPackIdentifier("state", "car_b"))
+    @TransceiverFunction("car_a")
+    def neighbours(a, b):
+        return neighbour_datapacks([a, b], agents=["car_a", "car_b"], radius=100.0)
+
+Users are listed sorted by id, so the view does not depend on the order of the inputs.
+"""
+
+import math
+
+from google.protobuf import json_format
+
+from nrp_core.data.nrp_protobuf import RoadUsersDataPack
+
+_RoadUser = None
+
+
+def _road_user_class():
+    global _RoadUser
+    if _RoadUser is None:
+        from nrp_core.data.nrp_protobuf import RoadUserDataPack
+        _RoadUser = type(RoadUserDataPack("_", "_").data)
+    return _RoadUser
+
+
+def road_users(datapacks):
+    """The RoadUser messages in a list of datapacks (RoadUser, RoadUsers or JSON; empty ones
+    are skipped)."""
+    out = []
+    for dp in datapacks:
+        if dp is None or dp.isEmpty():
+            continue
+        data = dp.data
+        if hasattr(data, "users") and not isinstance(data, dict):
+            out.extend(data.users)
+        elif isinstance(data, dict) or isinstance(data, list):
+            items = data if isinstance(data, list) else data.get("users", [data])
+            for item in items:
+                u = _road_user_class()()
+                json_format.ParseDict(item, u, ignore_unknown_fields=True)
+                out.append(u)
+        else:
+            out.append(data)
+    return out
+
+
+def neighbour_view(me, users, radius=100.0):
+    """Road users (other than `me`, present) whose reference point is within `radius` m of
+    `me`'s, sorted by id."""
+    near = [u for u in users
+            if u.id != me.id and not u.absent
+            and math.hypot(u.x - me.x, u.y - me.y) <= radius]
+    near.sort(key=lambda u: u.id)
+    return near
+
+
+def _varint(n):
+    out = bytearray()
+    while True:
+        b = n & 0x7F
+        n >>= 7
+        if n:
+            out.append(b | 0x80)
+        else:
+            out.append(b)
+            return bytes(out)
+
+
+def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", state_id=None):
+    """One RoadUsers datapack `name` for each engine in `agents`, holding its neighbours among
+    all road users in `datapacks` (the same as neighbour_view). An agent is found by its id
+    (`state_id(engine)` if given, else the engine's name); an agent with no state yet gets an
+    empty view.
+
+    Built for many agents: road users are put in a grid of `radius` cells, so each agent looks
+    at its 3x3 cells only, and each user is serialised once; a view is parsed from the
+    concatenated bytes (field 1 of RoadUsers, repeated) instead of copying messages."""
+    users = [u for u in road_users(datapacks) if not u.absent]
+    users.sort(key=lambda u: u.id)  # views sorted by id
+    by_id = {u.id: i for i, u in enumerate(users)}
+    xs = [u.x for u in users]
+    ys = [u.y for u in users]
+    frames = []
+    grid = {}
+    for i, u in enumerate(users):
+        payload = u.SerializeToString()
+        frames.append(b"\x0a" + _varint(len(payload)) + payload)
+        grid.setdefault((int(xs[i] // radius), int(ys[i] // radius)), []).append(i)
+    r2 = radius * radius
+    out = []
+    for engine in agents:
+        me = by_id.get(state_id(engine) if state_id else engine)
+        dp = RoadUsersDataPack(name, engine)
+        if me is not None:
+            mx, my = xs[me], ys[me]
+            cx, cy = int(mx // radius), int(my // radius)
+            near = []
+            for gx in (cx - 1, cx, cx + 1):
+                for gy in (cy - 1, cy, cy + 1):
+                    for j in grid.get((gx, gy), ()):
+                        if j != me and (xs[j] - mx) ** 2 + (ys[j] - my) ** 2 <= r2:
+                            near.append(j)
+            near.sort()
+            dp.data.ParseFromString(b"".join(frames[j] for j in near))
+            dp.data.time_ns = users[me].time_ns
+        out.append(dp)
+    return out
