@@ -9,14 +9,13 @@
 // messages are read and filled in C++ without passing through Python bytes
 // (python/proto_api.h).
 #include <cstdio>
-#include <optional>
 #include <set>
 
 #include "datapack/nrp.h"
 #include "datapack/registry.h"
 #include "engine/engine.h"
 #include "python/datapack_convert.h"
-#include "python/interpreter.h"
+#include "python/engine_script.h"
 
 namespace convoy::engines {
 namespace {
@@ -35,25 +34,13 @@ class PythonGrpcEngine final : public Engine {
                                              int64_t timestep_ns) override {
     name_ = name;
     read_packages(config);
-    interpreter_.emplace();
-    std::filesystem::path file = config.value("PythonFileName", "");
-    if (file.empty()) throw std::runtime_error("PythonFileName is not set");
-    interpreter_->add_path(file.parent_path());
-    try {
-      py::module_ module = python::load_module_from_file(file);
-      py::object base =
-          py::module_::import("nrp_core.engines.python_grpc").attr("GrpcEngineScript");
-      py::object cls = find_script_class(module, base, file);
-      script_ = cls();
-      script_.attr("_name") = name;
-      script_.attr("_config") = py::module_::import("json").attr("loads")(config.dump());
-      script_.attr("_check_type") = py::cpp_function(
-          [this](const std::string& datapack, py::handle type) { check_type(datapack, type); });
-      script_.attr("initialize")();
-      run_loop_ = script_.attr("runLoop");
-      advance_ = script_.attr("_advanceTime");
-      datapacks_ = script_.attr("_datapacks");
-      types_ = script_.attr("_datapack_types");
+    script_.load(name, config, "nrp_core.engines.python_grpc", "GrpcEngineScript");
+    py::object& script = script_.script();
+    script.attr("_check_type") = py::cpp_function(
+        [this](const std::string& datapack, py::handle type) { check_type(datapack, type); });
+    return script_.initialize([&] {
+      datapacks_ = script.attr("_datapacks");
+      types_ = script.attr("_datapack_types");
       std::vector<engine::DataPackId> ids;
       for (auto item : py::dict(types_)) {
         engine::DataPackId id;
@@ -65,21 +52,10 @@ class PythonGrpcEngine final : public Engine {
         ids.push_back(id);
       }
       return ids;
-    } catch (py::error_already_set& e) {
-      throw std::runtime_error("Python error in " + file.filename().string() +
-                               " during initialize:\n" + python::format_exception(e));
-    }
+    });
   }
 
-  int64_t step(int64_t duration_ns) override {
-    try {
-      advance_(duration_ns);
-      run_loop_(duration_ns);
-      return script_.attr("_time_ns").cast<int64_t>();
-    } catch (py::error_already_set& e) {
-      throw std::runtime_error("Python error in runLoop:\n" + python::format_exception(e));
-    }
-  }
+  int64_t step(int64_t duration_ns) override { return script_.step(duration_ns); }
 
   // A datapack from a transceiver function replaces the engine's message by a new one of the
   // registered class.
@@ -113,12 +89,12 @@ class PythonGrpcEngine final : public Engine {
   }
 
   void reset() override {
-    call("reset");
-    script_.attr("_time_ns") = 0;
+    script_.call("reset");
+    script_.script().attr("_time_ns") = 0;
   }
 
   void shutdown() override {
-    if (script_) call("shutdown");
+    if (script_.loaded()) script_.call("shutdown");
   }
 
  private:
@@ -161,39 +137,9 @@ class PythonGrpcEngine final : public Engine {
     }
   }
 
-  void call(const char* method) {
-    try {
-      script_.attr(method)();
-    } catch (py::error_already_set& e) {
-      throw std::runtime_error(std::string("Python error in ") + method + ":\n" +
-                               python::format_exception(e));
-    }
-  }
-
-  static py::object find_script_class(py::module_& module, py::object& base,
-                                      const std::filesystem::path& file) {
-    if (py::hasattr(module, "Script")) return module.attr("Script");
-    py::object found;
-    py::object issubclass = py::module_::import("builtins").attr("issubclass");
-    py::object isclass = py::module_::import("inspect").attr("isclass");
-    for (auto item : py::dict(module.attr("__dict__"))) {
-      py::handle v = item.second;
-      if (isclass(v).cast<bool>() && !v.is(base) && issubclass(v, base).cast<bool>()) {
-        if (found)
-          throw std::runtime_error(file.string() +
-                                   ": several GrpcEngineScript classes; name one Script");
-        found = py::reinterpret_borrow<py::object>(v);
-      }
-    }
-    if (!found)
-      throw std::runtime_error(file.string() + ": no class Script(GrpcEngineScript) found");
-    return found;
-  }
-
   std::string name_;
   std::set<std::string> packages_, warned_;
-  std::optional<python::Interpreter> interpreter_;
-  py::object script_, run_loop_, advance_;
+  python::EngineScript script_;   // first: its interpreter outlives the objects below
   py::object datapacks_, types_;  // the script's dicts (name -> message / class)
 };
 
