@@ -14,6 +14,18 @@
 //   Programs   {<junction id>: [{Duration, Green: [controller ids], Yellow: [...],
 //              RedYellow: [...]}]}: an explicit program (controllers not named are red)
 //   DataPack   name of the datapack written (default "traffic_lights")
+//   Leader     "self" (default: this engine's programs lead) | "sumo" (SUMO's lights lead)
+//   SumoLightsDataPack  name under which a TF passes the sumo engine's traffic_lights datapack
+//              in (default "sumo_traffic_lights"); it gives the TLS links, and with Leader
+//              "sumo" their states
+//   SumoOutDataPack  name of the datapack for the sumo engine's traffic_lights_in (default
+//              "traffic_lights_in"), written once SUMO's links are known
+//
+// SUMO mapping (netconvert names a junction's TLS after the OpenDRIVE junction id): a TLS link
+// whose incoming lane is on SUMO edge "-R[.s]" carries road R's traffic along s (a signal with
+// orientation "+"), edge "R[.s]" the traffic against s ("-"). Link i of TLS J gets the state of
+// the signal on that road and side switched by one of junction J's controllers (G, y, r, u);
+// a link with no such signal is "O" (off), warned once.
 //
 // Datapacks written:
 //   <DataPack>  JSON {"time_ns", "signals": {<OpenDRIVE signal id>: "red" | "yellow" | "green" |
@@ -21,7 +33,10 @@
 //               Traffic lights (type 1000001) show their controller's state; pedestrian lights
 //               (type 1000002) show "green" while their controller is green, else "red".
 //               Dynamic signals switched by no junction's controller are "off".
-// Datapacks read: none.
+//   <SumoOutDataPack>  JSON {"lights": {<SUMO TLS id>: {"state": "GrGr..."}}} (Leader "self").
+// Datapacks read:
+//   <SumoLightsDataPack>  the sumo engine's traffic_lights JSON ({lights: {<tls>: {state,
+//               links: [{index, from}]}}}).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -75,7 +90,49 @@ struct SignalOut {
   std::string controller;  // empty: no junction's controller switches it
   const JunctionProgram* junction = nullptr;
   bool pedestrian = false;
+  std::string road;         // OpenDRIVE road id
+  std::string orientation;  // "+", "-" or "none"
 };
+
+char sumo_char(const std::string& state) {
+  if (state == "green") return 'G';
+  if (state == "yellow") return 'y';
+  if (state == "red") return 'r';
+  if (state == "red_yellow") return 'u';
+  return 'O';
+}
+
+std::string state_of_sumo(char c) {
+  switch (c) {
+    case 'G':
+    case 'g':
+      return "green";
+    case 'y':
+    case 'Y':
+      return "yellow";
+    case 'r':
+    case 's':
+      return "red";
+    case 'u':
+      return "red_yellow";
+    default:
+      return "off";
+  }
+}
+
+// Road id and side ("+": along s) of a SUMO lane id made by netconvert from OpenDRIVE:
+// "-R.s_i" / "R.s_i" (the ".s" part only for roads of several sections).
+std::pair<std::string, std::string> road_of_sumo_lane(const std::string& lane) {
+  std::string e = lane.substr(0, lane.rfind('_'));
+  std::string side = "-";
+  if (!e.empty() && e[0] == '-') {
+    side = "+";
+    e = e.substr(1);
+  }
+  const auto dot = e.find('.');
+  if (dot != std::string::npos) e = e.substr(0, dot);
+  return {e, side};
+}
 
 class TrafficLightsEngine final : public Engine {
  public:
@@ -84,6 +141,12 @@ class TrafficLightsEngine final : public Engine {
     name_ = name;
     (void)timestep_ns;
     dp_name_ = config.at("DataPack").get<std::string>();
+    sumo_in_ = config.at("SumoLightsDataPack").get<std::string>();
+    sumo_out_ = config.at("SumoOutDataPack").get<std::string>();
+    const std::string leader = config.at("Leader").get<std::string>();
+    if (leader != "self" && leader != "sumo")
+      fail("Leader: expected \"self\" or \"sumo\", got \"" + leader + "\"");
+    sumo_leads_ = leader == "sumo";
     if (!config.contains("Map")) fail("Map: the .xodr is required");
     const std::string map = config.at("Map").get<std::string>();
     try {
@@ -157,6 +220,8 @@ class TrafficLightsEngine final : public Engine {
       SignalOut s;
       s.id = g.signal->id;
       s.pedestrian = g.pedestrian_light;
+      s.road = g.road_id;
+      s.orientation = g.signal->orientation;
       for (const auto& c : g.controllers) {
         auto it = by_controller.find(c);
         if (it != by_controller.end()) {
@@ -170,10 +235,13 @@ class TrafficLightsEngine final : public Engine {
     std::fprintf(stderr, "traffic_lights engine '%s': %zu junctions, %zu signals from %s\n",
                  name.c_str(), junctions_.size(), signals_.size(), map.c_str());
     time_ns_ = 0;
-    std::vector<engine::DataPackId> ids(1);
+    std::vector<engine::DataPackId> ids(sumo_leads_ ? 1 : 2);
     ids[0].set_name(dp_name_);
-    ids[0].set_type(std::string(datapack::kJsonType));
-    ids[0].set_engine_name(name);
+    if (!sumo_leads_) ids[1].set_name(sumo_out_);
+    for (auto& id : ids) {
+      id.set_type(std::string(datapack::kJsonType));
+      id.set_engine_name(name);
+    }
     return ids;
   }
 
@@ -184,42 +252,117 @@ class TrafficLightsEngine final : public Engine {
 
   void set_datapack(const datapack::View& dp) override {
     if (dp.empty()) return;
+    if (dp.id().name() == sumo_in_) {
+      if (!dp.is_json()) fail("datapack '" + sumo_in_ + "': expected JSON");
+      read_sumo(datapack::read_json(dp));
+      return;
+    }
     if (warned_.insert(dp.id().name()).second) {
-      std::fprintf(stderr,
-                   "warning: traffic_lights engine '%s': datapack '%s' ignored (it reads none)\n",
-                   name_.c_str(), dp.id().name().c_str());
+      std::fprintf(
+          stderr, "warning: traffic_lights engine '%s': datapack '%s' ignored (it reads only %s)\n",
+          name_.c_str(), dp.id().name().c_str(), sumo_in_.c_str());
     }
   }
 
   void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
+    if (id.name() == sumo_out_ && !sumo_leads_) {
+      if (tls_links_.empty()) return;
+      const json signals = states();
+      json lights = json::object();
+      for (const auto& [tls, links] : tls_links_) {
+        std::string state(links.size(), 'O');
+        for (size_t i = 0; i < links.size(); ++i) {
+          if (!links[i].empty()) state[i] = sumo_char(signals.at(links[i]).get<std::string>());
+        }
+        lights[tls] = {{"state", state}};
+      }
+      datapack::write_json(out, json{{"lights", std::move(lights)}});
+      return;
+    }
     if (id.name() != dp_name_) return;
-    json signals = json::object();
+    json signals = states();
     json junctions = json::object();
-    std::map<const JunctionProgram*, const Phase*> current;
     for (const auto& p : junctions_) {
-      int64_t t = (time_ns_ - p.offset_ns) % p.cycle_ns;
-      if (t < 0) t += p.cycle_ns;
-      size_t i = 0;
-      while (t >= p.phases[i].duration_ns) t -= p.phases[i++].duration_ns;
-      current[&p] = &p.phases[i];
+      const auto [i, t] = phase_at(p);
       junctions[p.id] = {{"phase", i}, {"remaining_s", (p.phases[i].duration_ns - t) * 1e-9}};
     }
+    json doc{{"time_ns", time_ns_},
+             {"signals", std::move(signals)},
+             {"junctions", std::move(junctions)}};
+    if (sumo_leads_) doc["leader"] = "sumo";
+    datapack::write_json(out, doc);
+  }
+
+  std::pair<size_t, int64_t> phase_at(const JunctionProgram& p) const {
+    int64_t t = (time_ns_ - p.offset_ns) % p.cycle_ns;
+    if (t < 0) t += p.cycle_ns;
+    size_t i = 0;
+    while (t >= p.phases[i].duration_ns) t -= p.phases[i++].duration_ns;
+    return {i, t};
+  }
+
+  // Each signal's state: from the programs, or (Leader "sumo") from SUMO's last lights.
+  json states() const {
+    json signals = json::object();
     for (const auto& s : signals_) {
       if (!s.junction) {
         signals[s.id] = "off";
         continue;
       }
-      const Phase* ph = current.at(s.junction);
-      auto it = ph->lights.find(s.controller);
-      const Light l = it == ph->lights.end() ? Light::kRed : it->second;
-      if (s.pedestrian)
-        signals[s.id] = l == Light::kGreen ? "green" : "red";
-      else
-        signals[s.id] = light_name(l);
+      std::string st = "red";
+      if (sumo_leads_) {
+        auto it = sumo_states_.find(s.id);
+        st = it == sumo_states_.end() ? "off" : it->second;
+      } else {
+        const Phase& ph = s.junction->phases[phase_at(*s.junction).first];
+        auto it = ph.lights.find(s.controller);
+        st = light_name(it == ph.lights.end() ? Light::kRed : it->second);
+      }
+      if (s.pedestrian) st = st == "green" ? "green" : "red";
+      signals[s.id] = st;
     }
-    datapack::write_json(out, json{{"time_ns", time_ns_},
-                                   {"signals", std::move(signals)},
-                                   {"junctions", std::move(junctions)}});
+    return signals;
+  }
+
+  // The OpenDRIVE signal (id) a SUMO TLS link is switched by; empty when none.
+  std::string signal_of_link(const std::string& tls, const std::string& from_lane) {
+    const auto [road, side] = road_of_sumo_lane(from_lane);
+    for (const auto& s : signals_) {
+      if (!s.junction || s.pedestrian || s.junction->id != tls || s.road != road) continue;
+      if (s.orientation == side || s.orientation == "none") return s.id;
+    }
+    if (warned_.insert("link:" + tls + ":" + from_lane).second) {
+      std::fprintf(stderr,
+                   "warning: traffic_lights engine '%s': SUMO TLS '%s' link from '%s' matches "
+                   "no signal of junction '%s' (road %s, orientation %s); it is off\n",
+                   name_.c_str(), tls.c_str(), from_lane.c_str(), tls.c_str(), road.c_str(),
+                   side.c_str());
+    }
+    return {};
+  }
+
+  void read_sumo(const json& j) {
+    const json& lights = j.contains("lights") ? j["lights"] : j;
+    if (!lights.is_object()) fail("datapack '" + sumo_in_ + "': expected {lights: {<tls>: ...}}");
+    for (const auto& [tls, v] : lights.items()) {
+      if (!v.is_object() || !v.contains("links") || !v["links"].is_array())
+        fail("datapack '" + sumo_in_ + "': TLS '" + tls + "' has no links");
+      if (!tls_links_.count(tls)) {
+        std::vector<std::string> links;
+        for (const auto& l : v["links"]) {
+          const size_t i = l.at("index").get<size_t>();
+          if (links.size() <= i) links.resize(i + 1);
+          if (links[i].empty()) links[i] = signal_of_link(tls, l.at("from").get<std::string>());
+        }
+        tls_links_[tls] = std::move(links);
+      }
+      if (!sumo_leads_) continue;
+      const std::string state = v.value("state", "");
+      const auto& links = tls_links_[tls];
+      for (size_t i = 0; i < links.size() && i < state.size(); ++i) {
+        if (!links[i].empty()) sumo_states_[links[i]] = state_of_sumo(state[i]);
+      }
+    }
   }
 
   void reset() override { time_ns_ = 0; }
@@ -272,7 +415,10 @@ class TrafficLightsEngine final : public Engine {
     return out;
   }
 
-  std::string name_, dp_name_;
+  std::string name_, dp_name_, sumo_in_, sumo_out_;
+  bool sumo_leads_ = false;
+  std::map<std::string, std::vector<std::string>> tls_links_;  // TLS -> link index -> signal
+  std::map<std::string, std::string> sumo_states_;             // signal -> state (Leader sumo)
   opendrive::Network net_;
   std::vector<JunctionProgram> junctions_;
   std::vector<SignalOut> signals_;

@@ -10,7 +10,7 @@ import os
 import shutil
 import unittest
 
-from e2e_util import E2ETestCase
+from e2e_util import BIN_DIR, E2ETestCase
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CITY = os.path.join(REPO, "experiments", "city_traffic", "city.xodr")
@@ -111,6 +111,111 @@ class Phases(TrafficLightsCase):
         self.assertEqual(first, second)
 
 
+SUMO_ENGINE = os.path.join(BIN_DIR, "convoy-engine-sumo")
+
+SYNC_TF = """\
+import json
+from nrp_core import *
+from nrp_core.data.nrp_json import JsonDataPack
+
+_out = open({out!r}, "a")
+
+
+@EngineDataPack(keyword="tl", id=DataPackIdentifier("traffic_lights", "lights"))
+@EngineDataPack(keyword="tin", id=DataPackIdentifier("traffic_lights_in", "lights"))
+@EngineDataPack(keyword="st", id=DataPackIdentifier("traffic_lights", "sumo"))
+@TransceiverFunction("lights")
+def sync(tl, tin, st):
+    row = {{}}
+    if not tl.isEmpty():
+        row["lights"] = tl.data
+    if not st.isEmpty():
+        row["sumo"] = st.data
+    _out.write(json.dumps(row, sort_keys=True) + "\\n")
+    _out.flush()
+    out = []
+    if not st.isEmpty():
+        out.append(JsonDataPack("sumo_traffic_lights", "lights", st.data))
+    if not tin.isEmpty():
+        out.append(JsonDataPack("traffic_lights_in", "sumo", tin.data))
+    return out
+"""
+
+
+class Sumo(TrafficLightsCase):
+    """Both directions of the SUMO sync, end to end with the sumo engine on city.xodr."""
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        if not os.access(SUMO_ENGINE, os.X_OK):
+            raise unittest.SkipTest("the sumo engine is not built (SUMO not found)")
+
+    def sync(self, leader, timeout=40.0):
+        shutil.copy(CITY, os.path.join(self.dir, "city.xodr"))
+        out = os.path.join(self.dir, "sync.jsonl")
+        self.write("tf.py", SYNC_TF.format(out=out))
+        self.write_config({
+            "SimulationName": "sync", "SimulationTimeout": timeout,
+            "EngineConfigs": [
+                {"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": 0.5,
+                 "Map": "city.xodr", "Leader": leader, "Green": 6.0, "Yellow": 2.0,
+                 "AllRed": 1.0},
+                {"EngineType": "sumo", "EngineName": "sumo", "EngineTimestep": 0.5,
+                 "OpenDriveFile": "city.xodr", "NetCacheDir": "netcache",
+                 "TrafficLightsLeader": "external" if leader == "self" else "sumo"}],
+            "DataPackProcessingFunctions": [{"Name": "sync", "FileName": "tf.py"}]})
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        rows = self.rows(out)
+        self.assertGreater(len(rows), 50)
+        return rows
+
+    @staticmethod
+    def link_state(sumo, tls, from_edge):
+        light = sumo["lights"][tls]
+        idx = sorted({l["index"] for l in light["links"]
+                      if l["from"].rsplit("_", 1)[0] == from_edge})
+        return {light["state"][i] for i in idx}
+
+    def test_self_leads_sumo(self):
+        rows = self.sync("self")
+        char = {"green": "G", "yellow": "y", "red": "r"}
+        seen, matched = set(), 0
+        # Edge "-1" is road 1 along s into junction 100 (signal 1); "4" road 4 against s
+        # (signal 3). SUMO's state at a step follows the lights sent one or two steps before.
+        for k, row in enumerate(rows):
+            if "sumo" not in row or k < 3:
+                continue
+            for edge, sig in (("-1", "1"), ("4", "3")):
+                states = self.link_state(row["sumo"], "100", edge)
+                self.assertEqual(len(states), 1, (row["sumo"]["time_ns"], edge, states))
+                recent = {char[rows[j]["lights"]["signals"][sig]] for j in range(k - 2, k + 1)}
+                self.assertIn(next(iter(states)), recent, (row["sumo"]["time_ns"], edge))
+                seen.add(next(iter(states)))
+                matched += 1
+        self.assertEqual(seen, {"G", "y", "r"})
+        self.assertGreater(matched, 100)
+
+    def test_sumo_leads(self):
+        rows = self.sync("sumo", timeout=60.0)  # SUMO's own program: 42 s green, 3 s yellow
+        seen = set()
+        for k, row in enumerate(rows[1:], 1):
+            prev = rows[k - 1].get("sumo")
+            if not prev:
+                continue
+            sumo_state = {c.lower() for c in self.link_state(prev, "100", "-1")}
+            mine = row["lights"]["signals"]["1"]
+            self.assertEqual(row["lights"]["leader"], "sumo")
+            if len(sumo_state) == 1:
+                c = next(iter(sumo_state))
+                want = {"g": "green", "y": "yellow", "r": "red", "u": "red_yellow"}[c]
+                self.assertIn(mine, (want, rows[k - 1]["lights"]["signals"]["1"]))
+            seen.add(mine)
+        self.assertIn("green", seen)
+        self.assertIn("red", seen)
+
+
 class BadInput(TrafficLightsCase):
     def check(self, *needles):
         r = self.run_convoy()
@@ -134,6 +239,13 @@ class BadInput(TrafficLightsCase):
     def test_unknown_controller_in_program(self):
         self.experiment(Programs={"100": [{"Duration": 1, "Green": ["2001"]}]})
         self.check("Programs.100[0].Green", "2001")
+
+    def test_bad_leader(self):
+        self.experiment(Leader="carla")
+        r = self.run_convoy()
+        self.assertNotEqual(r.proc.returncode if hasattr(r, "proc") else r.code, 0)
+        self.assertStderrHas(r, "Leader")
+        self.assertNoEngineLeft()
 
     def test_bad_map(self):
         self.experiment()
