@@ -22,10 +22,12 @@ LANE_CHANGE_S = 1.5  # lateral move duration
 
 class Script(EngineScript):
     def initialize(self):
+        # The engine config may override these (extra keys: the coordinator warns that it does
+        # not know them, and passes them on).
         cfg = self._config
         self.target = cfg.get("Target", "car_0")
-        self.x = float(cfg.get("StartX", -240.0))
-        self.speed = float(cfg.get("InitialSpeed", 12.0))
+        self.x = float(cfg.get("StartX", -235.0))
+        self.speed = float(cfg.get("InitialSpeed", 13.0))
         self.cruise = float(cfg.get("CruiseSpeed", 14.0))
         self.y = LANE_Y[-2]
         self.lane = -2
