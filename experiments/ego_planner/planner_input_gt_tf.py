@@ -1,0 +1,24 @@
+"""Ground-truth input of the ego planner: the ego's RoadUser from the world engine and the other
+road users' states (python_json JSON RoadUsers), in the ego's frame, labelled "ground_truth".
+Also poses the road users in the world (actors) and hands the pedestrian the ego's state."""
+from nrp_core import *
+from nrp_core.data.nrp_json import JsonDataPack
+from convoy_traffic.ego_planner import ego_state, objects_from_road_users
+from convoy_traffic.neighbours import road_users
+
+
+@EngineDataPack(keyword='ego', id=DataPackIdentifier('smart_car::road_user', 'gazebo'))
+@EngineDataPack(keyword='ped', id=DataPackIdentifier('state', 'pedestrian'))
+@TransceiverFunction("planner")
+def planner_input(ego, ped):
+    out = []
+    others = road_users([ped])
+    if not ped.isEmpty():
+        out.append(JsonDataPack("road_users", "gazebo", {"users": [dict(ped.data)]}))
+    if ego.isEmpty():
+        return out
+    e = ego_state(ego.data)
+    out.append(JsonDataPack("ego", "pedestrian", e))
+    out.append(JsonDataPack("planner_input", "planner", {
+        "source": "ground_truth", "ego": e, "objects": objects_from_road_users(e, others)}))
+    return out
