@@ -36,10 +36,18 @@ PARAMETERS = {
     "StopMargin": (3.0, 2.0, 20.0),            # m: AEB stops this far before the object
     "LateralMargin": (0.5, 0.0, 5.0),          # m: path corridor = ego half width + this
     "Range": (80.0, 5.0, 500.0),               # m: objects beyond are ignored
+    "MinCrossingSpeed": (0.5, 0.0, 10.0),      # m/s: slower lateral motion predicts no entry
+    "CrossingHorizon": (3.0, 0.0, 20.0),       # s: entries predicted further ahead are ignored
     "CommandSlack": (3.0, 0.1, 20.0),          # m/s: the command stays at most this above the speed
     "TraceRate": (10.0, 0.1, 1000.0),          # Hz of the speed trace in the output JSON
 }
 KEYS = set(PARAMETERS) | {"Input", "Output", "Ego"}
+# The road-user classes (docs/road_users.md) the planner reacts to; scenery (buildings, trees,
+# parked models' other classes) is not in the path's concern. COCO names a detector may give
+# are mapped onto them.
+ROAD_USER_CLASSES = ("car", "truck", "bus", "pedestrian", "cyclist")
+COCO_TO_CLASS = {"person": "pedestrian", "bicycle": "cyclist", "motorcycle": "cyclist"}
+EPISODE_GAP_S = 2.0  # a pedestrian stop episode ends when none was ahead for this long
 
 
 class PlannerConfigError(ValueError):
@@ -145,6 +153,7 @@ def objects_from_detections(detections, depth, width, height, hfov, cam_x=0.0, c
         lat = -(u - width / 2.0) / f * z
         w = (x1 - x0) / f * z
         cls = str(d.get("class", "unknown"))
+        cls = COCO_TO_CLASS.get(cls, cls)
         length = 0.5 if cls in ("pedestrian", "person", "cyclist") else 1.0
         out.append({"id": "%s#%d" % (cls, i), "class": cls,
                     "lon": cam_x + z + length / 2, "lat": cam_y + lat,
@@ -201,7 +210,7 @@ class Planner:
         self.p = params
         self.v_cmd = None
         self.stop_events = []       # ego stopped / AEB-braked because of a pedestrian
-        self._armed = {}            # pedestrian id -> counted already in this approach
+        self._episode_last = None   # last time a pedestrian led in the current stop episode
         self.min_ped_distance = None
         self.min_ped_distance_stopped = None
         self.min_gap = None
@@ -225,12 +234,12 @@ class Planner:
         if clearance <= 0:
             return True, gap
         toward = -o["v_lat"] if lat > 0 else o["v_lat"]
-        if toward <= 0.05:
+        if toward < max(p["MinCrossingSpeed"], 0.01):
             return False, gap
-        # it enters the corridor before the ego has passed it (1 s of slack)
+        # it enters the corridor soon, and before the ego has passed it (1 s of slack)
         t_enter = clearance / toward
         closing = max(ego["speed"] - o["v_lon"], 0.1)
-        return t_enter <= max(gap, 0.0) / closing + 1.0, gap
+        return t_enter <= min(p["CrossingHorizon"], max(gap, 0.0) / closing + 1.0), gap
 
     def step(self, t, ego, objects):
         p = self.p
@@ -239,6 +248,8 @@ class Planner:
             self.v_cmd = v
         lead, lead_gap = None, None
         for o in objects:
+            if o["class"] not in ROAD_USER_CLASSES:
+                continue
             ok, gap = self.in_path(ego, o)
             if ok and (lead_gap is None or gap < lead_gap):
                 lead, lead_gap = o, gap
@@ -282,11 +293,17 @@ class Planner:
         self.v_cmd = max(cmd, 0.0)
         if lead is not None:
             self.min_gap = lead_gap if self.min_gap is None else min(self.min_gap, lead_gap)
-        # pedestrian stop events: counted once per pedestrian and approach
+        # pedestrian stop events: one per episode (the ego stopped or AEB-braked with a
+        # pedestrian as the object it reacts to; the episode ends when no pedestrian has led
+        # for EPISODE_GAP_S, so track ids changing under a detector do not count twice)
         if lead is not None and lead["class"] == "pedestrian":
             stopped = v < 0.1
-            if (aeb or stopped) and not self._armed.get(lead["id"]):
-                self._armed[lead["id"]] = True
+            in_episode = (self._episode_last is not None
+                          and t - self._episode_last <= EPISODE_GAP_S)
+            if in_episode:
+                self._episode_last = t
+            elif aeb or stopped:
+                self._episode_last = t
                 self.stop_events.append({"t": round(t, 3), "pedestrian": lead["id"],
                                          "reason": "aeb" if aeb else "stopped",
                                          "gap_m": round(lead_gap, 3), "speed_mps": round(v, 3)})
@@ -294,10 +311,6 @@ class Planner:
                 d = lead_gap
                 if self.min_ped_distance_stopped is None or d < self.min_ped_distance_stopped:
                     self.min_ped_distance_stopped = d
-        for pid in list(self._armed):
-            if lead is None or lead["id"] != pid:
-                if v > 2.0:
-                    self._armed.pop(pid)  # passed or gone: a later approach counts again
         if self._prev_speed is not None and dt > 0:
             self.max_decel = max(self.max_decel, (self._prev_speed - v) / dt)
         self._prev_speed = v
