@@ -52,6 +52,8 @@ class Script(EngineScript):
         self._setDataPack("target", out)
 
     def shutdown(self):
+        if not hasattr(self, "planner"):
+            return  # initialize failed: its error is the message
         res = self.planner.result()
         with open(os.path.join(self.run_dir, self.params["Output"]), "w") as f:
             json.dump(res, f, indent=1, sort_keys=True)

@@ -41,7 +41,7 @@ PARAMETERS = {
     "CommandSlack": (3.0, 0.1, 20.0),          # m/s: the command stays at most this above the speed
     "TraceRate": (10.0, 0.1, 1000.0),          # Hz of the speed trace in the output JSON
 }
-KEYS = set(PARAMETERS) | {"Input", "Output", "Ego"}
+KEYS = set(PARAMETERS) | {"Input", "Output"}
 # The road-user classes (docs/road_users.md) the planner reacts to; scenery (buildings, trees,
 # parked models' other classes) is not in the path's concern. COCO names a detector may give
 # are mapped onto them.
@@ -71,9 +71,6 @@ def parse_config(cfg, engine="ego_planner"):
     out["Output"] = cfg.get("Output", "ego_planner.json")
     if not isinstance(out["Output"], str) or not out["Output"]:
         raise PlannerConfigError("%s: key 'Output': expected a file name" % engine)
-    out["Ego"] = cfg.get("Ego", "smart_car")
-    if not isinstance(out["Ego"], str) or not out["Ego"]:
-        raise PlannerConfigError("%s: key 'Ego': expected a model name" % engine)
     for k, (default, lo, hi) in PARAMETERS.items():
         v = cfg.get(k, default)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
