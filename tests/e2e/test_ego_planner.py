@@ -10,6 +10,8 @@ PID waypoint follower on the Parkring.
 - Detections: the same pedestrian scene with the planner's detection input. The detector's
   only backend shipped without a trained model is its ground-truth passthrough (the camera's
   ground-truth boxes): what is tested is the path boxes -> depth ranging -> tracker -> planner.
+- Logic (no simulation): frames, ranging, crossing prediction, episode counting, and a
+  stop from 30 km/h against an ideal first-order car.
 - Bad input: an unknown input source, a bad parameter, an unknown key, and an input TF that
   does not match the configured source each end with a message naming the engine and key,
   and a non-zero exit.
@@ -18,12 +20,17 @@ Ground-truth distances come from the road user's own record (pedestrian.json, le
 the ego's front to the road user along the ego's axis, from the world engine's RoadUser."""
 
 import json
+import math
 import os
 import subprocess
+import sys
 import tempfile
 import unittest
 
 from e2e_util import CONVOY, REPO
+
+sys.path.insert(0, os.path.join(REPO, "python"))
+from convoy_traffic import ego_planner as ep  # noqa: E402
 
 EXAMPLE = os.path.join(REPO, "experiments", "ego_planner")
 
@@ -64,6 +71,103 @@ def load(run_dir, name):
 def planner_params(name):
     with open(os.path.join(EXAMPLE, name)) as f:
         return json.load(f)
+
+
+EGO = {"id": "ego", "x": 0.0, "y": 0.0, "yaw": 0.0, "speed": 30 / 3.6, "yaw_rate": 0.0,
+       "length": 4.0, "width": 1.8, "length_offset": 0.0}
+
+
+def ped(lat, v_lat=0.0, lon=32.25, pid="p"):
+    return {"id": pid, "class": "pedestrian", "lon": lon, "lat": lat, "length": 0.5,
+            "width": 0.5, "v_lon": 0.0, "v_lat": v_lat, "source": "ground_truth"}
+
+
+class Logic(unittest.TestCase):
+    def params(self, **kw):
+        return ep.parse_config(dict({"Input": "ground_truth"}, **kw))
+
+    def test_road_users_in_the_ego_frame(self):
+        ego = dict(EGO, x=5.0, y=5.0, yaw=math.pi / 2)
+        objs = ep.objects_from_road_users(ego, [
+            {"id": "ego", "x": 5.0, "y": 5.0},  # itself: skipped
+            {"id": "a", "category": "car", "x": 5.0, "y": 15.0, "yaw": math.pi / 2,
+             "speed": 3.0, "length": 4.5, "width": 1.8, "length_offset": 1.0},
+            {"id": "b", "category": "pedestrian", "x": 3.0, "y": 5.0, "absent": True}])
+        self.assertEqual([o["id"] for o in objs], ["a"])
+        a = objs[0]
+        self.assertAlmostEqual(a["lon"], 11.0)
+        self.assertAlmostEqual(a["lat"], 0.0)
+        self.assertAlmostEqual(a["v_lon"], 3.0)
+        self.assertAlmostEqual(a["length"], 4.5)
+        self.assertEqual(a["source"], "ground_truth")
+
+    def test_detections_ranged_in_depth(self):
+        import numpy as np
+        w, h, hfov = 200, 100, math.pi / 2  # f = 100 px
+        depth = np.full((h, w), 50.0, np.float32)
+        depth[40:80, 140:160] = 10.0  # a person right of centre
+        dets = [{"class": "person", "x_min": 140, "x_max": 160, "y_min": 40, "y_max": 80},
+                {"class": "car", "x_min": 0, "x_max": 0, "y_min": 0, "y_max": 5}]  # empty
+        objs = ep.objects_from_detections(dets, depth, w, h, hfov, cam_x=0.5)
+        self.assertEqual(len(objs), 1)
+        o = objs[0]
+        self.assertEqual(o["class"], "pedestrian")
+        self.assertAlmostEqual(o["lon"], 0.5 + 10.0 + 0.25)
+        self.assertAlmostEqual(o["lat"], -(150 - 100) / 100 * 10.0)
+        self.assertAlmostEqual(o["width"], 2.0)
+        # the tracker turns a moving box into a velocity (ego standing)
+        tr = ep.Tracker(alpha=1.0)
+        tr.update([dict(o)], 0.0, 0.0)
+        moved = tr.update([dict(o, lat=o["lat"] + 0.15)], 0.1, 0.0)
+        self.assertAlmostEqual(moved[0]["v_lat"], 1.5)
+        self.assertEqual(moved[0]["id"], "track0")
+
+    def test_crossing_prediction(self):
+        pl = ep.Planner(self.params())
+        self.assertTrue(pl.in_path(EGO, ped(0.5))[0])
+        self.assertTrue(pl.in_path(EGO, ped(-2.3, 1.5))[0])     # stepping in
+        self.assertFalse(pl.in_path(EGO, ped(-2.3, -1.5))[0])   # stepping away
+        self.assertFalse(pl.in_path(EGO, ped(-2.3, 0.3))[0])    # below MinCrossingSpeed
+        self.assertFalse(pl.in_path(EGO, ped(-9.0, 1.5))[0])    # enters after 4.9 s
+        self.assertFalse(pl.in_path(EGO, ped(0.0, lon=-3.0))[0])  # behind
+
+    def stop(self, objects_at, lag=0.55, t_end=15.0):
+        """An ideal first-order car (time constant `lag`) at 30 km/h under the planner."""
+        pl = ep.Planner(self.params())
+        v, x, t, dt = 30 / 3.6, 0.0, 0.0, 0.02
+        gaps = []
+        while t < t_end:
+            ego = dict(EGO, x=x, speed=v)
+            objs = [dict(o, lon=o["lon"] - x) for o in objects_at(t)]
+            cmd = pl.step(t, ego, objs)["speed"]
+            v = max(0.0, v + (cmd - v) * dt / lag)
+            x += v * dt
+            t += dt
+            gaps.extend(o["lon"] - 0.25 - 2.0 for o in objs)
+        return pl, v, min(gaps)
+
+    def test_stops_2_m_before_a_pedestrian_30_m_ahead(self):
+        pl, v, gap = self.stop(lambda t: [ped(0.0, lon=32.25)])
+        self.assertLess(v, 0.05)
+        self.assertGreaterEqual(gap, 2.0)
+        res = pl.result()
+        self.assertEqual(res["ego_stops_for_pedestrians"], 1)
+        self.assertTrue(res["ground_truth"])
+
+    def test_one_event_per_episode_even_when_track_ids_change(self):
+        pl, v, gap = self.stop(lambda t: [ped(0.0, lon=32.25, pid="track%d" % int(t * 3))])
+        self.assertEqual(pl.result()["ego_stops_for_pedestrians"], 1)
+
+    def test_config_errors_name_the_key(self):
+        for cfg, needle in (({"Input": "radar"}, "key 'Input'"),
+                            ({"StopMargin": 1.5}, "key 'StopMargin'"),
+                            ({"TimeGap": True}, "key 'TimeGap'"),
+                            ({"Bogus": 1}, "unknown key 'Bogus'"),
+                            ({"Output": ""}, "key 'Output'")):
+            with self.assertRaises(ep.PlannerConfigError) as cm:
+                ep.parse_config(cfg, engine="engine 'planner'")
+            self.assertIn("engine 'planner'", str(cm.exception))
+            self.assertIn(needle, str(cm.exception))
 
 
 class Pedestrian(unittest.TestCase):
