@@ -402,5 +402,101 @@ class BadInput(PedCase):
         self.bad({"Map": "broken.xodr"}, "Map", "broken.xodr")
 
 
+# A pedestrian that ignores traffic: walks across road 2 at x = 100 along +y at 1.3 m/s from
+# y = -8.25 from the start.
+WALKER = """\
+from nrp_core.engines.python_json import EngineScript
+
+
+class Script(EngineScript):
+    def initialize(self):
+        self._registerDataPack("state")
+        self._publish()
+
+    def runLoop(self, timestep_ns):
+        self._publish()
+
+    def _publish(self):
+        t = self._time_ns * 1e-9
+        y = min(-8.25 + 1.3 * t, 8.25)
+        self._setDataPack("state", {"id": "walker", "category": "pedestrian", "model": "walker",
+                                    "x": 100.0, "y": y, "yaw": 1.5708, "speed": 1.3,
+                                    "length": 0.5, "width": 0.6, "time_ns": self._time_ns})
+"""
+
+CAR_TF = """\
+import json
+from nrp_core import *
+from convoy_traffic.neighbours import neighbour_datapacks, road_users
+
+_out = open({out!r}, "a")
+
+
+@EngineDataPack(keyword="car", id=DataPackIdentifier("state", "car"))
+@EngineDataPack(keyword="walker", id=DataPackIdentifier("state", "walker"))
+@TransceiverFunction("car")
+def neighbours(car, walker):
+    users = road_users([car, walker])
+    _out.write(json.dumps({{u.id: dict(x=u.x, y=u.y, speed=u.speed, absent=u.absent)
+                           for u in users}}) + "\\n")
+    _out.flush()
+    return neighbour_datapacks([car, walker], agents=["car"], radius=150.0)
+"""
+
+
+class VehicleReacts(PedCase):
+    def test_a_vehicle_agent_brakes_for_a_pedestrian_on_its_lane(self):
+        # The vehicle_agent drives road 2's lane 1 along -x from x = 186 at 10 m/s; the walker
+        # is in its path from t = 6.7 s to 8.7 s, when the car would pass x = 100 at 8.2 s.
+        out = os.path.join(self.dir, "stream.jsonl")
+        self.write("walker.py", WALKER)
+        self.write("tf.py", CAR_TF.format(out=out))
+        self.write_config({"SimulationName": "react", "SimulationTimeout": 20.0,
+                           "EngineConfigs": [
+                               {"EngineType": "vehicle_agent", "EngineName": "car",
+                                "EngineTimestep": 0.05, "Map": CITY,
+                                "Route": {"from": "2:1", "to": "2:1"}, "InitialSpeed": 10.0,
+                                "v0": 10.0, "LaneChanges": False},
+                               {"EngineType": "python_json", "EngineName": "walker",
+                                "PythonFileName": "walker.py", "EngineTimestep": 0.05}],
+                           "DataPackProcessingFunctions": [{"Name": "n", "FileName": "tf.py"}]})
+        rows = [r for r in self.run_ok(out) if "car" in r and "walker" in r]
+        # Along -x the car's front is 3.6 m ahead of its reference point.
+        gaps = [r["car"]["x"] - 3.6 - r["walker"]["x"] for r in rows
+                if -0.5 < r["walker"]["y"] < 4.0 and r["car"]["x"] > r["walker"]["x"]]
+        self.assertTrue(gaps)
+        self.assertGreater(min(gaps), 1.0, "it stopped short of the pedestrian")
+        self.assertLess(min(r["car"]["speed"] for r in rows), 5.0, "it braked")
+        self.assertLess(rows[-1]["car"]["x"], 90.0, "it went on once the lane was clear")
+
+
+class Example(PedCase):
+    def test_the_example_runs(self):
+        root = os.path.dirname(os.path.dirname(CITY))
+        ex = os.path.join(root, "pedestrians")
+        for name in ("simulation_config.json", "neighbours_tf.py"):
+            with open(os.path.join(ex, name)) as f:
+                text = f.read()
+            self.write(name, text.replace("../city_traffic/city.xodr", CITY))
+        r = self.run_convoy(timeout=120)
+        self.assertExit(r, 0)
+        rows = []
+        with open(os.path.join(self.dir, "tracks.jsonl")) as f:
+            rows = [json.loads(line) for line in f]
+        self.assertGreater(len(rows), 1000)
+        last = rows[-1]["users"]
+        self.assertEqual(sum(1 for k in last if k.startswith("ped_")), 6)
+        # Three of them crossed and left; none came within 2 m of a car's reference point.
+        self.assertGreaterEqual(sum(1 for k, u in last.items() if k.startswith("ped_") and u[3]),
+                                3)
+        for row in rows:
+            u = row["users"]
+            for c in ("car_0", "car_1"):
+                for p in u:
+                    if p.startswith("ped_") and not u[p][3] and c in u and not u[c][3]:
+                        d = ((u[c][0] - u[p][0]) ** 2 + (u[c][1] - u[p][1]) ** 2) ** 0.5
+                        self.assertGreater(d, 2.0, (row["t"], c, p))
+
+
 if __name__ == "__main__":
     unittest.main()
