@@ -123,6 +123,30 @@ NO_CROSSWALK = """<?xml version="1.0" encoding="UTF-8"?>
 """
 
 
+# The same road with a crosswalk at s = 50 and its pedestrian light "p1" (type 1000002), and a
+# vehicle light "v1" (type 1000001) at s = 45.
+PED_LIGHT = NO_CROSSWALK.replace("""    </lanes>
+  </road>""", """    </lanes>
+    <objects>
+      <object type="crosswalk" id="cw1" name="crosswalk" s="50" t="0" zOffset="0" hdg="0"
+              orientation="none" length="3" width="7" height="0">
+        <outline>
+          <cornerRoad s="48.5" t="-3.5" dz="0" height="0"/>
+          <cornerRoad s="51.5" t="-3.5" dz="0" height="0"/>
+          <cornerRoad s="51.5" t="3.5" dz="0" height="0"/>
+          <cornerRoad s="48.5" t="3.5" dz="0" height="0"/>
+        </outline>
+      </object>
+    </objects>
+    <signals>
+      <signal s="50" t="-4.5" id="p1" name="ped" dynamic="yes" orientation="+" zOffset="2"
+              country="OpenDRIVE" type="1000002" subtype="-1" value="-1"/>
+      <signal s="45" t="-4.5" id="v1" name="car" dynamic="yes" orientation="+" zOffset="2.5"
+              country="OpenDRIVE" type="1000001" subtype="-1" value="-1"/>
+    </signals>
+  </road>""")
+
+
 def on_road(u):
     return u["road"] == "2" and u["lane"] in (-2, -1, 1, 2)
 
@@ -251,6 +275,19 @@ class Lights(PedCase):
         self.assertGreaterEqual(first["ped"]["time_ns"], 12e9)
         self.assertLess(first["ped"]["time_ns"], 13e9, "it went as soon as it could")
         self.assertEqual(rows[-1]["ped"]["lane"], 3)
+
+    def test_a_pedestrian_light_rules_where_there_is_one(self):
+        # The vehicle light is red all along (would let it go); it waits for its own green.
+        self.write("pl.xodr", PED_LIGHT)
+        out = self.experiment(ped={"Map": "pl.xodr", "Route": {"crosswalk": "cw1"}},
+                              program=[(0.0, {"p1": "red", "v1": "red"}),
+                                       (10.0, {"p1": "green", "v1": "red"})], timeout=20.0)
+        rows = [r["ped"] for r in self.run_ok(out) if "ped" in r]
+        first = next(u for u in rows if u["lane"] in (-1, 1))
+        self.assertGreaterEqual(first["time_ns"], 10e9)
+        self.assertLess(first["time_ns"], 11e9)
+        self.assertTrue([u for u in rows if abs(u["speed"]) < 1e-9 and 0 < u["time_ns"] < 10e9])
+        self.assertEqual(rows[-1]["lane"], 2)
 
     def test_yellow_is_not_red(self):
         out = self.experiment(program=[(0.0, {"2": "yellow"}), (9.0, {"2": "red"})],
