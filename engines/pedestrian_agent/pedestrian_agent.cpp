@@ -14,8 +14,9 @@
 //   - and every approaching vehicle's time-to-arrival at its crossing line (the vehicle's front
 //     along its heading, at its speed) is at least its critical gap.
 // While crossing it stops before the next vehicle's lane when a moving vehicle's front is
-// within StopDistance of the crossing, and steps back out of the lane it is in when one is
-// within StepBackDistance. Speed (N(Speed, SpeedSd)) and critical gap (N(CriticalGap,
+// within StopDistance of the crossing (or would arrive before it has crossed that lane), and
+// steps back out of the lane it is in when one is within StepBackDistance (or would arrive
+// before it could clear the lane forwards, and backing out is shorter). Speed (N(Speed, SpeedSd)) and critical gap (N(CriticalGap,
 // CriticalGapSd)) differ per pedestrian, drawn from Seed, as are the mid-block choice and a
 // route when none is given. Deterministic: no wall clock, no other randomness.
 //
@@ -614,8 +615,11 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
         if (!over && t.speed < 0.5) continue;  // standing before the line
         const double lo = t.u - t.half_width - 0.5, hi = t.u + t.half_width + 0.5;
         if (my_u > lo && my_u < hi) {
-          if (!over && t.front < step_back_distance_)
-            limit = std::min(limit, c.start + lo - 0.2);  // back out of its lane
+          // In its lane: back out when the vehicle is within StepBackDistance, or when it
+          // would arrive before it could clear the lane forwards and backing out is shorter.
+          const double t_fwd = (hi - my_u) / v_des, t_back = (my_u - lo) / v_des;
+          if (!over && (t.front < step_back_distance_ || (t.tta < t_fwd + 0.5 && t_back < t_fwd)))
+            limit = std::min(limit, c.start + lo - 0.2);
         } else if (my_u <= lo && lo - my_u < 1.5 &&
                    (over || t.front < stop_distance_ || t.tta < (hi - my_u) / v_des + 1.0)) {
           limit = std::min(limit, std::max(arc_, c.start + lo - 0.2));  // wait before it

@@ -265,6 +265,23 @@ class GapAcceptance(PedCase):
                         "it stopped at the lane's edge")
         self.assertGreater(ys[-1], 7.0, "it crossed in the end")
 
+    def test_steps_back_when_a_car_appears_while_it_is_in_the_lane(self):
+        # It sees only 12 m around it; a car at 8 m/s on lane 2 (y = 5.25) reaches the crossing
+        # at 16 s and comes into view at about 15 s, when it has just entered lane 2's band.
+        out = self.experiment(ped={"CriticalGap": 3.0, "NeighbourRadius": 12.0},
+                              cars=[("slow", CROSS_X + CAR_FRONT + 8.0 * 16.0, 5.25,
+                                     3.141592653589793, 8.0)], timeout=22.0)
+        rows = [r for r in self.run_ok(out) if "ped" in r and "slow" in r]
+        backs = [r for r in rows if r["ped"]["speed"] < -1e-9]
+        self.assertTrue(backs, "it did not step back")
+        self.assertTrue(all(on_road(r["ped"]) and r["ped"]["y"] > 3.0 for r in backs))
+        passing = [r for r in rows if r["slow"]["x"] - CAR_FRONT - 0.5 < r["ped"]["x"] <
+                   r["slow"]["x"] + 0.9 + 0.5]
+        self.assertTrue(passing)
+        for r in passing:  # no contact with the car's side (y = 4.35)
+            self.assertLess(r["ped"]["y"] + 0.3, 4.35, r)
+        self.assertGreater(rows[-1]["ped"]["y"], 7.0, "it crossed in the end")
+
 
 class Lights(PedCase):
     def test_waits_while_the_crossed_road_has_green_and_crosses_on_red(self):
