@@ -16,9 +16,10 @@
 // While crossing it stops before the next vehicle's lane when a moving vehicle's front is
 // within StopDistance of the crossing (or would arrive before it has crossed that lane), and
 // steps back out of the lane it is in when one is within StepBackDistance (or would arrive
-// before it could clear the lane forwards, and backing out is shorter). Speed (N(Speed, SpeedSd)) and critical gap (N(CriticalGap,
-// CriticalGapSd)) differ per pedestrian, drawn from Seed, as are the mid-block choice and a
-// route when none is given. Deterministic: no wall clock, no other randomness.
+// before it could clear the lane forwards, and backing out is shorter). Speed (N(Speed, SpeedSd))
+// and critical gap (N(CriticalGap, CriticalGapSd)) differ per pedestrian, drawn from Seed, as are
+// the mid-block choice and a route when none is given. Deterministic: no wall clock, no other
+// randomness.
 //
 // Datapacks written:
 //   <StateDataPack> ("state")  convoy.data.RoadUser, category "pedestrian", walk_phase
