@@ -534,6 +534,7 @@ class Example(PedCase):
             self.write(name, text.replace("../city_traffic/city.xodr", CITY))
         r = self.run_convoy(timeout=120)
         self.assertExit(r, 0)
+        self.assertNotRegex(r.stderr, r"(?i)warning", "every key of the example is known")
         rows = []
         with open(os.path.join(self.dir, "tracks.jsonl")) as f:
             rows = [json.loads(line) for line in f]
