@@ -158,6 +158,21 @@ class Logic(unittest.TestCase):
         pl, v, gap = self.stop(lambda t: [ped(0.0, lon=32.25, pid="track%d" % int(t * 3))])
         self.assertEqual(pl.result()["ego_stops_for_pedestrians"], 1)
 
+    def test_aeb_when_the_car_ahead_brakes_hard(self):
+        # following at 30 km/h, 10 m (bumper to bumper) behind a car that brakes at 8 m/s^2 to a stop at t = 1
+        def car(t):
+            tb = min(max(t - 1.0, 0.0), 30 / 3.6 / 8.0)
+            s = 14.25 + 30 / 3.6 * min(t, 1.0) + 30 / 3.6 * tb - 4.0 * tb * tb
+            v = 30 / 3.6 - 8.0 * tb if t >= 1.0 else 30 / 3.6
+            return [{"id": "car", "class": "car", "lon": s, "lat": 0.0, "length": 4.5,
+                     "width": 1.8, "v_lon": v, "v_lat": 0.0, "source": "ground_truth"}]
+        pl, v, _ = self.stop(car, t_end=12.0)
+        self.assertLess(v, 0.05)
+        modes = [p["mode"] for p in pl.trace]
+        self.assertIn("aeb", modes)
+        self.assertGreaterEqual(pl.min_gap, 2.0)
+        self.assertEqual(pl.result()["ego_stops_for_pedestrians"], 0)
+
     def test_config_errors_name_the_key(self):
         for cfg, needle in (({"Input": "radar"}, "key 'Input'"),
                             ({"StopMargin": 1.5}, "key 'StopMargin'"),
