@@ -1,0 +1,61 @@
+"""The ego's longitudinal planner as a python_json engine (docs/architecture.md, "Ego planner").
+
+Reads `planner_input` ({"source", "ego": RoadUser dict, "objects": [...]}, built by
+planner_input_gt_tf.py or planner_input_det_tf.py) and publishes `target`
+({"speed", "mode", "lead", "gap_m", "ttc_s"}): the target speed that motor_tf.py applies to
+the report's PID waypoint follower. The parameters come from a JSON file: the environment's
+CONVOY_EGO_PLANNER_CONFIG (set it with EngineEnvParams), default ego_planner.json, relative to
+this script's folder. At shutdown it writes its result (ego_stops_for_pedestrians, distances,
+speed trace) to $CONVOY_RUN_DIR/<Output>.
+"""
+import json
+import os
+
+from nrp_core.engines.python_json import EngineScript
+
+from convoy_traffic.ego_planner import Planner, parse_config, SOURCE_LABELS
+
+
+class Script(EngineScript):
+    def initialize(self):
+        name = os.environ.get("CONVOY_EGO_PLANNER_CONFIG", "ego_planner.json")
+        path = name if os.path.isabs(name) else os.path.join(os.path.dirname(os.path.abspath(__file__)), name)
+        engine = "engine '%s' (ego planner)" % self._name
+        try:
+            with open(path) as f:
+                cfg = json.load(f)
+        except OSError as e:
+            raise RuntimeError("%s: cannot read its config %s: %s" % (engine, path, e.strerror))
+        except ValueError as e:
+            raise RuntimeError("%s: %s is not valid JSON: %s" % (engine, path, e))
+        self.params = parse_config(cfg, engine="%s, %s" % (engine, path))
+        self.planner = Planner(self.params)
+        self.engine = engine
+        self.run_dir = os.environ.get("CONVOY_RUN_DIR", ".")
+        self._registerDataPack("planner_input")
+        self._registerDataPack("target")
+        self._setDataPack("target", {"speed": 0.0, "mode": "wait", "lead": None, "gap_m": None,
+                                     "ttc_s": None, "input": self.params["Input"]})
+        print("%s: input %s (%s)" % (engine, self.params["Input"], SOURCE_LABELS[self.params["Input"]]),
+              flush=True)
+
+    def runLoop(self, timestep_ns):
+        d = self._getDataPack("planner_input")
+        if not d or "ego" not in d:
+            return
+        if d.get("source") != self.params["Input"]:
+            raise RuntimeError("%s: key 'Input' is %r but its input TF sends %r objects; list the "
+                               "matching planner_input TF" % (self.engine, self.params["Input"],
+                                                             d.get("source")))
+        out = self.planner.step(self._time_ns * 1e-9, d["ego"], d.get("objects", []))
+        out["input"] = self.params["Input"]
+        self._setDataPack("target", out)
+
+    def shutdown(self):
+        if not hasattr(self, "planner"):
+            return  # initialize failed: its error is the message
+        res = self.planner.result()
+        with open(os.path.join(self.run_dir, self.params["Output"]), "w") as f:
+            json.dump(res, f, indent=1, sort_keys=True)
+        print("%s: ego_stops_for_pedestrians %d (input: %s)" % (
+            self.engine, res["ego_stops_for_pedestrians"], res["input_label"]), flush=True)
