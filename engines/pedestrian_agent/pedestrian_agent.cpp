@@ -59,6 +59,8 @@ namespace {
 constexpr double kSampleDs = 0.25;    // m between the path's poses
 constexpr double kCurbWait = 0.3;     // m before the road's edge where it waits
 constexpr double kSignalNear = 12.0;  // m along the road: a signal belongs to a crosswalk
+constexpr double kKeepRight = 0.55;   // m right of its path's centre line: walkers pass
+constexpr double kFollowGap = 1.0;    // m: closer than this behind a walker, it keeps its pace
 
 struct Crossing {
   std::string road_id, crosswalk;  // crosswalk id, empty mid-block
@@ -157,6 +159,7 @@ class PedestrianAgent final : public Engine {
     double speed = 0;
   };
   std::vector<Threat> threats(const Crossing& c) const;
+  double walker_ahead_speed(double v) const;
 
   std::string name_;
   std::unique_ptr<odr::Network> net_;
@@ -499,8 +502,8 @@ void PedestrianAgent::start() {
   arc_ = 0;
   v_ = acc_ = walked_ = yaw_rate_ = 0;
   const odr::Pose2 p = path_.at(0);
-  x_ = p.x;
-  y_ = p.y;
+  x_ = p.x + kKeepRight * std::sin(p.heading);
+  y_ = p.y - kKeepRight * std::cos(p.heading);
   yaw_ = p.heading;
   committed_ = SIZE_MAX;
   absent_ = false;
@@ -545,6 +548,23 @@ bool PedestrianAgent::lights_allow(const Crossing& c) {
     if (st != "red") return false;  // the traffic it crosses may move
   }
   return true;
+}
+
+// The pace it may walk at with other walkers ahead: one in its way (within its body's width
+// of its line, going its way or standing) closer than kFollowGap is not overtaken.
+double PedestrianAgent::walker_ahead_speed(double v) const {
+  if (!neighbours_) return v;
+  const double c = std::cos(yaw_), s = std::sin(yaw_);
+  for (const auto& u : neighbours_->users()) {
+    if (u.absent() || u.id() == name_ || u.category() != "pedestrian") continue;
+    const double dx = u.x() - x_, dy = u.y() - y_;
+    const double lon = dx * c + dy * s, lat = -dx * s + dy * c;
+    if (lon <= 0 || lon > kFollowGap + 0.5 || std::abs(lat) > 0.6) continue;
+    const double along = u.speed() * std::cos(u.yaw() - yaw_);
+    if (along < -0.1) continue;  // coming towards it: they pass each other on the right
+    v = std::min(v, lon < kFollowGap ? std::max(0.0, along) : v);
+  }
+  return v;
 }
 
 std::vector<PedestrianAgent::Threat> PedestrianAgent::threats(const Crossing& c) const {
@@ -633,6 +653,7 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
     v = -std::min(v_des, (arc_ - limit) / dt);  // stepping back
   } else {
     v = std::min(v_des, (limit - arc_) / dt);
+    v = std::min(v, walker_ahead_speed(v));
   }
   arc_ = std::max(0.0, arc_ + v * dt);
   walked_ += std::abs(v) * dt;
@@ -641,8 +662,8 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   const odr::Pose2 p = path_.at(arc_);
   const double yaw_new = p.heading;
   yaw_rate_ = std::remainder(yaw_new - yaw_, 2 * M_PI) / dt;
-  x_ = p.x;
-  y_ = p.y;
+  x_ = p.x + kKeepRight * std::sin(p.heading);  // keeps right, so oncoming walkers pass
+  y_ = p.y - kKeepRight * std::cos(p.heading);
   yaw_ = yaw_new;
   if (arc_ >= path_.length() - 1e-6) {
     absent_ = true;

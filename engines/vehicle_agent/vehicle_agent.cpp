@@ -160,7 +160,9 @@ class VehicleAgent final : public Engine {
   // Gap to the entry of the next junction when it must wait there (first come by arrival
   // time, ties by id; anyone inside blocks), else +inf.
   double junction_wait(double my_front, const Snapshot* snap) const;
-  bool red_for(odr::LaneIndex lane, const Snapshot* snap) const;
+  // Whether one whose front is at front_s on `lane` waits at a red light: the lane's light
+  // is red and its front has not passed the light's stop line.
+  bool red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const;
   const Snapshot* perceived() const;
 
   std::string name_;
@@ -579,6 +581,9 @@ void VehicleAgent::consider_lane_change() {
 }
 
 namespace {
+constexpr double kCommitReaction = 1.0;  // s
+constexpr double kCommitDecel = 2.0;     // m/s^2
+
 // Time to cover d m from speed v accelerating at a up to v0.
 double eta(double d, double v, double a, double v0) {
   if (d <= 0) return 0;
@@ -586,18 +591,23 @@ double eta(double d, double v, double a, double v0) {
   const double t_up = std::max(v0 - v, 0.0) / a;
   const double d_up = v * t_up + 0.5 * a * t_up * t_up;
   if (d <= d_up) return (-v + std::sqrt(v * v + 2 * a * d)) / a;
-  return t_up + (d - d_up) / std::max(v0, 0.1);
+  return t_up + (d - d_up) / std::max({v0, v, 0.1});  // one faster than v0 keeps its speed
 }
 }  // namespace
 
-bool VehicleAgent::red_for(odr::LaneIndex lane, const Snapshot* snap) const {
+bool VehicleAgent::red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const {
   if (!snap || !snap->lights) return false;
   const json& sig = snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
+  const bool forward = graph_->lane(lane).forward;
   for (const auto& info : graph_->signals()) {
     if (!info.traffic_light || !info.signal) continue;
     if (std::find(info.lanes.begin(), info.lanes.end(), lane) == info.lanes.end()) continue;
     auto it = sig.find(info.signal->id);
-    if (it != sig.end() && it->is_string() && *it != "green" && *it != "off") return true;
+    if (it == sig.end() || !it->is_string() || (*it != "red" && *it != "red_yellow")) continue;
+    // Past its stop line (it went on yellow, or waits for the junction): not held by it.
+    const double stop_s = info.signal->s;
+    if (forward ? front_s > stop_s + 0.5 : front_s < stop_s - 0.5) continue;
+    return true;
   }
   return false;
 }
@@ -616,6 +626,8 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
   if (g < v_ * v_ / (2 * max_decel_)) return INFINITY;  // cannot stop before it: committed
   if (!snap || !snap->neighbours) return INFINITY;
   const double my_eta = eta(g, v_, idm_.a, idm_.v0);
+  // Until my rear has left the junction.
+  const double my_clear = eta(g + (next->exit - next->enter) + length_, v_, idm_.a, idm_.v0);
   const size_t lo = cursor_ > 40 ? cursor_ - 40 : 0;
   for (const auto& u : snap->neighbours->users()) {
     if (u.absent() || u.id() == name_) continue;
@@ -639,11 +651,18 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
       if (graph_->lane(nx).junction == next->junction) leads = true;
     }
     if (!leads) continue;
-    if (red_for(loc->lane, snap)) continue;  // it waits at its light
+    const double front_s = ln.forward ? loc->s + u_front : loc->s - u_front;
+    if (red_for(loc->lane, front_s, snap)) continue;  // it waits at its light
     const double remaining = (ln.forward ? ln.s1 - loc->s : loc->s - ln.s0) - u_front;
     if (remaining < 0) return std::max(g, 0.0);  // its front is in
     const double other_eta = eta(remaining, u.speed(), idm_.a, idm_.v0);
     if (other_eta < my_eta - 0.05 || (other_eta <= my_eta + 0.05 && u.id() < name_))
+      return std::max(g, 0.0);
+    // I would be first, but one that cannot stop comfortably before the junction any more
+    // (1 s to react, then 2 m/s^2) and arrives before I have cleared it does not yield,
+    // whoever drives it (SUMO's vehicles keep their right of way): wait for it.
+    const double v = std::max(u.speed(), 0.0);
+    if (remaining < v * kCommitReaction + v * v / (2 * kCommitDecel) && other_eta < my_clear + 0.5)
       return std::max(g, 0.0);
   }
   return INFINITY;
