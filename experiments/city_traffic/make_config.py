@@ -51,9 +51,10 @@ PEDESTRIANS = [
     {"from": "2:3", "from_s": 150.0, "to": "2:3", "to_s": 30.0},
     {"from": "1:-3", "from_s": 150.0, "to": "1:-3", "to_s": 225.0},
     {"from": "3:3", "from_s": 60.0, "to": "3:3", "to_s": 10.0},
-    {"from": "2:-3", "from_s": 100.0, "to": "2:3", "to_s": 60.0},  # crosses mid-block
+    # crosses mid-block at s = 190 (x = -60), in a gap in front of the ego
+    {"from": "1:-3", "from_s": 186.0, "to": "1:3", "to_s": 186.0},
 ]
-MIDBLOCK = {9: 1.0}
+MIDBLOCK = {9: (1.0, 42.84)}  # (probability, MidBlockDistance)
 
 # SUMO's background traffic: (from edge, to edge, vehicles per hour); edges are netconvert's
 # names for the roads ("-R": along s, "R": against it).
@@ -72,7 +73,8 @@ def vehicle(i, frm, s, to, model):
 def pedestrian(i, route):
     return {"EngineType": "pedestrian_agent", "EngineName": "ped_%d" % i, "EngineTimestep": AGENT_DT,
             "Map": MAP, "Route": route, "Seed": 100 + i, "Speed": 1.35, "CriticalGap": 4.0,
-            "MidBlockProbability": MIDBLOCK.get(i, 0.0)}
+            "MidBlockProbability": MIDBLOCK.get(i, (0.0, 25.0))[0],
+            "MidBlockDistance": MIDBLOCK.get(i, (0.0, 25.0))[1]}
 
 
 def config():
