@@ -177,6 +177,9 @@ class PedestrianAgent final : public Engine {
   double x_ = 0, y_ = 0, yaw_ = 0, yaw_rate_ = 0;
   size_t committed_ = SIZE_MAX;  // index of the crossing it has stepped onto / may step onto
   bool absent_ = false;
+  bool respawn_ = false;
+  double respawn_delay_s_ = 2.0;
+  int64_t absent_since_ns_ = 0;
   std::shared_ptr<const data::RoadUsers> neighbours_;
   std::shared_ptr<const json> lights_;
   double rain_factor_ = 1.0;
@@ -465,6 +468,8 @@ std::vector<engine::DataPackId> PedestrianAgent::initialize(const std::string& n
   const double u_dist = unit(rng);
   speed_ = std::max(
       0.3, config.at("Speed").get<double>() + z_speed * config.at("SpeedSd").get<double>());
+  respawn_ = config.at("Respawn").get<bool>();
+  respawn_delay_s_ = config.at("RespawnDelay").get<double>();
   gap_ = std::max(0.0, config.at("CriticalGap").get<double>() +
                            z_gap * config.at("CriticalGapSd").get<double>());
   const double p_mid = config.at("MidBlockProbability").get<double>();
@@ -602,7 +607,30 @@ std::vector<PedestrianAgent::Threat> PedestrianAgent::threats(const Crossing& c)
 int64_t PedestrianAgent::step(int64_t duration_ns) {
   const double dt = duration_ns * 1e-9;
   time_ns_ += duration_ns;
-  if (absent_) return time_ns_;
+  if (absent_) {
+    // Respawn: at its start again, once RespawnDelay has passed and no walker is within 1 m.
+    if (!respawn_ || time_ns_ - absent_since_ns_ < std::llround(respawn_delay_s_ * 1e9))
+      return time_ns_;
+    const odr::Pose2 p0 = initial_path_.at(0);
+    const double sx = p0.x + kKeepRight * std::sin(p0.heading);
+    const double sy = p0.y - kKeepRight * std::cos(p0.heading);
+    if (neighbours_) {
+      for (const auto& u : neighbours_->users()) {
+        if (!u.absent() && u.id() != name_ && std::hypot(u.x() - sx, u.y() - sy) < 1.0)
+          return time_ns_;
+      }
+    }
+    path_ = initial_path_;
+    arc_ = 0;
+    v_ = acc_ = yaw_rate_ = 0;
+    x_ = sx;
+    y_ = sy;
+    yaw_ = p0.heading;
+    committed_ = SIZE_MAX;
+    absent_ = false;
+    publish();
+    return time_ns_;
+  }
   const double v_des = speed_ * rain_factor_;
   double limit = path_.length();  // the farthest arc it may be at
   // The next crossing not yet behind it.
@@ -667,6 +695,13 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   yaw_ = yaw_new;
   if (arc_ >= path_.length() - 1e-6) {
     absent_ = true;
+    absent_since_ns_ = time_ns_;
+    if (respawn_) {  // absent, it waits at its start: its view is around there
+      const odr::Pose2 p0 = initial_path_.at(0);
+      x_ = p0.x + kKeepRight * std::sin(p0.heading);
+      y_ = p0.y - kKeepRight * std::cos(p0.heading);
+      yaw_ = p0.heading;
+    }
     v_ = acc_ = yaw_rate_ = 0;
   }
   publish();

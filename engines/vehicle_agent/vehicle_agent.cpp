@@ -152,6 +152,10 @@ class VehicleAgent final : public Engine {
   odr::LaneRoute pick_route(const json& config, uint64_t seed) const;
   Path make_path(const odr::LaneRoute& route) const;
   void start();
+  // Respawn: back at its start once its route has ended, RespawnDelay has passed and the
+  // start is free (nobody within its length + 6 m of it in its latest view).
+  bool start_free() const;
+  void restart();
   void publish();
   double desired_speed() const;
   // The leader ahead on `path` from arc `me` (my front bumper's arc): (gap, speed).
@@ -186,6 +190,10 @@ class VehicleAgent final : public Engine {
   double arc_ = 0;     // rear axle's arc along path_
   double x_ = 0, y_ = 0, yaw_ = 0, v_ = 0, acc_ = 0, yaw_rate_ = 0;
   bool absent_ = false;
+  bool respawn_ = false;
+  double respawn_delay_s_ = 2.0;
+  int64_t absent_since_ns_ = 0;
+  odr::Pose2 initial_path_start_{};
   int changing_ = 0;  // +1 left, -1 right while a lane change is under way
   int64_t next_mobil_ns_ = 0;
   std::deque<Snapshot> inputs_;
@@ -378,6 +386,8 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   radius_ = config.at("NeighbourRadius").get<double>();
   start_s_ = config.at("StartS").get<double>();
   initial_speed_ = config.at("InitialSpeed").get<double>();
+  respawn_ = config.at("Respawn").get<bool>();
+  respawn_delay_s_ = config.at("RespawnDelay").get<double>();
   model_ = config.at("Model").get<std::string>();
   category_ = config.at("Category").get<std::string>();
   length_ = config.at("Length").get<double>();
@@ -410,9 +420,19 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   return ids;
 }
 
-void VehicleAgent::start() {
+bool VehicleAgent::start_free() const {
+  const Snapshot* snap = perceived();
+  if (!snap || !snap->neighbours) return false;
+  const odr::Pose2 p = initial_path_start_;
+  for (const auto& u : snap->neighbours->users()) {
+    if (u.absent() || u.id() == name_) continue;
+    if (std::hypot(u.x() - p.x, u.y() - p.y) < length_ + 6.0) return false;
+  }
+  return true;
+}
+
+void VehicleAgent::restart() {
   path_ = make_path(initial_route_);
-  time_ns_ = 0;
   arc_ = start_s_;
   const odr::Pose2 p = path_.at(arc_);
   x_ = p.x;
@@ -422,6 +442,25 @@ void VehicleAgent::start() {
   acc_ = 0;
   yaw_rate_ = 0;
   absent_ = false;
+  changing_ = 0;
+  next_mobil_ns_ = time_ns_;
+  cursor_ = path_.project(x_, y_).index;
+}
+
+void VehicleAgent::start() {
+  path_ = make_path(initial_route_);
+  time_ns_ = 0;
+  arc_ = start_s_;
+  const odr::Pose2 p = path_.at(arc_);
+  initial_path_start_ = p;
+  x_ = p.x;
+  y_ = p.y;
+  yaw_ = p.heading;
+  v_ = initial_speed_;
+  acc_ = 0;
+  yaw_rate_ = 0;
+  absent_ = false;
+  absent_since_ns_ = 0;
   changing_ = 0;
   next_mobil_ns_ = 0;
   inputs_.clear();
@@ -674,7 +713,14 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
   // Drop inputs no longer needed (keep the newest one old enough).
   const int64_t limit = time_ns_ - static_cast<int64_t>(std::llround(reaction_s_ * 1e9));
   while (inputs_.size() > 1 && inputs_[1].time_ns <= limit) inputs_.pop_front();
-  if (absent_) return time_ns_;
+  if (absent_) {
+    if (!respawn_ || time_ns_ - absent_since_ns_ < std::llround(respawn_delay_s_ * 1e9) ||
+        !start_free())
+      return time_ns_;
+    restart();
+    publish();
+    return time_ns_;
+  }
 
   const double my_front_off = 0.5 * length_ + (0.5 * length_ - rear_overhang_);
   const double my_front = arc_ + my_front_off;
@@ -740,6 +786,12 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
   if (changing_ != 0 && std::abs(pr.lateral) < 0.2) changing_ = 0;
   if (arc_ >= path_.length() - 0.25) {
     absent_ = true;
+    absent_since_ns_ = time_ns_;
+    if (respawn_) {  // absent, it waits at its start: its view is around there
+      x_ = initial_path_start_.x;
+      y_ = initial_path_start_.y;
+      yaw_ = initial_path_start_.heading;
+    }
     v_ = 0;
     acc_ = 0;
     yaw_rate_ = 0;

@@ -11,7 +11,9 @@
   CARLA's agents treat red lights;
 - the recorder gets every road user's state, the signals and the planner's target.
 
-The agents' names come from make_config.py, which wrote the config."""
+The agents' names come from make_config.py, which wrote the config. Without a planner engine
+(the density run) there is no ego: the ego's inputs and outputs are left out."""
+import json
 import math
 import os
 import sys
@@ -27,6 +29,17 @@ import make_config  # noqa: E402
 from convoy_traffic.ego_planner import ego_state, objects_from_road_users  # noqa: E402
 from convoy_traffic.neighbours import neighbour_datapacks, road_users  # noqa: E402
 
+
+def _engines():
+    """The run's engine names (the coordinator keeps the config in the run folder)."""
+    try:
+        with open(os.path.join(os.environ.get("CONVOY_RUN_DIR", "."), "config.json")) as f:
+            return {e["EngineName"] for e in json.load(f)["EngineConfigs"]}
+    except (OSError, ValueError, KeyError):
+        return set()
+
+
+HAS_EGO = "planner" in _engines()  # the density run has no ego
 VEHICLES = ["car_%d" % i for i in range(len(make_config.VEHICLES))]
 PEDESTRIANS = ["ped_%d" % i for i in range(len(make_config.PEDESTRIANS))]
 AGENTS = VEHICLES + PEDESTRIANS
@@ -67,7 +80,9 @@ def _stop_line_object(ego, signals):
 
 def _traffic(**dps):
     lights, tin, sumo_tl = dps["lights"], dps["tin"], dps["sumo_tl"]
-    sumo, ego_dp, target = dps["sumo"], dps["ego"], dps["target"]
+    sumo, ego_dp, target = dps["sumo"], dps.get("ego"), dps.get("target")
+    if ego_dp is not None and ego_dp.isEmpty():
+        ego_dp = None
     agent_dps = [dps[a] for a in AGENTS]
     out = []
     # Lights: this engine leads SUMO.
@@ -78,7 +93,7 @@ def _traffic(**dps):
     signals = dict(lights.data["signals"]) if not lights.isEmpty() else {}
 
     # Every agent's view.
-    everyone = agent_dps + [sumo, ego_dp]
+    everyone = agent_dps + [sumo] + ([ego_dp] if ego_dp is not None else [])
     out += neighbour_datapacks(everyone, agents=AGENTS, radius=100.0)
     if not lights.isEmpty():
         out += [JsonDataPack("traffic_lights", a, lights.data) for a in AGENTS]
@@ -103,7 +118,7 @@ def _traffic(**dps):
             v = ext.data.users.add()
             v.id, v.absent = p, True
             _in_sumo.discard(p)
-    if not ego_dp.isEmpty():
+    if ego_dp is not None:
         ext.data.users.append(ego_dp.data)
     out.append(ext)
 
@@ -120,13 +135,13 @@ def _traffic(**dps):
     sumo_users = road_users([sumo])
     others = [u for u in agents + sumo_users if not u.absent]
     rec = {"signals": signals, "users": []}
-    for u in others + ([ego_dp.data] if not ego_dp.isEmpty() else []):
+    for u in others + ([ego_dp.data] if ego_dp is not None else []):
         rec["users"].append([u.id, u.category, round(u.x, 3), round(u.y, 3), round(u.yaw, 4),
                              round(u.speed, 3), round(u.length, 2), round(u.length_offset, 2)])
-    if not target.isEmpty():
+    if target is not None and not target.isEmpty():
         rec["target"] = {k: target.data[k] for k in ("speed", "mode", "lead", "gap_m", "ttc_s")
                          if k in target.data}
-    if not ego_dp.isEmpty():
+    if ego_dp is not None:
         ego = ego_dp.data
         objs = list(others)
         line = _stop_line_object(ego, signals)
@@ -146,6 +161,7 @@ traffic = EngineDataPack(keyword="lights", id=DataPackIdentifier("traffic_lights
 traffic = EngineDataPack(keyword="tin", id=DataPackIdentifier("traffic_lights_in", "lights"))(traffic)
 traffic = EngineDataPack(keyword="sumo_tl", id=DataPackIdentifier("traffic_lights", "sumo"))(traffic)
 traffic = EngineDataPack(keyword="sumo", id=DataPackIdentifier("vehicles", "sumo"))(traffic)
-traffic = EngineDataPack(keyword="ego", id=DataPackIdentifier("smart_car::road_user", "gazebo"))(traffic)
-traffic = EngineDataPack(keyword="target", id=DataPackIdentifier("target", "planner"))(traffic)
+if HAS_EGO:
+    traffic = EngineDataPack(keyword="ego", id=DataPackIdentifier("smart_car::road_user", "gazebo"))(traffic)
+    traffic = EngineDataPack(keyword="target", id=DataPackIdentifier("target", "planner"))(traffic)
 traffic = TransceiverFunction("lights")(traffic)
