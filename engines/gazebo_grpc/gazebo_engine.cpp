@@ -317,7 +317,7 @@ class GazeboEngine final : public Engine {
     int physics = -1, camera = -1;
     bool present = false;
     int64_t last_seen_ns = 0;
-    int64_t created_ns = -1;  // the step it first appeared in
+    int64_t created_ns = -1;                                 // the step it first appeared in
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the model's frame
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     Eigen::Vector3d half = Eigen::Vector3d::Zero();  // half the box, about the model's frame
