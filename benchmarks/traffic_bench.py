@@ -27,7 +27,21 @@ neighbour view (python/convoy_traffic/neighbours.py, radius 100 m) each step. Fo
 time / loop wall time, start-up excluded; median of --runs), and last the largest N at >= 1x:
 `participants at real time: N`.
 
-  --sections sumo,agents   which sections to run (default both)
+Section "city": experiments/city_traffic (the ego with its 30 Hz camera, the detector on every
+third frame, the planner, 20 vehicle agents, 10 pedestrian agents, SUMO, the lights) for
+--city-end simulated seconds, --runs times. Prints, median of the runs:
+  - start-up: the coordinator's "engines initialized in ... s" (target <= 2 s); the first run
+    starts with an empty parsed-world cache (CONVOY_CACHE_DIR in a temporary folder), the
+    others hit it; both are printed;
+  - camera frames/s (wall): frames written to camera.mp4 per wall second of the loop
+    (target >= 20), detector frames and detections per wall second, the real-time factor.
+
+Section "density": experiments/city_traffic/simulation_config_density.json, 10 simulated
+minutes of the same road users respawning at their starts and SUMO's flows doubled (no ego).
+Prints the collisions among participants (target 0), red-light violations, the road users
+seen and the real-time factor.
+
+  --sections sumo,agents,city,density   which sections to run (default all)
 """
 import argparse
 import json
@@ -248,6 +262,78 @@ def section_agents(args):
     print("participants at real time: %d" % best)
 
 
+CITY = os.path.join(REPO, "experiments", "city_traffic")
+
+
+def city_run(args, config, end, run_dir, env=None):
+    cmd = [os.path.join(args.build, "bin", "convoy"), "run", "-c", config, "--run-dir", run_dir,
+           "-o", "SimulationTimeout=%g" % end]
+    out = subprocess.run(cmd, cwd=CITY, capture_output=True, text=True, env=env)
+    if out.returncode != 0:
+        sys.exit("city: %s failed (exit %d):\n%s" % (config, out.returncode, out.stderr[-3000:]))
+    startup = None
+    for line in out.stdout.splitlines():
+        if "engines initialized in" in line:
+            startup = float(line.split("engines initialized in")[1].split()[0])
+    with open(os.path.join(run_dir, "summary.json")) as f:
+        return startup, json.load(f)
+
+
+def section_city(args):
+    if not os.path.exists(os.path.join(args.build, "bin", "convoy-engine-sumo")):
+        print("city: the sumo engine is not built")
+        return
+    work = tempfile.mkdtemp(prefix="convoy-trafficbench-city-")
+    try:
+        env = dict(os.environ, CONVOY_CACHE_DIR=os.path.join(work, "cache"))
+        rows = []
+        for i in range(max(args.runs, 2)):
+            startup, s = city_run(args, "simulation_config.json", args.city_end,
+                                  os.path.join(work, "run%d" % i), env)
+            wall = s["loop_wall_s"]
+            rows.append((startup, s["camera_frames"] / wall, s["detector_frames"] / wall,
+                         s["detections"] / wall, s["real_time_factor"], s))
+            shutil.rmtree(os.path.join(work, "run%d" % i), ignore_errors=True)
+        warm = rows[1:]
+        med = lambda k: statistics.median(r[k] for r in warm)  # noqa: E731
+        s = rows[-1][5]
+        print("city: experiments/city_traffic, %g s simulated, %d run(s) (the first with an empty "
+              "parsed-world cache); participants %s" % (args.city_end, len(rows),
+                                                         json.dumps(s["participants"])))
+        print("  start-up (engines initialized in): %.2f s with the cache (runs: %s), %.2f s "
+              "without it  target <= 2 s" % (med(0), ", ".join("%.2f" % r[0] for r in warm),
+                                            rows[0][0]))
+        print("  camera frames/s (30 Hz camera, wall): %.1f (runs: %s)  target >= 20"
+              % (med(1), ", ".join("%.1f" % r[1] for r in warm)))
+        print("  detector frames/s (every third camera frame): %.1f; detections/s: %.1f"
+              % (med(2), med(3)))
+        print("  real-time factor: %.2fx; collisions %d, red-light violations %d, ego stops "
+              "for pedestrians %s" % (med(4), len(s["collisions"]), s["red_light_violations"],
+                                      s["ego_stops_for_pedestrians"]))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def section_density(args):
+    if not os.path.exists(os.path.join(args.build, "bin", "convoy-engine-sumo")):
+        print("density: the sumo engine is not built")
+        return
+    work = tempfile.mkdtemp(prefix="convoy-trafficbench-density-")
+    try:
+        _, s = city_run(args, "simulation_config_density.json", args.density_end,
+                        os.path.join(work, "run"))
+        print("density: %g simulated s of city_traffic's road users respawning, SUMO's flows "
+              "doubled; %d road users seen (%d SUMO vehicles), real-time factor %.2fx"
+              % (args.density_end, s["road_users_seen"], s["participants"]["sumo_vehicles"],
+                 s["real_time_factor"]))
+        print("  collisions among participants: %d  target 0" % len(s["collisions"]))
+        for c in s["collisions"]:
+            print("    %s" % json.dumps(c))
+        print("  red-light violations: %d" % s["red_light_violations"])
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -255,8 +341,12 @@ def main():
     ap.add_argument("--end", type=int, default=600, help="simulated seconds")
     ap.add_argument("--grid", type=int, default=10, help="junctions per side of the grid")
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
-    ap.add_argument("--sections", default="sumo,agents")
-    ap.add_argument("--agents", default="8,16,32,64,128", help="agent counts, comma-separated")
+    ap.add_argument("--sections", default="sumo,agents,city,density")
+    ap.add_argument("--agents", default="8,16,32,64,128,256", help="agent counts, comma-separated")
+    ap.add_argument("--city-end", type=float, default=60.0,
+                    help="simulated seconds of each city run")
+    ap.add_argument("--density-end", type=float, default=600.0,
+                    help="simulated seconds of the density run")
     ap.add_argument("--agent-end", type=float, default=10.0,
                     help="simulated seconds of each agents run")
     args = ap.parse_args()
@@ -265,6 +355,10 @@ def main():
         section_sumo(args)
     if "agents" in sections:
         section_agents(args)
+    if "city" in sections:
+        section_city(args)
+    if "density" in sections:
+        section_density(args)
 
 
 if __name__ == "__main__":

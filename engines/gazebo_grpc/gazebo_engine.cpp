@@ -317,6 +317,7 @@ class GazeboEngine final : public Engine {
     int physics = -1, camera = -1;
     bool present = false;
     int64_t last_seen_ns = 0;
+    int64_t created_ns = -1;                                 // the step it first appeared in
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the model's frame
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     Eigen::Vector3d half = Eigen::Vector3d::Zero();  // half the box, about the model's frame
@@ -357,6 +358,7 @@ class GazeboEngine final : public Engine {
     }
     ActorState a;
     a.id = u.id();
+    a.created_ns = time_ns_;
     a.category = u.category().empty() ? am->cls : u.category();
     a.cls = a.category;
     Eigen::Vector3d scale(u.length() > 0 ? u.length() / am->size.x() : 1,
@@ -482,6 +484,17 @@ class GazeboEngine final : public Engine {
       for (size_t j = i + 1; j < actors_.size(); ++j) {
         const ActorState& b = actors_[j];
         if (!b.present || !boxes_overlap(a, b)) continue;
+        if (a.created_ns == time_ns_ && b.created_ns == time_ns_) {
+          // Both appear in this step, on top of each other: a placement error, not a crash.
+          const Eigen::Vector3d p = a.pose.translation();
+          char where[64];
+          std::snprintf(where, sizeof where, "(%.2f, %.2f)", p.x(), p.y());
+          throw std::runtime_error(
+              "engine '" + name_ + "': road users '" + a.id + "' and '" + b.id +
+              "' are placed on the same spot: their boxes overlap where they first appear, at " +
+              where + ", t = " + std::to_string(static_cast<double>(time_ns_) * 1e-9) +
+              " s. Give one of them another start (its engine's Route, StartS or Position)");
+        }
         const auto* ka = physics_->actor_skeleton(a.physics);
         const auto* kb = physics_->actor_skeleton(b.physics);
         note_contact(ka, kb, entity_.at(ka), entity_.at(kb));

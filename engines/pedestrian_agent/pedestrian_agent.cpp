@@ -59,6 +59,8 @@ namespace {
 constexpr double kSampleDs = 0.25;    // m between the path's poses
 constexpr double kCurbWait = 0.3;     // m before the road's edge where it waits
 constexpr double kSignalNear = 12.0;  // m along the road: a signal belongs to a crosswalk
+constexpr double kKeepRight = 0.55;   // m right of its path's centre line: walkers pass
+constexpr double kFollowGap = 1.0;    // m: closer than this behind a walker, it keeps its pace
 
 struct Crossing {
   std::string road_id, crosswalk;  // crosswalk id, empty mid-block
@@ -157,6 +159,7 @@ class PedestrianAgent final : public Engine {
     double speed = 0;
   };
   std::vector<Threat> threats(const Crossing& c) const;
+  double walker_ahead_speed(double v) const;
 
   std::string name_;
   std::unique_ptr<odr::Network> net_;
@@ -174,6 +177,9 @@ class PedestrianAgent final : public Engine {
   double x_ = 0, y_ = 0, yaw_ = 0, yaw_rate_ = 0;
   size_t committed_ = SIZE_MAX;  // index of the crossing it has stepped onto / may step onto
   bool absent_ = false;
+  bool respawn_ = false;
+  double respawn_delay_s_ = 2.0;
+  int64_t absent_since_ns_ = 0;
   std::shared_ptr<const data::RoadUsers> neighbours_;
   std::shared_ptr<const json> lights_;
   double rain_factor_ = 1.0;
@@ -462,6 +468,8 @@ std::vector<engine::DataPackId> PedestrianAgent::initialize(const std::string& n
   const double u_dist = unit(rng);
   speed_ = std::max(
       0.3, config.at("Speed").get<double>() + z_speed * config.at("SpeedSd").get<double>());
+  respawn_ = config.at("Respawn").get<bool>();
+  respawn_delay_s_ = config.at("RespawnDelay").get<double>();
   gap_ = std::max(0.0, config.at("CriticalGap").get<double>() +
                            z_gap * config.at("CriticalGapSd").get<double>());
   const double p_mid = config.at("MidBlockProbability").get<double>();
@@ -499,8 +507,8 @@ void PedestrianAgent::start() {
   arc_ = 0;
   v_ = acc_ = walked_ = yaw_rate_ = 0;
   const odr::Pose2 p = path_.at(0);
-  x_ = p.x;
-  y_ = p.y;
+  x_ = p.x + kKeepRight * std::sin(p.heading);
+  y_ = p.y - kKeepRight * std::cos(p.heading);
   yaw_ = p.heading;
   committed_ = SIZE_MAX;
   absent_ = false;
@@ -547,6 +555,23 @@ bool PedestrianAgent::lights_allow(const Crossing& c) {
   return true;
 }
 
+// The pace it may walk at with other walkers ahead: one in its way (within its body's width
+// of its line, going its way or standing) closer than kFollowGap is not overtaken.
+double PedestrianAgent::walker_ahead_speed(double v) const {
+  if (!neighbours_) return v;
+  const double c = std::cos(yaw_), s = std::sin(yaw_);
+  for (const auto& u : neighbours_->users()) {
+    if (u.absent() || u.id() == name_ || u.category() != "pedestrian") continue;
+    const double dx = u.x() - x_, dy = u.y() - y_;
+    const double lon = dx * c + dy * s, lat = -dx * s + dy * c;
+    if (lon <= 0 || lon > kFollowGap + 0.5 || std::abs(lat) > 0.6) continue;
+    const double along = u.speed() * std::cos(u.yaw() - yaw_);
+    if (along < -0.1) continue;  // coming towards it: they pass each other on the right
+    v = std::min(v, lon < kFollowGap ? std::max(0.0, along) : v);
+  }
+  return v;
+}
+
 std::vector<PedestrianAgent::Threat> PedestrianAgent::threats(const Crossing& c) const {
   std::vector<Threat> out;
   if (!neighbours_) return out;
@@ -582,7 +607,30 @@ std::vector<PedestrianAgent::Threat> PedestrianAgent::threats(const Crossing& c)
 int64_t PedestrianAgent::step(int64_t duration_ns) {
   const double dt = duration_ns * 1e-9;
   time_ns_ += duration_ns;
-  if (absent_) return time_ns_;
+  if (absent_) {
+    // Respawn: at its start again, once RespawnDelay has passed and no walker is within 1 m.
+    if (!respawn_ || time_ns_ - absent_since_ns_ < std::llround(respawn_delay_s_ * 1e9))
+      return time_ns_;
+    const odr::Pose2 p0 = initial_path_.at(0);
+    const double sx = p0.x + kKeepRight * std::sin(p0.heading);
+    const double sy = p0.y - kKeepRight * std::cos(p0.heading);
+    if (neighbours_) {
+      for (const auto& u : neighbours_->users()) {
+        if (!u.absent() && u.id() != name_ && std::hypot(u.x() - sx, u.y() - sy) < 1.0)
+          return time_ns_;
+      }
+    }
+    path_ = initial_path_;
+    arc_ = 0;
+    v_ = acc_ = yaw_rate_ = 0;
+    x_ = sx;
+    y_ = sy;
+    yaw_ = p0.heading;
+    committed_ = SIZE_MAX;
+    absent_ = false;
+    publish();
+    return time_ns_;
+  }
   const double v_des = speed_ * rain_factor_;
   double limit = path_.length();  // the farthest arc it may be at
   // The next crossing not yet behind it.
@@ -633,6 +681,7 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
     v = -std::min(v_des, (arc_ - limit) / dt);  // stepping back
   } else {
     v = std::min(v_des, (limit - arc_) / dt);
+    v = std::min(v, walker_ahead_speed(v));
   }
   arc_ = std::max(0.0, arc_ + v * dt);
   walked_ += std::abs(v) * dt;
@@ -641,11 +690,18 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   const odr::Pose2 p = path_.at(arc_);
   const double yaw_new = p.heading;
   yaw_rate_ = std::remainder(yaw_new - yaw_, 2 * M_PI) / dt;
-  x_ = p.x;
-  y_ = p.y;
+  x_ = p.x + kKeepRight * std::sin(p.heading);  // keeps right, so oncoming walkers pass
+  y_ = p.y - kKeepRight * std::cos(p.heading);
   yaw_ = yaw_new;
   if (arc_ >= path_.length() - 1e-6) {
     absent_ = true;
+    absent_since_ns_ = time_ns_;
+    if (respawn_) {  // absent, it waits at its start: its view is around there
+      const odr::Pose2 p0 = initial_path_.at(0);
+      x_ = p0.x + kKeepRight * std::sin(p0.heading);
+      y_ = p0.y - kKeepRight * std::cos(p0.heading);
+      yaw_ = p0.heading;
+    }
     v_ = acc_ = yaw_rate_ = 0;
   }
   publish();

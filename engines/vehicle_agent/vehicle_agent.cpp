@@ -152,6 +152,10 @@ class VehicleAgent final : public Engine {
   odr::LaneRoute pick_route(const json& config, uint64_t seed) const;
   Path make_path(const odr::LaneRoute& route) const;
   void start();
+  // Respawn: back at its start once its route has ended, RespawnDelay has passed and the
+  // start is free (nobody within its length + 6 m of it in its latest view).
+  bool start_free() const;
+  void restart();
   void publish();
   double desired_speed() const;
   // The leader ahead on `path` from arc `me` (my front bumper's arc): (gap, speed).
@@ -160,7 +164,9 @@ class VehicleAgent final : public Engine {
   // Gap to the entry of the next junction when it must wait there (first come by arrival
   // time, ties by id; anyone inside blocks), else +inf.
   double junction_wait(double my_front, const Snapshot* snap) const;
-  bool red_for(odr::LaneIndex lane, const Snapshot* snap) const;
+  // Whether one whose front is at front_s on `lane` waits at a red light: the lane's light
+  // is red and its front has not passed the light's stop line.
+  bool red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const;
   const Snapshot* perceived() const;
 
   std::string name_;
@@ -184,6 +190,10 @@ class VehicleAgent final : public Engine {
   double arc_ = 0;     // rear axle's arc along path_
   double x_ = 0, y_ = 0, yaw_ = 0, v_ = 0, acc_ = 0, yaw_rate_ = 0;
   bool absent_ = false;
+  bool respawn_ = false;
+  double respawn_delay_s_ = 2.0;
+  int64_t absent_since_ns_ = 0;
+  odr::Pose2 initial_path_start_{};
   int changing_ = 0;  // +1 left, -1 right while a lane change is under way
   int64_t next_mobil_ns_ = 0;
   std::deque<Snapshot> inputs_;
@@ -376,6 +386,8 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   radius_ = config.at("NeighbourRadius").get<double>();
   start_s_ = config.at("StartS").get<double>();
   initial_speed_ = config.at("InitialSpeed").get<double>();
+  respawn_ = config.at("Respawn").get<bool>();
+  respawn_delay_s_ = config.at("RespawnDelay").get<double>();
   model_ = config.at("Model").get<std::string>();
   category_ = config.at("Category").get<std::string>();
   length_ = config.at("Length").get<double>();
@@ -408,9 +420,19 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   return ids;
 }
 
-void VehicleAgent::start() {
+bool VehicleAgent::start_free() const {
+  const Snapshot* snap = perceived();
+  if (!snap || !snap->neighbours) return false;
+  const odr::Pose2 p = initial_path_start_;
+  for (const auto& u : snap->neighbours->users()) {
+    if (u.absent() || u.id() == name_) continue;
+    if (std::hypot(u.x() - p.x, u.y() - p.y) < length_ + 6.0) return false;
+  }
+  return true;
+}
+
+void VehicleAgent::restart() {
   path_ = make_path(initial_route_);
-  time_ns_ = 0;
   arc_ = start_s_;
   const odr::Pose2 p = path_.at(arc_);
   x_ = p.x;
@@ -420,6 +442,25 @@ void VehicleAgent::start() {
   acc_ = 0;
   yaw_rate_ = 0;
   absent_ = false;
+  changing_ = 0;
+  next_mobil_ns_ = time_ns_;
+  cursor_ = path_.project(x_, y_).index;
+}
+
+void VehicleAgent::start() {
+  path_ = make_path(initial_route_);
+  time_ns_ = 0;
+  arc_ = start_s_;
+  const odr::Pose2 p = path_.at(arc_);
+  initial_path_start_ = p;
+  x_ = p.x;
+  y_ = p.y;
+  yaw_ = p.heading;
+  v_ = initial_speed_;
+  acc_ = 0;
+  yaw_rate_ = 0;
+  absent_ = false;
+  absent_since_ns_ = 0;
   changing_ = 0;
   next_mobil_ns_ = 0;
   inputs_.clear();
@@ -579,6 +620,9 @@ void VehicleAgent::consider_lane_change() {
 }
 
 namespace {
+constexpr double kCommitReaction = 1.0;  // s
+constexpr double kCommitDecel = 2.0;     // m/s^2
+
 // Time to cover d m from speed v accelerating at a up to v0.
 double eta(double d, double v, double a, double v0) {
   if (d <= 0) return 0;
@@ -586,18 +630,23 @@ double eta(double d, double v, double a, double v0) {
   const double t_up = std::max(v0 - v, 0.0) / a;
   const double d_up = v * t_up + 0.5 * a * t_up * t_up;
   if (d <= d_up) return (-v + std::sqrt(v * v + 2 * a * d)) / a;
-  return t_up + (d - d_up) / std::max(v0, 0.1);
+  return t_up + (d - d_up) / std::max({v0, v, 0.1});  // one faster than v0 keeps its speed
 }
 }  // namespace
 
-bool VehicleAgent::red_for(odr::LaneIndex lane, const Snapshot* snap) const {
+bool VehicleAgent::red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const {
   if (!snap || !snap->lights) return false;
   const json& sig = snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
+  const bool forward = graph_->lane(lane).forward;
   for (const auto& info : graph_->signals()) {
     if (!info.traffic_light || !info.signal) continue;
     if (std::find(info.lanes.begin(), info.lanes.end(), lane) == info.lanes.end()) continue;
     auto it = sig.find(info.signal->id);
-    if (it != sig.end() && it->is_string() && *it != "green" && *it != "off") return true;
+    if (it == sig.end() || !it->is_string() || (*it != "red" && *it != "red_yellow")) continue;
+    // Past its stop line (it went on yellow, or waits for the junction): not held by it.
+    const double stop_s = info.signal->s;
+    if (forward ? front_s > stop_s + 0.5 : front_s < stop_s - 0.5) continue;
+    return true;
   }
   return false;
 }
@@ -616,6 +665,8 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
   if (g < v_ * v_ / (2 * max_decel_)) return INFINITY;  // cannot stop before it: committed
   if (!snap || !snap->neighbours) return INFINITY;
   const double my_eta = eta(g, v_, idm_.a, idm_.v0);
+  // Until my rear has left the junction.
+  const double my_clear = eta(g + (next->exit - next->enter) + length_, v_, idm_.a, idm_.v0);
   const size_t lo = cursor_ > 40 ? cursor_ - 40 : 0;
   for (const auto& u : snap->neighbours->users()) {
     if (u.absent() || u.id() == name_) continue;
@@ -639,11 +690,18 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
       if (graph_->lane(nx).junction == next->junction) leads = true;
     }
     if (!leads) continue;
-    if (red_for(loc->lane, snap)) continue;  // it waits at its light
+    const double front_s = ln.forward ? loc->s + u_front : loc->s - u_front;
+    if (red_for(loc->lane, front_s, snap)) continue;  // it waits at its light
     const double remaining = (ln.forward ? ln.s1 - loc->s : loc->s - ln.s0) - u_front;
     if (remaining < 0) return std::max(g, 0.0);  // its front is in
     const double other_eta = eta(remaining, u.speed(), idm_.a, idm_.v0);
     if (other_eta < my_eta - 0.05 || (other_eta <= my_eta + 0.05 && u.id() < name_))
+      return std::max(g, 0.0);
+    // I would be first, but one that cannot stop comfortably before the junction any more
+    // (1 s to react, then 2 m/s^2) and arrives before I have cleared it does not yield,
+    // whoever drives it (SUMO's vehicles keep their right of way): wait for it.
+    const double v = std::max(u.speed(), 0.0);
+    if (remaining < v * kCommitReaction + v * v / (2 * kCommitDecel) && other_eta < my_clear + 0.5)
       return std::max(g, 0.0);
   }
   return INFINITY;
@@ -655,7 +713,14 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
   // Drop inputs no longer needed (keep the newest one old enough).
   const int64_t limit = time_ns_ - static_cast<int64_t>(std::llround(reaction_s_ * 1e9));
   while (inputs_.size() > 1 && inputs_[1].time_ns <= limit) inputs_.pop_front();
-  if (absent_) return time_ns_;
+  if (absent_) {
+    if (!respawn_ || time_ns_ - absent_since_ns_ < std::llround(respawn_delay_s_ * 1e9) ||
+        !start_free())
+      return time_ns_;
+    restart();
+    publish();
+    return time_ns_;
+  }
 
   const double my_front_off = 0.5 * length_ + (0.5 * length_ - rear_overhang_);
   const double my_front = arc_ + my_front_off;
@@ -721,6 +786,12 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
   if (changing_ != 0 && std::abs(pr.lateral) < 0.2) changing_ = 0;
   if (arc_ >= path_.length() - 0.25) {
     absent_ = true;
+    absent_since_ns_ = time_ns_;
+    if (respawn_) {  // absent, it waits at its start: its view is around there
+      x_ = initial_path_start_.x;
+      y_ = initial_path_start_.y;
+      yaw_ = initial_path_start_.heading;
+    }
     v_ = 0;
     acc_ = 0;
     yaw_rate_ = 0;

@@ -85,9 +85,13 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
     Built for many agents: road users are put in a grid of `radius` cells, so each agent looks
     at its 3x3 cells only, and each user is serialised once; a view is parsed from the
     concatenated bytes (field 1 of RoadUsers, repeated) instead of copying messages."""
-    users = [u for u in road_users(datapacks) if not u.absent]
+    every = road_users(datapacks)
+    users = [u for u in every if not u.absent]
     users.sort(key=lambda u: u.id)  # views sorted by id
     by_id = {u.id: i for i, u in enumerate(users)}
+    # An absent agent (its route ended) still gets the view around where it says it is: one
+    # that respawns checks its start with it.
+    gone = {u.id: u for u in every if u.absent}
     xs = [u.x for u in users]
     ys = [u.y for u in users]
     frames = []
@@ -99,10 +103,12 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
     r2 = radius * radius
     out = []
     for engine in agents:
-        me = by_id.get(state_id(engine) if state_id else engine)
+        key = state_id(engine) if state_id else engine
+        me = by_id.get(key)
         dp = RoadUsersDataPack(name, engine)
-        if me is not None:
-            mx, my = xs[me], ys[me]
+        absent = gone.get(key) if me is None else None
+        if me is not None or absent is not None:
+            mx, my = (xs[me], ys[me]) if me is not None else (absent.x, absent.y)
             cx, cy = int(mx // radius), int(my // radius)
             near = []
             for gx in (cx - 1, cx, cx + 1):
@@ -112,6 +118,6 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
                             near.append(j)
             near.sort()
             dp.data.ParseFromString(b"".join(frames[j] for j in near))
-            dp.data.time_ns = users[me].time_ns
+            dp.data.time_ns = users[me].time_ns if me is not None else absent.time_ns
         out.append(dp)
     return out

@@ -10,6 +10,7 @@ JSON-lines file.
 """
 
 import json
+import math
 import os
 import unittest
 
@@ -70,6 +71,7 @@ class Script(EngineScript):
 
 TF = """\
 import json
+import math
 from nrp_core import *
 from nrp_core.data.nrp_json import JsonDataPack
 from convoy_traffic.neighbours import neighbour_datapacks, road_users
@@ -327,7 +329,8 @@ class Sidewalk(PedCase):
         rows = [r["ped"] for r in self.run_ok(out) if "ped" in r]
         present = [u for u in rows if not u["absent"]]
         self.assertTrue(all(u["lane"] == -3 and u["road"] == "2" for u in present))
-        self.assertTrue(all(abs(u["y"] + 8.25) < 0.01 for u in present))
+        # the sidewalk's centre is y = -8.25; walking east, it keeps 0.55 m to its right
+        self.assertTrue(all(abs(u["y"] + 8.25 + 0.55) < 0.01 for u in present))
         self.assertAlmostEqual(present[0]["x"], 34.0, delta=0.1)
         self.assertAlmostEqual(present[-1]["x"], 54.0, delta=0.1)
         self.assertTrue(rows[-1]["absent"], "absent at its route's end")
@@ -480,6 +483,7 @@ class Script(EngineScript):
 
 CAR_TF = """\
 import json
+import math
 from nrp_core import *
 from convoy_traffic.neighbours import neighbour_datapacks, road_users
 
@@ -555,3 +559,61 @@ class Example(PedCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+WALKERS_TF = """\
+import json
+import math
+from nrp_core import *
+from convoy_traffic.neighbours import neighbour_datapacks, road_users
+
+_out = open({out!r}, "a")
+
+
+@EngineDataPack(keyword="a", id=DataPackIdentifier("state", "a"))
+@EngineDataPack(keyword="b", id=DataPackIdentifier("state", "b"))
+@TransceiverFunction("a")
+def neighbours(a, b):
+    users = road_users([a, b])
+    _out.write(json.dumps({{u.id: [u.x, u.y, u.speed, u.absent] for u in users}}) + "\\n")
+    return neighbour_datapacks([a, b], agents=["a", "b"], radius=50.0)
+"""
+
+
+class Walkers(PedCase):
+    """Walkers on one sidewalk never overlap: oncoming ones pass on their right, a faster one
+    keeps behind a slower one."""
+
+    def walkers(self, a, b, timeout):
+        out = os.path.join(self.dir, "walkers.jsonl")
+        self.write("tf.py", WALKERS_TF.format(out=out))
+        base = {"EngineType": "pedestrian_agent", "EngineTimestep": 0.05, "Map": CITY,
+                "SpeedSd": 0.0, "CriticalGapSd": 0.0}
+        self.write_config({
+            "SimulationName": "walkers", "SimulationTimeout": timeout,
+            "EngineConfigs": [dict(base, EngineName="a", **a), dict(base, EngineName="b", **b)],
+            "DataPackProcessingFunctions": [{"Name": "tf", "FileName": "tf.py"}]})
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        with open(out) as f:
+            rows = [json.loads(l) for l in f]
+        both = [r for r in rows if "a" in r and "b" in r and not r["a"][3] and not r["b"][3]]
+        self.assertGreater(len(both), 20)
+        # bodies 0.45 m wide, 0.3 m deep: apart by more than that at every step
+        return min(math.hypot(r["a"][0] - r["b"][0], r["a"][1] - r["b"][1]) for r in both), rows
+
+    def test_oncoming_walkers_pass_each_other(self):
+        gap, rows = self.walkers(
+            {"Route": {"from": "2:-3", "from_s": 20.0, "to": "2:-3", "to_s": 60.0}},
+            {"Route": {"from": "2:-3", "from_s": 60.0, "to": "2:-3", "to_s": 20.0}}, 35.0)
+        self.assertGreater(gap, 0.6)
+        self.assertTrue(rows[-1]["a"][3] and rows[-1]["b"][3], "both arrived")
+
+    def test_a_faster_walker_keeps_behind(self):
+        gap, rows = self.walkers(
+            {"Route": {"from": "2:-3", "from_s": 20.0, "to": "2:-3", "to_s": 60.0}, "Speed": 1.8},
+            {"Route": {"from": "2:-3", "from_s": 23.0, "to": "2:-3", "to_s": 60.0}, "Speed": 1.0},
+            15.0)
+        self.assertGreater(gap, 0.6)
+        late = [r for r in rows if "a" in r and "b" in r and not r["b"][3]][-1]
+        self.assertLess(late["a"][0], late["b"][0], "a is still behind b")

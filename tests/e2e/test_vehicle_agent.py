@@ -189,6 +189,24 @@ class Idm(AgentCase):
         self.assertGreater(cars[-1]["x"], LENGTH - 10)
 
 
+class Respawn(AgentCase):
+    def test_starts_again_at_its_start_after_the_delay(self):
+        out = self.experiment(agent={"InitialSpeed": 15.0, "v0": 25.0, "LaneChanges": False,
+                                     "Respawn": True, "RespawnDelay": 1.5},
+                              timeout=90.0, timestep=0.1)
+        r = self.run_convoy(timeout=120)
+        self.assertExit(r, 0)
+        cars = [row["car"] for row in self.stream(out) if "car" in row]
+        first_gone = next(i for i, u in enumerate(cars) if u["absent"])
+        back = next(i for i in range(first_gone, len(cars)) if not cars[i]["absent"])
+        # absent at least RespawnDelay, then present again at its start, at InitialSpeed
+        self.assertGreaterEqual(cars[back]["time_ns"] - cars[first_gone]["time_ns"], 1.5e9 - 1)
+        self.assertLess(cars[back]["x"], 1.0)
+        self.assertAlmostEqual(cars[back]["speed"], 15.0, delta=0.5)
+        # and it drives the route again
+        self.assertGreater(max(u["x"] for u in cars[back:]), LENGTH / 2)
+
+
 class Mobil(AgentCase):
     def test_overtakes_a_slow_leader(self):
         out = self.experiment(agent={"InitialSpeed": 12.0, "v0": 15.0},

@@ -182,8 +182,8 @@ class Actors(unittest.TestCase):
             def users(t):
                 return [{"id": "traffic/ped", "category": "pedestrian", "x": 1.5, "y": -10.0},
                         {"id": "traffic/a", "category": "car", "x": 20.0, "y": 30.0},
-                        {"id": "traffic/b", "category": "bus", "x": 20.0 + max(0.0, 10.0 - 10.0 * t),
-                         "y": 31.0, "yaw": 3.14159, "speed": 10.0 if t < 1.0 else 0.0}]
+                        {"id": "traffic/b", "category": "bus", "x": 20.0 + max(0.0, 16.0 - 16.0 * t),
+                         "y": 31.0, "yaw": 3.14159, "speed": 16.0 if t < 1.0 else 0.0}]
             """, drive=8.0)
         ex.run(2.5)
         recs = self.records(ex)
@@ -217,6 +217,19 @@ class Actors(unittest.TestCase):
         self.assertIn("engine 'gazebo'", r.stderr)
         self.assertIn("datapack 'road_users'", r.stderr)
         self.assertIn("category 'spaceship' is not one of car", r.stderr)
+
+    def test_two_road_users_placed_on_the_same_spot(self):
+        ex = self.experiment("""\
+            def users(t):
+                return [{"id": "traffic/p", "category": "car", "x": 12.0, "y": 4.0},
+                        {"id": "traffic/q", "category": "pedestrian", "x": 12.5, "y": 4.2},
+                        {"id": "traffic/r", "category": "car", "x": 30.0, "y": 4.0}]
+            """)
+        r = ex.run(0.2, expect=3)
+        self.assertIn("engine 'gazebo'", r.stderr)
+        self.assertIn("road users 'traffic/p' and 'traffic/q' are placed on the same spot", r.stderr)
+        self.assertIn("Route, StartS or Position", r.stderr)
+        self.assertNotIn("traffic/r'", r.stderr)
 
     def test_unknown_model_falls_back_to_the_category_with_one_warning(self):
         ex = self.experiment("""\

@@ -1,0 +1,241 @@
+"""The city experiment's recorder (a python_json engine). It writes into the run folder:
+
+  camera.mp4      the ego's camera (30 Hz) with the detector's boxes drawn
+  birds_eye.png   every road user's track over the city road, coloured by class
+  tracks.jsonl    every road user's state at 20 Hz (id, class, x, y, yaw, speed)
+  summary.json    participants (count by engine type), collisions, min_ttc_s,
+                  red_light_violations, ego_stops_for_pedestrians, camera and detection rates
+
+It is listed after the planner in the config: engines shut down in config order, so the
+planner's ego_planner.json (its ego_stops_for_pedestrians) is written when this one reads it."""
+import hashlib
+import json
+import math
+import os
+import sys
+import time
+
+import cv2
+import numpy as np
+from nrp_core.engines.python_json import EngineScript
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import city_map  # noqa: E402
+import make_config  # noqa: E402
+
+FPS = 30
+COLOURS = {"car": (40, 40, 220), "truck": (0, 120, 200), "bus": (0, 160, 255),
+           "pedestrian": (200, 60, 200), "cyclist": (0, 170, 0)}  # BGR
+EGO = "smart_car"
+
+
+def load_obj(path):
+    verts, faces = [], []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("v "):
+                verts.append([float(v) for v in line.split()[1:3]])
+            elif line.startswith("f "):
+                faces.append([int(p.split("/")[0]) - 1 for p in line.split()[1:]])
+    return np.array(verts), faces
+
+
+class Script(EngineScript):
+    def initialize(self):
+        self._registerDataPack("traffic")
+        self._registerDataPack("observation")
+        self.dir = os.environ.get("CONVOY_RUN_DIR", ".")
+        self.map = city_map.CityMap(os.path.join(HERE, make_config.MAP))
+        self.tracks = {}          # id -> (class, [(x, y)])
+        self.tracks_file = open(os.path.join(self.dir, "tracks.jsonl"), "w")
+        self.digest = hashlib.sha1()
+        self.prev_ahead = {}      # (id, line id) -> distance before the line at the last step
+        self.violations = []
+        self.crossed_on_red = {}  # (id, signal) -> the light was red when its front crossed the line
+        self.min_ttc = None
+        self.video = None
+        self.frames = 0
+        self.last_key = None
+        self.detections = 0
+        self.detector_frames = 0
+        self.last_det_key = None
+        self.collisions = []
+        self.sumo_ids = set()
+        self.wall0 = None
+        self.last_t = None
+
+    def _traffic(self, t, d):
+        users = d.get("users", [])
+        signals = d.get("signals", {})
+        row = {"t": round(t, 3), "users": users, "signals": signals}
+        line = json.dumps(row, separators=(",", ":"))
+        self.tracks_file.write(line + "\n")
+        self.digest.update(line.encode())
+        for uid, cls, x, y, yaw, speed, length, loff in users:
+            self.tracks.setdefault(uid, (cls, []))[1].append((x, y))
+            if uid.startswith("sumo/"):
+                self.sumo_ids.add(uid)
+            if cls == "pedestrian":
+                continue
+            # Red-light violations: the front crosses its approach's stop line on red and then
+            # enters the junction (the end of its road) on red. Vehicles stop at the stop line
+            # or, as SUMO's, at the junction's edge behind the crosswalk; both are legal, as is
+            # a vehicle that crossed the line on yellow and enters on red.
+            fx = x + (loff + 0.5 * length) * math.cos(yaw)
+            fy = y + (loff + 0.5 * length) * math.sin(yaw)
+            for sl in self.map.stop_lines:
+                a = sl.ahead(fx, fy, yaw, at_entry=True)
+                key = (uid, sl.id)
+                prev = self.prev_ahead.get(key)
+                if a is None:
+                    self.prev_ahead.pop(key, None)
+                    continue
+                self.prev_ahead[key] = a
+                line_key = (uid, sl.id, "line")
+                b = sl.ahead(fx, fy, yaw)
+                pb = self.prev_ahead.get(line_key)
+                self.prev_ahead[line_key] = b
+                if pb is not None and b is not None and pb > 0 >= b:
+                    self.crossed_on_red[(uid, sl.id)] = signals.get(sl.id) == "red"
+                if prev is not None and prev > 0 >= a and signals.get(sl.id) == "red" and \
+                        self.crossed_on_red.get((uid, sl.id), True):
+                    self.violations.append({"t": round(t, 3), "id": uid, "class": cls,
+                                            "signal": sl.id, "speed_mps": round(speed, 2)})
+        tgt = d.get("target")
+        if tgt and tgt.get("ttc_s") is not None and not str(tgt.get("lead", "")).startswith("stop_line"):
+            ttc = float(tgt["ttc_s"])
+            if math.isfinite(ttc) and (self.min_ttc is None or ttc < self.min_ttc):
+                self.min_ttc = ttc
+
+    def _frame(self, obs):
+        frame = obs.get("frame")
+        if frame is None:
+            return
+        key = hash(frame[::29, ::31].tobytes())
+        if key == self.last_key:
+            return
+        self.last_key = key
+        img = cv2.cvtColor(np.ascontiguousarray(frame[:, :, :3]), cv2.COLOR_RGB2BGR)
+        for det in (obs.get("detections") or {}).get("detections", []):
+            p1, p2 = (int(det["x_min"]), int(det["y_min"])), (int(det["x_max"]), int(det["y_max"]))
+            cv2.rectangle(img, p1, p2, (0, 255, 255), 2)
+            cv2.putText(img, det["class"], (p1[0], max(12, p1[1] - 4)), cv2.FONT_HERSHEY_SIMPLEX,
+                        0.45, (0, 255, 255), 1, cv2.LINE_AA)
+        if self.video is None:
+            h, w = img.shape[:2]
+            self.video = cv2.VideoWriter(os.path.join(self.dir, "camera.mp4"),
+                                         cv2.VideoWriter_fourcc(*"mp4v"), FPS, (w, h))
+        self.video.write(img)
+        self.frames += 1
+
+    def runLoop(self, timestep_ns):
+        if self.wall0 is None:
+            self.wall0 = time.perf_counter()
+            self.sim0 = self._time_ns - timestep_ns
+        t = self._time_ns * 1e-9
+        self.last_t = self._time_ns
+        d = self._getDataPack("traffic")
+        if d and d.get("users") is not None and d is not getattr(self, "_last_traffic", None):
+            self._last_traffic = d
+            self._traffic(t, d)
+        obs = self._getDataPack("observation")
+        if obs:
+            self._frame(obs)
+            dets = (obs.get("detections") or {}).get("detections")
+            if dets is not None:
+                k = json.dumps(dets, sort_keys=True)
+                if k != self.last_det_key:
+                    self.last_det_key = k
+                    self.detector_frames += 1
+                    self.detections += len(dets)
+            if obs.get("collisions") is not None:
+                self.collisions = obs["collisions"]
+        if self._time_ns % 10_000_000_000 == 0:
+            print("t=%5.1f s  road users %d  frames %d  collisions %d  red-light violations %d" % (
+                t, len(self.tracks), self.frames, len(self.collisions), len(self.violations)), flush=True)
+
+    def _birds_eye(self):
+        share = os.environ.get("CONVOY_SHARE_DIR", "")
+        obj = os.path.join(share, "models", "city_road", "road.obj")
+        x0, x1, y0, y1 = -260.0, 460.0, -160.0, 160.0
+        scale = 2.0  # px per m
+        W, H = int((x1 - x0) * scale), int((y1 - y0) * scale)
+        img = np.full((H, W, 3), (70, 110, 70), np.uint8)
+
+        def px(x, y):
+            return int(round((x - x0) * scale)), int(round((y1 - y) * scale))
+        if os.path.exists(obj):
+            v, faces = load_obj(obj)
+            pts = np.stack([(v[:, 0] - x0) * scale, (y1 - v[:, 1]) * scale], axis=1).astype(np.int32)
+            for f in faces:
+                cv2.fillConvexPoly(img, pts[f], (105, 105, 105))
+        for sl in self.map.stop_lines:
+            c, s = math.cos(sl.heading), math.sin(sl.heading)
+            a = (sl.x - sl.t_min * s, sl.y + sl.t_min * c)
+            b = (sl.x - sl.t_max * s, sl.y + sl.t_max * c)
+            cv2.line(img, px(*a), px(*b), (255, 255, 255), 1)
+        for uid in sorted(self.tracks):
+            cls, pts = self.tracks[uid]
+            if uid == EGO:
+                continue
+            p = np.array([px(x, y) for x, y in pts], np.int32)
+            cv2.polylines(img, [p], False, COLOURS.get(cls, (200, 200, 200)), 1, cv2.LINE_AA)
+        if EGO in self.tracks:
+            p = np.array([px(x, y) for x, y in self.tracks[EGO][1]], np.int32)
+            cv2.polylines(img, [p], False, (0, 255, 255), 3, cv2.LINE_AA)
+        legend = [("ego", (0, 255, 255))] + [(k, c) for k, c in COLOURS.items()]
+        for i, (name, col) in enumerate(legend):
+            cv2.line(img, (10, 14 + 16 * i), (30, 14 + 16 * i), col, 3)
+            cv2.putText(img, name, (36, 18 + 16 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1,
+                        cv2.LINE_AA)
+        cv2.imwrite(os.path.join(self.dir, "birds_eye.png"), img)
+
+    def shutdown(self):
+        if not hasattr(self, "tracks_file"):
+            return
+        self.tracks_file.close()
+        if self.video is not None:
+            self.video.release()
+        self._birds_eye()
+        wall = time.perf_counter() - self.wall0 if self.wall0 is not None else 0.0
+        sim = (self.last_t - self.sim0) * 1e-9 if self.wall0 is not None else 0.0
+        participants = {}
+        try:
+            with open(os.path.join(self.dir, "config.json")) as f:
+                for e in json.load(f)["EngineConfigs"]:
+                    participants[e["EngineType"]] = participants.get(e["EngineType"], 0) + 1
+        except (OSError, ValueError, KeyError):
+            pass
+        participants["sumo_vehicles"] = len(self.sumo_ids)
+        planner = {}
+        try:
+            with open(os.path.join(self.dir, "ego_planner.json")) as f:
+                planner = json.load(f)
+        except (OSError, ValueError):
+            print("recorder: no ego_planner.json in the run folder", flush=True)
+        summary = {
+            "participants": participants,
+            "collisions": [{k: c.get(k) for k in ("t", "a", "b", "class_a", "class_b",
+                                                   "relative_speed_mps")} for c in self.collisions],
+            "min_ttc_s": self.min_ttc,
+            "red_light_violations": len(self.violations),
+            "red_light_violation_list": self.violations,
+            "ego_stops_for_pedestrians": planner.get("ego_stops_for_pedestrians"),
+            "ego_input": planner.get("input_label"),
+            "road_users_seen": len(self.tracks),
+            "tracks_sha1": self.digest.hexdigest(),
+            "camera_frames": self.frames,
+            "camera_frames_per_s": self.frames / wall if wall > 0 else None,
+            "detector_frames": self.detector_frames,
+            "detections": self.detections,
+            "detections_per_s": self.detections / wall if wall > 0 else None,
+            "simulated_s": sim,
+        }
+        path = os.path.join(self.dir, "summary.json")
+        with open(path, "w") as f:
+            json.dump(summary, f, indent=1)
+        print("recorder: %d road users, %d collisions, %d red-light violations, min TTC %s, "
+              "ego stops for pedestrians %s, %d camera frames; %s" % (
+                  len(self.tracks), len(self.collisions), len(self.violations), self.min_ttc,
+                  summary["ego_stops_for_pedestrians"], self.frames, path), flush=True)
