@@ -272,9 +272,10 @@ def city_run(args, config, end, run_dir, env=None):
     if out.returncode != 0:
         sys.exit("city: %s failed (exit %d):\n%s" % (config, out.returncode, out.stderr[-3000:]))
     startup = None
-    for line in out.stdout.splitlines():
-        if "engines initialized in" in line:
-            startup = float(line.split("engines initialized in")[1].split()[0])
+    with open(os.path.join(run_dir, "logs", "coordinator.log")) as f:
+        for line in f:
+            if "engines initialized in" in line:
+                startup = float(line.split("engines initialized in")[1].split()[0])
     with open(os.path.join(run_dir, "summary.json")) as f:
         return startup, json.load(f)
 

@@ -9,7 +9,8 @@ traffic on the generated city map.
 - Bad input: two participants placed on the same spot end the run with a message naming both
   and a non-zero exit, and leave no process behind.
 
-The whole 10-minute density run is `benchmarks/traffic_bench.py --section density`."""
+- Density: 10 simulated minutes of the dense variant (every agent respawning, SUMO's flows
+  doubled) without a contact among the participants (about a minute of wall time)."""
 
 import json
 import os
@@ -121,6 +122,27 @@ class Determinism(CityCase):
             with open(os.path.join(d, "tracks.jsonl")) as f:
                 self.assertGreater(len(f.readlines()), 150)
         self.assertEqual(digests[0], digests[1])
+
+
+class Density(CityCase):
+    """The issue's density test: 10 simulated minutes of the dense scene (every agent
+    respawning, SUMO's flows doubled; about a minute of wall time), no contact among the
+    participants and no red light run."""
+
+    def test_ten_minutes_without_a_collision(self):
+        d = os.path.join(self.tmp, "run")
+        args = [CONVOY, "run", "-c", "simulation_config_density.json", "--run-dir", d, "-q"]
+        r = subprocess.run(args, cwd=EXAMPLE, capture_output=True, text=True, timeout=900)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        s = self.summary(d)
+        self.assertAlmostEqual(s["sim_time_s"], 600.0, delta=0.1)
+        self.assertEqual(s["collisions"], [])
+        self.assertEqual(s["red_light_violations"], 0)
+        # dense: all 30 agents came back at least once, and SUMO kept feeding vehicles
+        self.assertGreater(s["participants"]["sumo_vehicles"], 150)
+        with open(os.path.join(d, "tracks.jsonl")) as f:
+            peak = max(len(json.loads(line)["users"]) for line in f)
+        self.assertGreater(peak, 100)
 
 
 class BadInput(CityCase):
