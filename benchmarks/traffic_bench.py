@@ -288,7 +288,7 @@ def section_city(args):
     try:
         env = dict(os.environ, CONVOY_CACHE_DIR=os.path.join(work, "cache"))
         rows = []
-        for i in range(max(args.runs, 2)):
+        for i in range(args.runs + 1):  # the first with an empty cache, then --runs warm
             startup, s = city_run(args, "simulation_config.json", args.city_end,
                                   os.path.join(work, "run%d" % i), env)
             wall = s["loop_wall_s"]
