@@ -36,20 +36,42 @@ bool is_vehicle_class(const std::string& cls) {
   return cls == "car" || cls == "bus" || cls == "truck";
 }
 
-// How far a model's front lies ahead of its origin (along +x), from its collision boxes.
-double half_length(const ModelDesc& model) {
-  double front = 0;
+// A vehicle's front and ground in the frame of its first link (the one tracked), from its
+// collision shapes: how far the front lies ahead (+x), and how high the link's origin is
+// above the lowest point (the tyres' contact).
+VehicleExtent vehicle_extent(const ModelDesc& model) {
+  VehicleExtent e;
+  if (model.links.empty()) return e;
+  const Eigen::Isometry3d to_first = model.links.front().pose.inverse();
+  double front = 0, bottom = 0;
+  bool any = false;
   for (const auto& l : model.links)
     for (const auto& c : l.collisions) {
-      if (c.shape.kind != Shape::kBox) continue;
-      const Eigen::Isometry3d t = l.pose * c.pose;
-      for (int sx : {-1, 1})
-        for (int sy : {-1, 1}) {
-          const Eigen::Vector3d corner(sx * c.shape.size.x() / 2, sy * c.shape.size.y() / 2, 0);
-          front = std::max(front, (t * corner).x());
-        }
+      const Eigen::Isometry3d t = to_first * l.pose * c.pose;
+      if (c.shape.kind == Shape::kBox) {
+        for (int sx : {-1, 1})
+          for (int sy : {-1, 1})
+            for (int sz : {-1, 1}) {
+              const Eigen::Vector3d p = t * Eigen::Vector3d(sx * c.shape.size.x() / 2,
+                                                            sy * c.shape.size.y() / 2,
+                                                            sz * c.shape.size.z() / 2);
+              front = any ? std::max(front, p.x()) : p.x();
+              bottom = any ? std::min(bottom, p.z()) : p.z();
+              any = true;
+            }
+      } else if (c.shape.kind == Shape::kCylinder || c.shape.kind == Shape::kSphere) {
+        const Eigen::Vector3d p = t.translation();
+        const double r = c.shape.size.x();
+        front = any ? std::max(front, p.x() + r) : p.x() + r;
+        bottom = any ? std::min(bottom, p.z() - r) : p.z() - r;
+        any = true;
+      }
     }
-  return front > 0 ? front : 2.0;
+  if (any) {
+    e.front = front > 0 ? front : 2.0;
+    e.height = std::max(0.0, -bottom);
+  }
+  return e;
 }
 
 render::Rgba scaled(const render::Rgba& c, double k) {
@@ -141,8 +163,8 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
           if (&c == cam.desc) cam.own_model = model_id;
     }
     if (!model.is_static && !model.links.empty() && is_vehicle_class(class_of(model)))
-      vehicles_.push_back(
-          {model_id, physics_.link_index(model.links.front().name), -1, half_length(model)});
+      vehicles_.push_back({model_id, physics_.link_index(model.links.front().name), -1,
+                           vehicle_extent(model)});
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
       add_visuals(link, link.pose, label, &tracked);
@@ -227,7 +249,7 @@ int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls) {
   }
   actors_.push_back(std::move(actor));
   const int index = static_cast<int>(actors_.size() - 1);
-  if (is_vehicle_class(cls)) vehicles_.push_back({label, -1, index, half_length(model)});
+  if (is_vehicle_class(cls)) vehicles_.push_back({label, -1, index, vehicle_extent(model)});
   return index;
 }
 
@@ -301,7 +323,7 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
                az = w.sun_azimuth_deg * std::numbers::pi / 180;
   const Eigen::Vector3d to_sun(std::cos(alt) * std::sin(az), std::cos(alt) * std::cos(az),
                                std::sin(alt));
-  const double sun_scale = day * (1.0 - 0.75 * overcast);
+  const double sun_scale = day * (1.0 - 0.65 * overcast);
   bool sun_done = false;
   for (size_t i = 0; i < base_lights_.size(); ++i) {
     render::Light l = base_lights_[i];
@@ -321,27 +343,29 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
   }
   // Headlights at night: the camera's own vehicle (two lamps) and the three nearest others.
   if (w.night) {
-    auto add_lamp = [&](const Eigen::Isometry3d& pose, double front, double side) {
+    // A lamp 0.7 m above the ground at the vehicle's front, aimed 6 degrees down.
+    auto add_lamp = [&](const Eigen::Isometry3d& pose, const VehicleExtent& e, double side) {
       if (static_cast<int>(scene_.lights().size()) >= render::Scene::kMaxLights) return;
       render::Light l;
       l.type = render::Light::kSpot;
-      const Eigen::Vector3d p = pose * Eigen::Vector3d(front + 0.05, side, 0.7);
+      const Eigen::Vector3d p = pose * Eigen::Vector3d(e.front + 0.05, side, 0.7 - e.height);
       const Eigen::Vector3d d = pose.linear() * Eigen::Vector3d(0.995, 0, -0.1).normalized();
       l.position = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
       l.direction = {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())};
-      l.diffuse = {1.6f, 1.5f, 1.3f, 1};
+      l.diffuse = {3.5f, 3.3f, 3.0f, 1};
       l.specular = {0.3f, 0.3f, 0.3f, 1};
       l.range = 80;
       l.attenuation_constant = 1;
       l.attenuation_linear = 0;
-      l.attenuation_quadratic = 0.006f;
+      l.attenuation_quadratic = 0.005f;
       l.spot_inner_angle = 0.35f;
       l.spot_outer_angle = 0.9f;
       l.spot_falloff = 1.0f;
       scene_.add_light(l);
     };
     struct Other {
-      double distance, half_length;
+      double distance;
+      VehicleExtent extent;
       Eigen::Isometry3d pose;
     };
     std::vector<Other> others;
@@ -354,19 +378,20 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
         pose = actors_[v.actor].pose;
       }
       if (v.model_id == cam.own_model) {
-        add_lamp(pose, v.half_length, 0.5);
-        add_lamp(pose, v.half_length, -0.5);
+        add_lamp(pose, v.extent, 0.5);
+        add_lamp(pose, v.extent, -0.5);
       } else {
         const double d = (pose.translation() - camera_pose.translation()).norm();
-        if (d < 80) others.push_back({d, v.half_length, pose});
+        if (d < 80) others.push_back({d, v.extent, pose});
       }
     }
     std::stable_sort(others.begin(), others.end(),
                      [](const Other& a, const Other& b) { return a.distance < b.distance; });
     for (size_t k = 0; k < others.size() && k < 3; ++k)
-      add_lamp(others[k].pose, others[k].half_length, 0.0);
+      add_lamp(others[k].pose, others[k].extent, 0.0);
   }
-  scene_.set_ambient(scaled(base_ambient_, (0.06 + 0.94 * day) * (1.0 - 0.2 * overcast)));
+  // Under clouds the sky's diffuse light makes up for some of the sun's.
+  scene_.set_ambient(scaled(base_ambient_, (0.06 + 0.94 * day) * (1.0 + 0.25 * overcast)));
   // The sky: greyer under clouds, dark at night; in fog, the fog's colour.
   const render::Rgba grey{0.6f, 0.62f, 0.65f, 1};
   const render::Rgba sky = scaled(mixed(base_background_, grey, overcast), 0.03 + 0.97 * day);

@@ -17,6 +17,12 @@
 
 namespace convoy::world {
 
+// A vehicle's front and ground in the frame of its first link: how far the front lies ahead
+// (+x) and how high the link's origin is above the tyres' contact (camera_sensors.cpp).
+struct VehicleExtent {
+  double front = 2.0, height = 0.0;
+};
+
 class CameraSensors {
  public:
   // Builds the scene. The renderer (EGL) starts only if the world has a camera.
@@ -80,13 +86,13 @@ class CameraSensors {
     std::vector<int> instances;  // scene instances of this link's visuals
     std::vector<render::Pose> offsets;
   };
-  // A vehicle that lights the road at night: a world model or an actor of class car, bus or
-  // truck; its front is half_length ahead of its origin along +x.
+  // A vehicle that lights the road at night: a world model (its first link tracked) or an
+  // actor of class car, bus or truck; extent: its front and the ground in that frame.
   struct Vehicle {
     uint32_t model_id;
     int link = -1;   // physics link (world models)
     int actor = -1;  // actor index (actors)
-    double half_length;
+    VehicleExtent extent;
   };
   struct Actor {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();

@@ -182,7 +182,7 @@ void main() {
     // Up-facing surfaces: snow turns them white; water darkens them and mirrors the sky at
     // grazing angles (Schlick's Fresnel term for water).
     float flat_up = smoothstep(0.6, 0.9, dot(n, u_up));
-    color = mix(color, 0.85 * (u_scene_ambient + g_diffuse), u_snow * flat_up);
+    color = mix(color, 0.95 * (u_scene_ambient + g_diffuse), u_snow * flat_up);
     float ndv = max(dot(n, -normalize(p)), 0.0);
     float fresnel = 0.02 + 0.98 * pow(1.0 - ndv, 5.0);
     float w = u_wetness * flat_up;
