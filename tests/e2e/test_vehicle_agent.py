@@ -475,6 +475,9 @@ class Example(AgentCase):
         with open(os.path.join(self.dir, "simulation_config.json")) as f:
             cfg = json.load(f)
         cfg["SimulationTimeout"] = 45.0
+        for fn in cfg["DataPackProcessingFunctions"]:  # shared TFs, relative to the example
+            if fn["FileName"].startswith(".."):
+                fn["FileName"] = os.path.normpath(os.path.join(src, fn["FileName"]))
         for e in cfg["EngineConfigs"]:
             if e["EngineType"] == "vehicle_agent":
                 e["Map"] = CITY
