@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "datapack/camera.h"
 #include "datapack/json.h"
@@ -28,6 +29,59 @@ render::Material to_material(const Material& m) {
   out.ambient = m.ambient;
   out.specular = m.specular;
   out.emissive = m.emissive;
+  return out;
+}
+
+bool is_vehicle_class(const std::string& cls) {
+  return cls == "car" || cls == "bus" || cls == "truck";
+}
+
+// A vehicle's front and ground in the frame of its first link (the one tracked), from its
+// collision shapes: how far the front lies ahead (+x), and how high the link's origin is
+// above the lowest point (the tyres' contact).
+VehicleExtent vehicle_extent(const ModelDesc& model) {
+  VehicleExtent e;
+  if (model.links.empty()) return e;
+  const Eigen::Isometry3d to_first = model.links.front().pose.inverse();
+  double front = 0, bottom = 0;
+  bool any = false;
+  for (const auto& l : model.links)
+    for (const auto& c : l.collisions) {
+      const Eigen::Isometry3d t = to_first * l.pose * c.pose;
+      if (c.shape.kind == Shape::kBox) {
+        for (int sx : {-1, 1})
+          for (int sy : {-1, 1})
+            for (int sz : {-1, 1}) {
+              const Eigen::Vector3d p = t * Eigen::Vector3d(sx * c.shape.size.x() / 2,
+                                                            sy * c.shape.size.y() / 2,
+                                                            sz * c.shape.size.z() / 2);
+              front = any ? std::max(front, p.x()) : p.x();
+              bottom = any ? std::min(bottom, p.z()) : p.z();
+              any = true;
+            }
+      } else if (c.shape.kind == Shape::kCylinder || c.shape.kind == Shape::kSphere) {
+        const Eigen::Vector3d p = t.translation();
+        const double r = c.shape.size.x();
+        front = any ? std::max(front, p.x() + r) : p.x() + r;
+        bottom = any ? std::min(bottom, p.z() - r) : p.z() - r;
+        any = true;
+      }
+    }
+  if (any) {
+    e.front = front > 0 ? front : 2.0;
+    e.height = std::max(0.0, -bottom);
+  }
+  return e;
+}
+
+render::Rgba scaled(const render::Rgba& c, double k) {
+  return {static_cast<float>(c[0] * k), static_cast<float>(c[1] * k), static_cast<float>(c[2] * k),
+          c[3]};
+}
+
+render::Rgba mixed(const render::Rgba& a, const render::Rgba& b, double t) {
+  render::Rgba out = a;
+  for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(a[i] + (b[i] - a[i]) * t);
   return out;
 }
 
@@ -83,10 +137,19 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
     light.attenuation_constant = static_cast<float>(l.constant);
     light.attenuation_linear = static_cast<float>(l.linear);
     light.attenuation_quadratic = static_cast<float>(l.quadratic);
-    if (static_cast<int>(scene_.lights().size()) < render::Scene::kMaxLights)
+    if (static_cast<int>(scene_.lights().size()) < render::Scene::kMaxLights) {
       scene_.add_light(light);
+      street_light_.push_back(l.type != LightDesc::kDirectional &&
+                              (l.name.rfind("street_light", 0) == 0 || l.name.rfind("lamp", 0) == 0));
+    }
   }
-  if (desc.lights.empty()) scene_.add_light(render::Light{});
+  if (desc.lights.empty()) {
+    scene_.add_light(render::Light{});
+    street_light_.push_back(false);
+  }
+  base_lights_ = scene_.lights();
+  base_ambient_ = desc.ambient;
+  base_background_ = desc.background;
   uint32_t model_id = 0;
   for (const auto& model : desc.models) {
     ++model_id;
@@ -99,6 +162,9 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
         for (const auto& c : link.cameras)
           if (&c == cam.desc) cam.own_model = model_id;
     }
+    if (!model.is_static && !model.links.empty() && is_vehicle_class(class_of(model)))
+      vehicles_.push_back({model_id, physics_.link_index(model.links.front().name), -1,
+                           vehicle_extent(model)});
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
       add_visuals(link, link.pose, label, &tracked);
@@ -182,18 +248,22 @@ int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls) {
     actor.link_poses.insert(actor.link_poses.end(), tracked.instances.size(), link.pose);
   }
   actors_.push_back(std::move(actor));
-  return static_cast<int>(actors_.size() - 1);
+  const int index = static_cast<int>(actors_.size() - 1);
+  if (is_vehicle_class(cls)) vehicles_.push_back({label, -1, index, vehicle_extent(model)});
+  return index;
 }
 
 void CameraSensors::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
   if (actor < 0) return;
-  const Actor& a = actors_[actor];
+  Actor& a = actors_[actor];
+  a.pose = pose;
   for (size_t k = 0; k < a.instances.size(); ++k)
     scene_.set_pose(a.instances[k], render::compose(to_pose(pose * a.link_poses[k]), a.offsets[k]));
 }
 
 void CameraSensors::set_actor_visible(int actor, bool visible) {
   if (actor < 0) return;
+  actors_[actor].visible = visible;
   for (int inst : actors_[actor].instances) scene_.set_visible(inst, visible);
 }
 
@@ -225,13 +295,124 @@ void CameraSensors::update(double t) {
 void CameraSensors::render(Camera& cam) {
   const CameraDesc& d = *cam.desc;
   render::CameraSpec spec{d.width, d.height, d.hfov, d.near_clip, d.far_clip};
-  render::Pose pose = to_pose(physics_.link_pose(cam.link) * d.pose);
+  const Eigen::Isometry3d camera_pose = physics_.link_pose(cam.link) * d.pose;
+  if (has_weather_) apply_weather(cam, camera_pose);
+  render::Pose pose = to_pose(camera_pose);
   renderer_->render(scene_, pose, spec, &cam.frame, cam.want_depth, cam.want_boxes);
   ++cam.frames;
   cam.has_depth = cam.want_depth;
   cam.has_boxes = cam.want_boxes;
   draw_noise(cam);
   cam.rendered = true;
+}
+
+void CameraSensors::set_weather(const Weather& weather) {
+  weather_ = weather;
+  has_weather_ = true;
+}
+
+void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& camera_pose) {
+  const Weather& w = weather_;
+  const double day = std::clamp(w.daylight, 0.0, 1.0);
+  const double fog_amount = std::clamp((1000.0 - w.visibility_m) / 800.0, 0.0, 1.0);
+  const double overcast = std::clamp(std::max(1.5 * w.precipitation, fog_amount), 0.0, 1.0);
+  // The sun (the world's first directional light) from its altitude and azimuth; dimmed by
+  // clouds, gone at night. Other directional lights dim with it.
+  scene_.clear_lights();
+  const double alt = w.sun_altitude_deg * std::numbers::pi / 180,
+               az = w.sun_azimuth_deg * std::numbers::pi / 180;
+  const Eigen::Vector3d to_sun(std::cos(alt) * std::sin(az), std::cos(alt) * std::cos(az),
+                               std::sin(alt));
+  const double sun_scale = day * (1.0 - 0.65 * overcast);
+  bool sun_done = false;
+  for (size_t i = 0; i < base_lights_.size(); ++i) {
+    render::Light l = base_lights_[i];
+    if (l.type == render::Light::kDirectional) {
+      if (!sun_done) {
+        l.direction = {static_cast<float>(-to_sun.x()), static_cast<float>(-to_sun.y()),
+                       static_cast<float>(-to_sun.z())};
+        sun_done = true;
+      }
+      if (sun_scale <= 0.001) continue;
+      l.diffuse = scaled(l.diffuse, sun_scale);
+      l.specular = scaled(l.specular, sun_scale);
+    } else if (street_light_[i] && day > 0.5) {
+      continue;  // street lights are off by day
+    }
+    scene_.add_light(l);
+  }
+  // Headlights at night: the camera's own vehicle (two lamps) and the three nearest others.
+  if (w.night) {
+    // A lamp 0.7 m above the ground at the vehicle's front, aimed 6 degrees down.
+    auto add_lamp = [&](const Eigen::Isometry3d& pose, const VehicleExtent& e, double side) {
+      if (static_cast<int>(scene_.lights().size()) >= render::Scene::kMaxLights) return;
+      render::Light l;
+      l.type = render::Light::kSpot;
+      const Eigen::Vector3d p = pose * Eigen::Vector3d(e.front + 0.05, side, 0.7 - e.height);
+      const Eigen::Vector3d d = pose.linear() * Eigen::Vector3d(0.995, 0, -0.1).normalized();
+      l.position = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      l.direction = {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())};
+      l.diffuse = {3.5f, 3.3f, 3.0f, 1};
+      l.specular = {0.3f, 0.3f, 0.3f, 1};
+      l.range = 80;
+      l.attenuation_constant = 1;
+      l.attenuation_linear = 0;
+      l.attenuation_quadratic = 0.005f;
+      l.spot_inner_angle = 0.35f;
+      l.spot_outer_angle = 0.9f;
+      l.spot_falloff = 1.0f;
+      scene_.add_light(l);
+    };
+    struct Other {
+      double distance;
+      VehicleExtent extent;
+      Eigen::Isometry3d pose;
+    };
+    std::vector<Other> others;
+    for (const Vehicle& v : vehicles_) {
+      Eigen::Isometry3d pose;
+      if (v.link >= 0) {
+        pose = physics_.link_pose(v.link);
+      } else {
+        if (!actors_[v.actor].visible) continue;
+        pose = actors_[v.actor].pose;
+      }
+      if (v.model_id == cam.own_model) {
+        add_lamp(pose, v.extent, 0.5);
+        add_lamp(pose, v.extent, -0.5);
+      } else {
+        const double d = (pose.translation() - camera_pose.translation()).norm();
+        if (d < 80) others.push_back({d, v.extent, pose});
+      }
+    }
+    std::stable_sort(others.begin(), others.end(),
+                     [](const Other& a, const Other& b) { return a.distance < b.distance; });
+    for (size_t k = 0; k < others.size() && k < 3; ++k)
+      add_lamp(others[k].pose, others[k].extent, 0.0);
+  }
+  // Under clouds the sky's diffuse light makes up for some of the sun's.
+  scene_.set_ambient(scaled(base_ambient_, (0.06 + 0.94 * day) * (1.0 + 0.25 * overcast)));
+  // The sky: greyer under clouds, dark at night; in fog, the fog's colour.
+  const render::Rgba grey{0.6f, 0.62f, 0.65f, 1};
+  const render::Rgba sky = scaled(mixed(base_background_, grey, overcast), 0.03 + 0.97 * day);
+  const render::Rgba fog = scaled(render::Rgba{0.75f, 0.77f, 0.8f, 1}, 0.04 + 0.96 * day);
+  render::Atmosphere a;
+  const bool foggy = std::isfinite(w.visibility_m) && w.visibility_m < 1e6;
+  a.visibility = foggy ? static_cast<float>(w.visibility_m) : std::numeric_limits<float>::infinity();
+  a.fog_color = fog;
+  a.wetness = static_cast<float>(w.wetness);
+  a.snow_cover = static_cast<float>(w.snow_cover);
+  a.sky = sky;
+  a.precipitation = static_cast<float>(w.precipitation);
+  a.snow = w.snow;
+  // Drops fall at about 7 m/s, flakes at 1 m/s; the wind across the image slants them.
+  const Eigen::Vector3d left = camera_pose.linear() * Eigen::Vector3d::UnitY();
+  const double across = -(w.wind_x * left.x() + w.wind_y * left.y());  // towards image right
+  a.fall_slant = static_cast<float>(std::clamp(across / (w.snow ? 1.0 : 7.0), -1.5, 1.5));
+  a.seed = static_cast<uint32_t>(w.seed ^ (w.seed >> 32));
+  a.time = now_;
+  scene_.set_atmosphere(a);
+  scene_.set_background(foggy ? mixed(fog, sky, std::exp(-3.912 * 1000.0 / w.visibility_m)) : sky);
 }
 
 void CameraSensors::first_render(Camera& cam) {
@@ -307,6 +488,11 @@ void CameraSensors::depth_datapack(size_t i, datapack::Builder& out) {
                              {"depth", datapack::ndarray_json(out, "<f4", shape, bytes)}});
 }
 
+double CameraSensors::visibility(double distance) const {
+  if (!has_weather_ || !std::isfinite(weather_.visibility_m) || !std::isfinite(distance)) return 1.0;
+  return std::exp(-3.912 * distance / weather_.visibility_m);
+}
+
 void CameraSensors::boxes_datapack(size_t i, datapack::Builder& out) {
   Camera& cam = cameras_[i];
   cam.want_boxes = true;
@@ -324,7 +510,9 @@ void CameraSensors::boxes_datapack(size_t i, datapack::Builder& out) {
                      {"y_min", b.y_min},
                      {"x_max", b.x_max},
                      {"y_max", b.y_max},
-                     {"pixels", b.pixel_count}});
+                     {"pixels", b.pixel_count},
+                     {"distance", std::isfinite(b.distance) ? b.distance : -1.0f},
+                     {"visibility", visibility(b.distance)}});
   }
   datapack::write_json(
       out, {{"width", cam.frame.width}, {"height", cam.frame.height}, {"boxes", boxes}});

@@ -12,9 +12,16 @@
 #include "datapack/datapack.h"
 #include "physics_world.h"
 #include "render/renderer.h"
+#include "weather_effects.h"
 #include "world_description.h"
 
 namespace convoy::world {
+
+// A vehicle's front and ground in the frame of its first link: how far the front lies ahead
+// (+x) and how high the link's origin is above the tyres' contact (camera_sensors.cpp).
+struct VehicleExtent {
+  double front = 2.0, height = 0.0;
+};
 
 class CameraSensors {
  public:
@@ -39,14 +46,23 @@ class CameraSensors {
   void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
   void set_actor_visible(int actor, bool visible);
 
+  // The weather from now on (see weather_effects.h): the sun, the sky, fog, wet or snowy
+  // ground, rain or snow over the image, and at night the vehicles' headlights and the street
+  // lights (the world's point and spot lights named street_light* or lamp*), which are off by
+  // day. Until the first call the world's own lights and sky hold.
+  void set_weather(const Weather& weather);
+
   // The latest frame as a convoy.data.Camera datapack.
   void image_datapack(size_t i, datapack::Builder& out);
   // The latest depth image (metres, float32, H x W) as a JSON datapack
   // {"width", "height", "depth": ndarray}.
   void depth_datapack(size_t i, datapack::Builder& out);
   // The latest ground truth as a JSON datapack: {"boxes": [{"model", "class", "instance",
-  // "x_min", "y_min", "x_max", "y_max", "pixels"}...]}: every visible model but the ground
-  // and the camera's own.
+  // "x_min", "y_min", "x_max", "y_max", "pixels", "distance", "visibility"}...]}: every
+  // visible model but the ground and the camera's own. distance: metres from the camera to
+  // the model's nearest visible part's centre; visibility: the share of its contrast the fog
+  // leaves, exp(-3.912 distance / visibility_m) (1 without fog).
+  double visibility(double distance) const;
   void boxes_datapack(size_t i, datapack::Builder& out);
 
  private:
@@ -70,12 +86,24 @@ class CameraSensors {
     std::vector<int> instances;  // scene instances of this link's visuals
     std::vector<render::Pose> offsets;
   };
+  // A vehicle that lights the road at night: a world model (its first link tracked) or an
+  // actor of class car, bus or truck; extent: its front and the ground in that frame.
+  struct Vehicle {
+    uint32_t model_id;
+    int link = -1;   // physics link (world models)
+    int actor = -1;  // actor index (actors)
+    VehicleExtent extent;
+  };
   struct Actor {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    bool visible = false;
     std::vector<int> instances;
     std::vector<render::Pose> offsets;          // each instance in its link's frame
     std::vector<Eigen::Isometry3d> link_poses;  // its link in the actor's frame
   };
   void build_scene(const WorldDesc& desc);
+  // The scene's lights, sky and atmosphere for camera `cam` under weather_.
+  void apply_weather(const Camera& cam, const Eigen::Isometry3d& camera_pose);
   // Adds the scene instances of a link's visuals, the link placed at `placement`, labelled
   // `label` (0: no ground truth), into `tracked`.
   void add_visuals(const LinkDesc& link, const Eigen::Isometry3d& placement, uint32_t label,
@@ -94,7 +122,13 @@ class CameraSensors {
   std::vector<Actor> actors_;
   std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
   std::mt19937_64 rng_;
-  double now_ = 0;  // simulated time of the last update()
+  double now_ = 0;
+  std::vector<render::Light> base_lights_;
+  std::vector<bool> street_light_;  // by base light
+  render::Rgba base_ambient_{}, base_background_{};
+  std::vector<Vehicle> vehicles_;
+  bool has_weather_ = false;
+  Weather weather_;  // simulated time of the last update()
 };
 
 }  // namespace convoy::world

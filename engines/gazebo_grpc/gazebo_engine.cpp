@@ -18,6 +18,12 @@
 // A joint datapack sent to the engine sets the joint's PID target: its position for a
 // position controller, its velocity for a velocity controller; a non-zero effort is added
 // as a feed-forward effort.
+//   <brake plugin>::<joint>  GazeboJointDataPack, read and write (ConvoyBrakePlugin.so, see
+//                       world_description.h): the effort written is the brake torque (Nm,
+//                       0..MaxTorque); the effort read is the torque the ABS applies. While a
+//                       wheel brakes, its joint controller (if any) is idle.
+//   <WeatherDataPack> ("weather")  the weather engine's JSON, written: applied to the cameras
+//                       and to the wheels' friction and the wind (docs/weather.md).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +31,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <optional>
 #include <set>
 #include <unordered_map>
 
@@ -85,6 +92,7 @@ class GazeboEngine final : public Engine {
     seed_ = config.value("GazeboRNGSeed", 0u);
     actor_timeout_ = config.value("ActorTimeout", 1.0);
     actor_table_ = config.value("ActorModels", std::string());
+    weather_dp_ = config.value("WeatherDataPack", std::string("weather"));
     rng_.seed(seed_);
     const auto t0 = std::chrono::steady_clock::now();
     world::CacheResult cache;
@@ -118,6 +126,22 @@ class GazeboEngine final : public Engine {
             joint_dps_[n] = controllers_.size() - 1;
             add(n, datapack::type_name<data::Joint>());
           }
+        }
+      }
+      for (const auto& bp : model.brake_plugins) {
+        for (const auto& b : bp.brakes) {
+          Brake brake;
+          brake.joint = physics_->joint_index(b.joint);
+          if (brake.joint < 0)
+            throw std::runtime_error("brake plugin '" + bp.name + "': joint '" + b.joint +
+                                     "' has no degree of freedom");
+          brake.max_torque = b.max_torque;
+          brake.abs = bp.abs;
+          brake.slip = bp.slip;
+          brakes_.push_back(brake);
+          const std::string n = bp.name + "::" + b.joint.substr(model.name.size() + 2);
+          brake_dps_[n] = brakes_.size() - 1;
+          add(n, datapack::type_name<data::Joint>());
         }
       }
       for (const auto& plugin : model.link_plugins) {
@@ -187,6 +211,8 @@ class GazeboEngine final : public Engine {
     pending_.clear();
     contacts_.clear();
     collisions_ = nlohmann::json::array();
+    for (auto& b : brakes_) b.command = b.applied = b.last_command = b.last_omega = 0;
+    if (weather_) apply_weather(*weather_);
     for (auto& e : egos_) {
       e.speed = 0;
       e.speed_ns = -1;
@@ -205,7 +231,13 @@ class GazeboEngine final : public Engine {
     physics_steps_ += n;
     apply_road_users();
     for (int64_t k = 0; k < n; ++k) {
+      update_brakes(dt);
       for (auto& c : controllers_) {
+        if (braking(c.joint)) {
+          physics_->set_joint_effort(c.joint, 0.0);
+          c.pid.reset();
+          continue;
+        }
         auto s = physics_->joint_state(c.joint);
         double error = (c.velocity ? s.velocity : s.position) - c.target;
         physics_->set_joint_effort(c.joint, c.pid.update(error, dt) + c.feed_forward);
@@ -219,6 +251,23 @@ class GazeboEngine final : public Engine {
   }
 
   void set_datapack(const datapack::View& dp) override {
+    if (dp.id().name() == weather_dp_) {
+      take_weather(dp);
+      return;
+    }
+    if (auto b = brake_dps_.find(dp.id().name()); b != brake_dps_.end()) {
+      if (dp.empty()) return;
+      if (dp.proto_type() != datapack::type_name<data::Joint>())
+        throw std::runtime_error("datapack '" + dp.id().name() + "' must be a GazeboJointDataPack");
+      const double torque = datapack::read_proto<data::Joint>(dp).effort();
+      Brake& brake = brakes_[b->second];
+      if (!(torque >= 0))
+        throw std::runtime_error("engine '" + name_ + "': datapack '" + dp.id().name() +
+                                 "': the brake torque (effort) must be >= 0 Nm, got " +
+                                 std::to_string(torque));
+      brake.command = std::min(torque, brake.max_torque);
+      return;
+    }
     auto it = joint_dps_.find(dp.id().name());
     if (it == joint_dps_.end() && take_road_users(dp)) return;
     if (it == joint_dps_.end()) {
@@ -262,6 +311,16 @@ class GazeboEngine final : public Engine {
       sent_frames_[id.name()] = cameras_->frames(index);
       return;
     }
+    if (auto it = brake_dps_.find(id.name()); it != brake_dps_.end()) {
+      const Brake& b = brakes_[it->second];
+      auto s = physics_->joint_state(b.joint);
+      data::Joint j;
+      j.set_position(static_cast<float>(s.position));
+      j.set_velocity(static_cast<float>(s.velocity));
+      j.set_effort(static_cast<float>(b.applied));
+      datapack::write_proto(out, j);
+      return;
+    }
     if (auto it = joint_dps_.find(id.name()); it != joint_dps_.end()) {
       const auto& c = controllers_[it->second];
       auto s = physics_->joint_state(c.joint);
@@ -285,6 +344,111 @@ class GazeboEngine final : public Engine {
   }
 
  private:
+  // --- Weather and brakes -------------------------------------------------------------------
+  struct Brake {
+    int joint = -1;
+    double max_torque = 0, slip = 0.15;
+    bool abs = true;
+    double command = 0, applied = 0;  // Nm
+    double radius = -1;               // m; -1: not yet found
+    double last_command = 0;          // in the previous physics step
+    double last_omega = 0;            // the wheel's spin (rad/s, forward) in the previous step
+    double integral = 0;  // ABS: the PI controller's integral torque
+  };
+
+  void take_weather(const datapack::View& dp) {
+    if (dp.empty()) return;
+    auto where = [&] { return "engine '" + name_ + "': datapack '" + dp.id().name() + "': "; };
+    if (!dp.is_json()) throw std::runtime_error(where() + "expected the weather engine's JSON");
+    try {
+      weather_ = world::weather_from_json(datapack::read_json(dp));
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(where() + e.what());
+    }
+    apply_weather(*weather_);
+  }
+
+  void apply_weather(const world::Weather& w) {
+    physics_->set_wheel_friction(w.mu);
+    physics_->set_wind(Eigen::Vector3d(w.wind_x, w.wind_y, 0.0));
+    cameras_->set_weather(w);
+  }
+
+  bool braking(int joint) const {
+    for (const auto& b : brakes_)
+      if (b.joint == joint && b.command > 0) return true;
+    return false;
+  }
+
+  // ABS: a PI controller per wheel holds its longitudinal slip at the target (<slip>). The
+  // brake starts at the full command; while the wheel slips more than the target the torque
+  // falls, while it slips less the torque rises, never above the command. Near the target
+  // the tyre slides at its full grip (Coulomb friction), and the wheel never locks. While a
+  // wheel over the target spins up again, the integral holds (as an ABS holds its pressure
+  // once the wheel accelerates).
+  // The gains place the slip loop's poles at 30 rad/s (damping 0.7) at 10 m/s, from the
+  // wheel's inertia I and radius r: slip' = r / (v I) (brake torque - road torque). Below
+  // 2 m/s, or without ABS, the full command applies.
+  void update_brakes(double dt) {
+    for (auto& b : brakes_) {
+      const double command_before = b.last_command;
+      b.last_command = b.command;
+      if (b.command <= 0) {
+        b.applied = 0;
+        physics_->set_joint_brake(b.joint, 0.0);
+        continue;
+      }
+      const auto* wheel = physics_->joint_child(b.joint);
+      const Eigen::Vector3d axis = physics_->joint_axis_world(b.joint);
+      Eigen::Vector3d rolling = axis.cross(Eigen::Vector3d::UnitZ());
+      const double n = rolling.norm();
+      const double radius = wheel_radius(b);
+      double v = 0, w = 0;
+      if (n > 1e-6 && radius > 0) {
+        rolling /= n;
+        v = wheel->getLinearVelocity().dot(rolling);  // ground speed along the wheel's path
+        w = wheel->getAngularVelocity().dot(axis);
+        if (v < 0) {  // forward is where it travels
+          v = -v;
+          w = -w;
+        }
+      }
+      const double slip = v > 1e-3 ? (v - w * radius) / v : 0.0;
+      if (command_before <= 0) b.integral = b.command;  // brakes just pressed
+      if (!b.abs || v < 2.0 || radius <= 0) {
+        b.applied = b.command;
+      } else {
+        const double inertia = std::max(axis.dot(wheel->getInertia().getMoment() * axis), 1e-3);
+        const double wn = 30.0, zeta = 0.7, v_ref = 10.0;
+        const double ki = wn * wn * v_ref * inertia / radius;
+        const double kp = 2 * zeta * wn * v_ref * inertia / radius;
+        const double e = slip - b.slip;
+        // Over the target but the wheel already spinning up: the torque is under the grip
+        // already, and lowering it further would only lose braking.
+        const bool recovering = e > 0 && w > b.last_omega;
+        if (!recovering) b.integral = std::clamp(b.integral - ki * e * dt, 0.0, b.command);
+        b.applied = std::clamp(b.integral - kp * e, 0.0, b.command);
+      }
+      b.last_omega = w;
+      physics_->set_joint_brake(b.joint, b.applied);
+    }
+  }
+
+  // A braked wheel's radius: its collision cylinder's or sphere's (0: none).
+  double wheel_radius(Brake& b) {
+    if (b.radius >= 0) return b.radius;
+    b.radius = 0;
+    const auto* body = physics_->joint_child(b.joint);
+    for (const auto* node : body->getShapeNodesWith<dart::dynamics::CollisionAspect>()) {
+      const auto* shape = node->getShape().get();
+      if (auto* c = dynamic_cast<const dart::dynamics::CylinderShape*>(shape))
+        b.radius = std::max(b.radius, c->getRadius());
+      else if (auto* sp = dynamic_cast<const dart::dynamics::SphereShape*>(shape))
+        b.radius = std::max(b.radius, sp->getRadius());
+    }
+    return b.radius;
+  }
+
   // --- Road users as actors ---------------------------------------------------------------
 
   // A RoadUser / RoadUsers datapack (protobuf or JSON): its users wait for the next step.
@@ -632,6 +796,10 @@ class GazeboEngine final : public Engine {
   enum CameraOutput { kImage, kDepth, kBoxes };
   std::unordered_map<std::string, std::pair<size_t, CameraOutput>> camera_dps_;
   std::vector<Controller> controllers_;
+  std::vector<Brake> brakes_;
+  std::unordered_map<std::string, size_t> brake_dps_;
+  std::string weather_dp_ = "weather";
+  std::optional<world::Weather> weather_;
   std::unordered_map<std::string, size_t> joint_dps_;
   std::unordered_map<std::string, int> link_dps_;
   std::mt19937_64 rng_;

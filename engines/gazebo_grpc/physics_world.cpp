@@ -388,7 +388,7 @@ void PhysicsWorld::add_link(const std::string& name, dd::BodyNode* body,
 }
 
 void PhysicsWorld::add_joint(const std::string& name, dd::Joint* joint) {
-  joints_.push_back({name, joint, 0});
+  joints_.push_back({name, joint, 0, joint->getNumDofs() > 0 ? joint->getCoulombFriction(0) : 0.0});
   joint_by_name_[name] = static_cast<int>(joints_.size() - 1);
 }
 
@@ -412,6 +412,51 @@ void PhysicsWorld::add_skeleton(const dd::SkeletonPtr& skel, const ModelDesc& mo
       moving_.push_back({bn, farthest_corner(box)});
     }
   }
+  // Wheels and vehicles, for the weather.
+  if (scenery || model.is_static) return;
+  bool has_wheels = false;
+  for (size_t b = 0; b < skel->getNumBodyNodes(); ++b) {
+    dd::BodyNode* bn = skel->getBodyNode(b);
+    if (!dynamic_cast<dd::RevoluteJoint*>(bn->getParentJoint())) continue;
+    for (dd::ShapeNode* node : bn->getShapeNodesWith<dd::CollisionAspect>()) {
+      if (auto* dyn = node->getDynamicsAspect()) {
+        wheels_.push_back({node, dyn->getFrictionCoeff()});
+        has_wheels = true;
+      }
+    }
+  }
+  if (has_wheels) {
+    dd::BodyNode* root = skel->getRootBodyNode();
+    const Eigen::AlignedBox3d box = collision_box(root);
+    const Eigen::Vector3d size = box.isEmpty() ? Eigen::Vector3d(4.0, 1.8, 1.5) : box.sizes();
+    vehicles_.push_back({root, size.y() * size.z(), size.x() * size.z()});
+  }
+}
+
+void PhysicsWorld::set_wheel_friction(double mu) {
+  for (auto& w : wheels_) w.shape->getDynamicsAspect()->setFrictionCoeff(mu * w.sdf_mu);
+}
+
+void PhysicsWorld::set_wind(const Eigen::Vector3d& wind) { wind_ = wind; }
+
+Eigen::Vector3d PhysicsWorld::wind_force(int vehicle) const { return vehicles_[vehicle].force; }
+
+void PhysicsWorld::set_joint_brake(int index, double torque) {
+  JointRef& j = joints_[index];
+  j.joint->setCoulombFriction(0, j.base_friction + std::max(0.0, torque));
+}
+
+dd::BodyNode* PhysicsWorld::joint_child(int index) const {
+  return joints_[index].joint->getChildBodyNode();
+}
+
+Eigen::Vector3d PhysicsWorld::joint_axis_world(int index) const {
+  const dd::Joint* j = joints_[index].joint;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  if (auto* r = dynamic_cast<const dd::RevoluteJoint*>(j)) axis = r->getAxis();
+  // The axis is in the child's frame (DART: the joint frame of the child).
+  return j->getChildBodyNode()->getWorldTransform().linear() *
+         (j->getTransformFromChildBodyNode().linear() * axis);
 }
 
 void PhysicsWorld::gate_scenery() {
@@ -446,6 +491,18 @@ void PhysicsWorld::step() {
     if (j.effort != 0) j.joint->setForce(0, j.effort);
   }
   if (steps_++ % gate_every_ == 0) gate_scenery();
+  for (auto& v : vehicles_) {
+    v.force.setZero();
+    if (wind_.squaredNorm() == 0) continue;
+    // 1/2 rho |w| Cd A w per body axis (air density 1.225 kg/m^3).
+    const Eigen::Matrix3d r = v.root->getWorldTransform().linear();
+    const Eigen::Vector3d w = r.transpose() * wind_;
+    const double q = 0.5 * 1.225 * wind_.norm();
+    const Eigen::Vector3d f_body(q * 0.4 * v.area_x * w.x(), q * 1.0 * v.area_y * w.y(), 0.0);
+    v.force = r * f_body;
+    v.root->addExtForce(v.force, v.root->getLocalCOM(), /*isForceLocal=*/false,
+                        /*isOffsetLocal=*/true);
+  }
   world_->step();
 }
 

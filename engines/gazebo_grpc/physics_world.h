@@ -51,6 +51,26 @@ class PhysicsWorld {
 
   dart::simulation::WorldPtr dart_world() const { return world_; }
 
+  // --- Weather and brakes --------------------------------------------------------------------
+  // Tyre-road friction: every collision shape of a wheel (a body with collision shapes on a
+  // revolute joint of a moving model) gets friction coefficient mu times its SDF <mu> (1 for
+  // the smart car). DART takes the lesser of two touching shapes' coefficients, so a road
+  // with <mu> 1 leaves the tyre's. Before any call the SDF's values hold.
+  void set_wheel_friction(double mu);
+  int wheel_count() const { return static_cast<int>(wheels_.size()); }
+  // Wind (m/s, world frame): each moving model with wheels is pushed at its root body's
+  // centre of mass by 1/2 rho |w| (Cd_x A_x w_x, Cd_y A_y w_y) in the body's frame (areas from
+  // its collision box; Cd 0.4 head-on, 1.0 sideways), every step. Not the drag of the
+  // vehicle's own motion: still air pushes nothing.
+  void set_wind(const Eigen::Vector3d& wind);
+  Eigen::Vector3d wind_force(int vehicle) const;  // the push on vehicle i in the last step (N)
+  // A brake: Coulomb friction torque (Nm) on the joint's first axis, on top of the SDF's
+  // <friction>, until changed. It holds a stopped wheel, as a brake does.
+  void set_joint_brake(int index, double torque);
+  // The joint's child body (the wheel) and its axis in the world frame.
+  dart::dynamics::BodyNode* joint_child(int index) const;
+  Eigen::Vector3d joint_axis_world(int index) const;
+
   // Actors: road users posed from outside. Each is one immobile body on a free joint with
   // the collision shapes of `model` (link poses in the actor's frame): the physically
   // simulated models collide with it; it does not move in response. Returns its index.
@@ -74,7 +94,20 @@ class PhysicsWorld {
     std::string name;
     dart::dynamics::Joint* joint = nullptr;
     double effort = 0;
+    double base_friction = 0;  // the SDF's <friction> on the first axis
   };
+  struct Wheel {
+    dart::dynamics::ShapeNode* shape;
+    double sdf_mu;
+  };
+  struct Vehicle {
+    dart::dynamics::BodyNode* root;
+    double area_x, area_y;  // m^2: frontal (facing +x) and side
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  };
+  std::vector<Wheel> wheels_;
+  std::vector<Vehicle> vehicles_;
+  Eigen::Vector3d wind_ = Eigen::Vector3d::Zero();
   // Builds a model's skeleton (none for a static model with neither collisions nor cameras)
   // and registers its links and movable joints.
   void build_model(const ModelDesc& model);

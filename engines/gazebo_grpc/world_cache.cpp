@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '2'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '3'};  // bump on format change
 
 // --- Binary writer and reader -------------------------------------------------------------
 
@@ -226,6 +226,17 @@ void put(Writer& w, const ModelDesc& m) {
   }
   w.size(m.link_plugins.size());
   for (const auto& p : m.link_plugins) w.str(p);
+  w.size(m.brake_plugins.size());
+  for (const auto& b : m.brake_plugins) {
+    w.str(b.name);
+    w.pod<uint8_t>(b.abs);
+    w.pod(b.slip);
+    w.size(b.brakes.size());
+    for (const auto& k : b.brakes) {
+      w.str(k.joint);
+      w.pod(k.max_torque);
+    }
+  }
 }
 void get(Reader& r, ModelDesc& m) {
   m.name = r.str();
@@ -264,6 +275,17 @@ void get(Reader& r, ModelDesc& m) {
   }
   m.link_plugins.resize(r.size());
   for (auto& p : m.link_plugins) p = r.str();
+  m.brake_plugins.resize(r.size());
+  for (auto& b : m.brake_plugins) {
+    b.name = r.str();
+    b.abs = r.pod<uint8_t>() != 0;
+    b.slip = r.pod<double>();
+    b.brakes.resize(r.size());
+    for (auto& k : b.brakes) {
+      k.joint = r.str();
+      k.max_torque = r.pod<double>();
+    }
+  }
 }
 
 // --- Keys ---------------------------------------------------------------------------------

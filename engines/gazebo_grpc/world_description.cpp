@@ -232,6 +232,47 @@ class Loader {
           pids.push_back(pid);
         }
         model->joint_plugins.emplace_back(name, std::move(pids));
+      } else if (filename.find("ConvoyBrakePlugin") != std::string::npos) {
+        BrakePluginDesc bp;
+        bp.name = name;
+        for (auto j = p->GetFirstElement(); j; j = j->GetNextElement()) {
+          const std::string tag = j->GetName();
+          auto number = [&](const std::string& text, const std::string& what) {
+            try {
+              size_t used = 0;
+              double v = std::stod(text, &used);
+              if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
+              return v;
+            } catch (const std::exception&) {
+              throw std::runtime_error(file_.string() + ": " + where + ": " + what + " '" + text +
+                                       "' is not a number");
+            }
+          };
+          if (tag == "abs") {
+            const std::string v = j->GetValue() ? j->GetValue()->GetAsString() : "";
+            if (v != "true" && v != "false" && v != "1" && v != "0")
+              throw std::runtime_error(file_.string() + ": " + where + ": <abs> must be true or false, got '" + v + "'");
+            bp.abs = v == "true" || v == "1";
+          } else if (tag == "slip") {
+            bp.slip = number(j->GetValue() ? j->GetValue()->GetAsString() : "", "<slip>");
+            if (!(bp.slip > 0 && bp.slip < 1))
+              throw std::runtime_error(file_.string() + ": " + where + ": <slip> must be in (0, 1)");
+          } else {
+            BrakeDesc b;
+            b.joint = model_name + "::" + tag;
+            bool known = false;
+            for (const auto& jd : model->joints) known |= jd.name == b.joint;
+            if (!known)
+              throw std::runtime_error(file_.string() + ": " + where + ": unknown joint '" + tag + "'");
+            const std::string t = attr(j, "MaxTorque");
+            if (!t.empty()) b.max_torque = number(t, "joint '" + tag + "': MaxTorque");
+            if (!(b.max_torque > 0))
+              throw std::runtime_error(file_.string() + ": " + where + ": joint '" + tag +
+                                       "': MaxTorque must be > 0");
+            bp.brakes.push_back(b);
+          }
+        }
+        model->brake_plugins.push_back(std::move(bp));
       } else if (filename == "convoy_class") {
         std::string cls = p->HasElement("class") ? p->Get<std::string>("class") : "";
         if (!is_known_class(cls)) {

@@ -90,6 +90,24 @@ struct PidDesc {
   bool velocity = false;  // Type: velocity, else position
 };
 
+// A brake plugin (Convoy's own):
+//   <plugin name="smart_car_brake_plugin" filename="ConvoyBrakePlugin.so">
+//     <abs>true</abs> <slip>0.15</slip>                  (optional; these are the defaults)
+//     <front_left_wheel_joint MaxTorque="1500"/> ...     (Nm; default 1500)
+//   </plugin>
+// Each named joint gets a brake commanded through the datapack <plugin>::<joint> (a
+// GazeboJointDataPack whose effort is the brake torque, Nm).
+struct BrakeDesc {
+  std::string joint;  // scoped
+  double max_torque = 1500;
+};
+struct BrakePluginDesc {
+  std::string name;
+  bool abs = true;
+  double slip = 0.15;  // ABS target: longitudinal slip kept below this
+  std::vector<BrakeDesc> brakes;
+};
+
 struct ModelDesc {
   std::string name;
   // Ground-truth class, from the model's annotation
@@ -102,6 +120,7 @@ struct ModelDesc {
   std::vector<JointDesc> joints;
   std::vector<std::pair<std::string, std::vector<PidDesc>>> joint_plugins;  // plugin name
   std::vector<std::string> link_plugins;                                    // plugin names
+  std::vector<BrakePluginDesc> brake_plugins;
 };
 
 struct LightDesc {

@@ -10,7 +10,8 @@
 // Config keys (schema.json): Map, Route {from, to} ("ROAD:LANE") or Seed, StartS,
 // InitialSpeed, Model, Category, Length, Width, Height, Wheelbase, v0, SpeedLimitFactor, T,
 // s0, a, b, delta, MaxDeceleration, politeness, threshold, b_safe, LaneChanges, ReactionTime,
-// NeighbourRadius, StateDataPack, NeighboursDataPack, TrafficLightsDataPack.
+// NeighbourRadius, StateDataPack, NeighboursDataPack, TrafficLightsDataPack, WeatherDataPack,
+// WeatherAdaptation.
 //
 // Datapacks written:
 //   <StateDataPack> ("state")  convoy.data.RoadUser: its state after each step, with
@@ -21,6 +22,13 @@
 //                    users around it (its own id is skipped).
 //   <TrafficLightsDataPack> ("traffic_lights")  JSON {"time_ns", "signals": {"<signal id>":
 //                    "red"|"yellow"|"green"|"red_yellow"|"off"}}; a missing signal is green.
+//   <WeatherDataPack> ("weather")  optional: the weather engine's JSON. With WeatherAdaptation
+//                    (default on) it drives as people do in bad weather (docs/weather.md):
+//                    on a road of friction mu (0.8 dry) its desired speed is
+//                    x (1 - 0.4 (1 - mu/0.8)) and its time headway T x (1 + 0.5 (1 - mu/0.8));
+//                    a and b are at most 0.5 mu g; in fog (visibility V < 1000 m) T grows by
+//                    up to 30 % more and its speed is capped so that it stops within V (1.5 s
+//                    of reaction plus braking at 0.5 mu g).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -178,7 +186,12 @@ class VehicleAgent final : public Engine {
   double reaction_s_ = 0, radius_ = 100, start_s_ = 0, initial_speed_ = 0;
   double length_ = 4.5, width_ = 1.8, height_ = 1.5, wheelbase_ = 2.7, rear_overhang_ = 0.9;
   std::string model_, category_;
-  std::string state_dp_, neighbours_dp_, lights_dp_;
+  std::string state_dp_, neighbours_dp_, lights_dp_, weather_dp_;
+  // Weather: the configured IDM, and the factors the weather applies to it (see the header).
+  bool weather_adaptation_ = true;
+  Idm base_idm_;
+  double speed_factor_ = 1.0, visibility_speed_ = INFINITY;
+  void adapt_to_weather(double mu, double visibility_m);
   odr::LaneRoute initial_route_;
   odr::LaneIndex dest_lane_ = odr::kNoLane;
   double dest_s_ = 0;
@@ -399,6 +412,9 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   state_dp_ = config.at("StateDataPack").get<std::string>();
   neighbours_dp_ = config.at("NeighboursDataPack").get<std::string>();
   lights_dp_ = config.at("TrafficLightsDataPack").get<std::string>();
+  weather_dp_ = config.at("WeatherDataPack").get<std::string>();
+  weather_adaptation_ = config.at("WeatherAdaptation").get<bool>();
+  base_idm_ = idm_;
 
   initial_route_ = pick_route(config, config.at("Seed").get<uint64_t>());
   const auto& last = initial_route_.segments.back();
@@ -479,12 +495,34 @@ void VehicleAgent::start() {
 }
 
 double VehicleAgent::desired_speed() const {
-  if (limit_factor_ <= 0 || path_.route.segments.empty()) return idm_.v0;
-  const auto loc = graph_->locate(x_, y_, yaw_);
-  if (!loc) return idm_.v0;
-  const odr::SpeedLimit lim = graph_->speed_limit(loc->lane, loc->s);
-  if (!lim.known || !std::isfinite(lim.mps)) return idm_.v0;
-  return limit_factor_ * lim.mps;
+  double v = idm_.v0;
+  if (limit_factor_ > 0 && !path_.route.segments.empty()) {
+    if (const auto loc = graph_->locate(x_, y_, yaw_)) {
+      const odr::SpeedLimit lim = graph_->speed_limit(loc->lane, loc->s);
+      if (lim.known && std::isfinite(lim.mps)) v = limit_factor_ * lim.mps * speed_factor_;
+    }
+  }
+  return std::min(v, visibility_speed_);
+}
+
+void VehicleAgent::adapt_to_weather(double mu, double visibility_m) {
+  idm_ = base_idm_;
+  speed_factor_ = 1.0;
+  visibility_speed_ = INFINITY;
+  if (!weather_adaptation_) return;
+  const double loss = std::clamp(1.0 - mu / 0.8, 0.0, 1.0);  // 0 dry .. 1 no grip
+  const double grip = std::max(0.5 * mu * 9.81, 0.3);        // comfortable use of the grip
+  speed_factor_ = 1.0 - 0.4 * loss;
+  idm_.v0 = base_idm_.v0 * speed_factor_;
+  idm_.T = base_idm_.T * (1.0 + 0.5 * loss);
+  idm_.a = std::min(base_idm_.a, grip);
+  idm_.b = std::min(base_idm_.b, grip);
+  if (visibility_m < 1000.0) {
+    idm_.T *= 1.0 + 0.3 * std::clamp((1000.0 - visibility_m) / 900.0, 0.0, 1.0);
+    // Stop within the visibility: 1.5 s v + v^2 / (2 grip) = V.
+    const double tr = 1.5;
+    visibility_speed_ = grip * (-tr + std::sqrt(tr * tr + 2.0 * visibility_m / grip));
+  }
 }
 
 const Snapshot* VehicleAgent::perceived() const {
@@ -845,6 +883,19 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
                      (dp.is_proto() ? dp.proto_type() : std::string("JSON")));
     }
     last_neighbours_ = std::move(users);
+  } else if (name == weather_dp_) {
+    if (!dp.is_json()) fail(name, "expected the weather engine's JSON datapack");
+    const json w = datapack::read_json(dp);
+    const auto num = [&](const char* key, double fallback) {
+      if (!w.is_object() || !w.contains(key)) return fallback;
+      if (!w[key].is_number()) fail(name, std::string(key) + ": expected a number");
+      return w[key].get<double>();
+    };
+    const double mu = num("mu", 0.8), visibility = num("visibility_m", INFINITY);
+    if (!(mu >= 0)) fail(name, "mu: must be >= 0");
+    if (!(visibility > 0)) fail(name, "visibility_m: must be > 0");
+    adapt_to_weather(mu, visibility);
+    return;
   } else if (name == lights_dp_) {
     if (!dp.is_json()) fail(name, "expected a JSON datapack {\"signals\": {id: state}}");
     auto j = std::make_shared<json>(datapack::read_json(dp));
@@ -852,7 +903,7 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
     last_lights_ = std::move(j);
   } else {
     warn_once("dp:" + name, "datapack '" + name + "' is not one it reads (" + neighbours_dp_ +
-                                ", " + lights_dp_ + "); ignored");
+                                ", " + lights_dp_ + ", " + weather_dp_ + "); ignored");
     return;
   }
   // Stamped with the time it arrived (the state the TF saw).

@@ -86,6 +86,15 @@ def pedestrian(i, route, respawn=False):
     return e
 
 
+def weather(dt):
+    """The weather engine, clear by default (-o EngineConfigs/1/Precipitation=0.8 and so on)."""
+    return {"EngineType": "weather", "EngineName": "weather", "EngineTimestep": dt, "Seed": 0,
+            "Surface": "dry", "Precipitation": 0.0, "Visibility": 20000.0, "WindSpeed": 0.0}
+
+
+WEATHER_TF = {"Name": "weather_tf", "FileName": "../common/weather_tf.py"}
+
+
 def density_config():
     """The density run (benchmarks/traffic_bench.py --section density): the same road users,
     each starting its route again when it ends, SUMO's flows doubled, for 10 simulated minutes;
@@ -93,6 +102,7 @@ def density_config():
     engines = [
         {"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "city_world_no_ego.sdf",
          "EngineTimestep": AGENT_DT, "ActorTimeout": 1.0},
+        weather(AGENT_DT),
         {"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
          "Map": MAP, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0},
         {"EngineType": "sumo", "EngineName": "sumo", "EngineTimestep": AGENT_DT,
@@ -113,6 +123,7 @@ def density_config():
         "SimulationTimeout": 600,
         "EngineConfigs": engines,
         "DataPackProcessingFunctions": [
+            WEATHER_TF,
             {"Name": "traffic_tf", "FileName": "traffic_tf.py"},
             {"Name": "recorder_tf", "FileName": "recorder_tf.py"},
         ],
@@ -123,6 +134,7 @@ def config():
     engines = [
         {"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "city_world.sdf",
          "GazeboRNGSeed": 7, "EngineTimestep": WORLD_DT, "ActorTimeout": 1.0},
+        weather(AGENT_DT),
         {"EngineType": "python_json", "EngineName": "car_ctl_engine", "PythonFileName": "ego_driver.py",
          "EngineTimestep": WORLD_DT},
         {"EngineType": "python_json", "EngineName": "planner",
@@ -151,6 +163,7 @@ def config():
         "SimulationTimeout": 110,
         "EngineConfigs": engines,
         "DataPackProcessingFunctions": [
+            WEATHER_TF,
             {"Name": "state_tf", "FileName": "../autonomous_driving/state_tf.py"},
             {"Name": "motor_tf", "FileName": "../ego_planner/motor_tf.py"},
             {"Name": "camera_tf", "FileName": "../autonomous_driving/camera_tf.py"},

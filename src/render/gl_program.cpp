@@ -84,13 +84,13 @@ out vec3 v_added;  // plus this
 #else
 out vec3 v_normal;
 #endif
-#if defined(DEPTH) || !defined(PER_VERTEX)
+#if defined(DEPTH) || !defined(PER_VERTEX) || defined(FOG)
 out vec3 v_position;  // eye space
 #endif
 LIGHTING_CODE
 void main() {
   vec4 p = u_model_view * vec4(a_position, 1.0);
-#if defined(DEPTH) || !defined(PER_VERTEX)
+#if defined(DEPTH) || !defined(PER_VERTEX) || defined(FOG)
   v_position = p.xyz;
 #endif
   vec3 normal = u_normal_matrix * a_normal;
@@ -122,7 +122,7 @@ in vec3 v_color;
 #ifdef TEXTURED
 in vec3 v_added;
 #endif
-#ifdef DEPTH
+#if defined(DEPTH) || defined(FOG)
 in vec3 v_position;
 #endif
 #else
@@ -138,6 +138,16 @@ uniform bool u_double_sided;
 #ifdef TEXTURED
 in vec2 v_uv;
 uniform sampler2D u_texture;
+#endif
+#ifdef FOG
+uniform float u_fog_k;  // 3.912 / visibility
+uniform vec3 u_fog_color;
+#endif
+#ifdef SURFACE_WEATHER
+uniform vec3 u_up;  // world up in eye space
+uniform float u_wetness;
+uniform float u_snow;
+uniform vec3 u_sky;
 #endif
 layout(location = 0) out vec4 out_color;
 #ifdef DEPTH
@@ -167,6 +177,21 @@ void main() {
   vec3 p = v_position;
   LIGHT_CALLS
   color += g_diffuse * u_diffuse.rgb * tex + g_specular * u_specular.rgb;
+#ifdef SURFACE_WEATHER
+  {
+    // Up-facing surfaces: snow turns them white; water darkens them and mirrors the sky at
+    // grazing angles (Schlick's Fresnel term for water).
+    float flat_up = smoothstep(0.6, 0.9, dot(n, u_up));
+    color = mix(color, 0.95 * (u_scene_ambient + g_diffuse), u_snow * flat_up);
+    float ndv = max(dot(n, -normalize(p)), 0.0);
+    float fresnel = 0.02 + 0.98 * pow(1.0 - ndv, 5.0);
+    float w = u_wetness * flat_up;
+    color = color * (1.0 - 0.45 * w) + (w * fresnel) * u_sky;
+  }
+#endif
+#endif
+#ifdef FOG
+  color = mix(u_fog_color, color, exp(-u_fog_k * length(v_position)));
 #endif
   out_color = vec4(color, 1.0);
 #ifdef DEPTH
@@ -215,6 +240,8 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   if (key.ids) header += "#define IDS\n";
   if (key.per_vertex) header += "#define PER_VERTEX\n";
   if (key.specular) header += "#define SPECULAR\n";
+  if (key.fog) header += "#define FOG\n";
+  if (key.surface_weather && !key.per_vertex) header += "#define SURFACE_WEATHER\n";
   std::string calls;
   for (size_t i = 0; i < key.lights.size(); ++i) {
     const char* f = key.lights[i] == 'D' ? "directional" : key.lights[i] == 'P' ? "point" : "spot";
@@ -268,8 +295,104 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   p.light_specular = at("u_light_specular");
   p.light_attenuation = at("u_light_attenuation");
   p.light_spot = at("u_light_spot");
+  p.fog_k = at("u_fog_k");
+  p.fog_color = at("u_fog_color");
+  p.up = at("u_up");
+  p.wetness = at("u_wetness");
+  p.snow = at("u_snow");
+  p.sky = at("u_sky");
   glUseProgram(p.id);
   if (key.textured) glUniform1i(at("u_texture"), 0);
+  return p;
+}
+
+namespace {
+
+// One triangle covering the viewport.
+const char* kFullScreenVertexShader = R"(#version 300 es
+void main() {
+  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+// Rain: three layers of thin streaks (nearer layers longer, wider, brighter), each in cells
+// of its own size: a cell holds one streak with a probability that grows with the amount.
+// Snow: three layers of round flakes. The pattern is a hash of the cell and u_seed, so a new
+// seed (one per frame) gives a new pattern and the same seed the same one.
+const char* kPrecipitationShader = R"(#version 300 es
+precision highp float;
+precision highp int;
+uniform vec2 u_size;
+uniform uint u_seed;
+uniform float u_amount;
+uniform bool u_snow;
+uniform float u_slant;
+out vec4 out_color;
+uint hash(uint x) {
+  x ^= x >> 16u; x *= 0x7feb352du; x ^= x >> 15u; x *= 0x846ca68bu; x ^= x >> 16u;
+  return x;
+}
+void main() {
+  vec2 px = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);
+  float alpha = 0.0;
+  for (int layer = 0; layer < 3; ++layer) {
+    float fl = float(layer);
+    vec2 cell = u_snow ? vec2(14.0 + 14.0 * fl) : vec2(7.0 + 5.0 * fl, 80.0 + 60.0 * fl);
+    vec2 q = vec2(px.x - u_slant * px.y, px.y);
+    vec2 c = floor(q / cell);
+    uint id = uint(int(c.x) + 8192) * 16384u + uint(int(c.y) + 8192);
+    uint key = hash(id ^ hash(u_seed + uint(layer) * 0x9e3779b9u));
+    float exists = float(key & 0xffffu) / 65535.0;
+    float p = u_amount * (u_snow ? 0.45 - 0.1 * fl : 0.4 - 0.1 * fl);
+    if (exists >= p) continue;
+    vec2 local = q - c * cell;
+    float rx = float((key >> 16) & 0xffu) / 255.0, ry = float(key >> 24) / 255.0;
+    if (u_snow) {
+      float radius = 0.7 + 0.9 * fl;
+      vec2 centre = vec2(radius) + vec2(rx, ry) * (cell - 2.0 * radius);
+      float d = length(local - centre);
+      alpha = max(alpha, 0.9 * (1.0 - smoothstep(0.5 * radius, radius, d)));
+    } else {
+      float x0 = rx * cell.x, len = cell.y * (0.3 + 0.15 * fl), y0 = ry * (cell.y - len);
+      float dx = abs(local.x - x0), width = 0.6 + 0.35 * fl;
+      if (dx < width && local.y > y0 && local.y < y0 + len)
+        alpha = max(alpha, (0.16 + 0.08 * fl) * (1.0 - 0.5 * dx / width));
+    }
+  }
+  out_color = vec4(u_snow ? vec3(0.96) : vec3(0.8, 0.83, 0.87), alpha);
+}
+)";
+
+}  // namespace
+
+PrecipitationProgram build_precipitation_program() {
+  const GLuint vs = compile(GL_VERTEX_SHADER, kFullScreenVertexShader);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, kPrecipitationShader);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  PrecipitationProgram p;
+  p.id = glCreateProgram();
+  glAttachShader(p.id, vs);
+  glAttachShader(p.id, fs);
+  glLinkProgram(p.id);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    glDeleteProgram(p.id);
+    throw std::runtime_error("render: the precipitation program does not link");
+  }
+  p.size = glGetUniformLocation(p.id, "u_size");
+  p.seed = glGetUniformLocation(p.id, "u_seed");
+  p.amount = glGetUniformLocation(p.id, "u_amount");
+  p.snow = glGetUniformLocation(p.id, "u_snow");
+  p.slant = glGetUniformLocation(p.id, "u_slant");
   return p;
 }
 

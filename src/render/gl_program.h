@@ -26,6 +26,8 @@ struct ProgramKey {
   bool ids = false;
   bool per_vertex = false;  // lighting in the vertex shader
   bool specular = true;     // false: the material has no specular colour (no highlights to compute)
+  bool fog = false;              // Atmosphere::fog()
+  bool surface_weather = false;  // Atmosphere::surface_weather() (per-pixel programs only)
 
   auto operator<=>(const ProgramKey&) const = default;
 };
@@ -40,7 +42,15 @@ struct SurfaceProgram {
   GLint projection = -1, scene_ambient = -1;
   GLint light_position = -1, light_direction = -1, light_diffuse = -1, light_specular = -1;
   GLint light_attenuation = -1, light_spot = -1;
+  GLint fog_k = -1, fog_color = -1, up = -1, wetness = -1, snow = -1, sky = -1;
 };
+
+// Draws rain streaks or snow flakes over the image (Atmosphere's precipitation), blended.
+struct PrecipitationProgram {
+  GLuint id = 0;
+  GLint size = -1, seed = -1, amount = -1, snow = -1, slant = -1;
+};
+PrecipitationProgram build_precipitation_program();
 
 // Compiles and links the program; throws std::runtime_error with the driver's log on failure.
 SurfaceProgram build_surface_program(const ProgramKey& key);

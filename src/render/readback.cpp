@@ -26,7 +26,7 @@ void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels) {
 }
 
 void boxes_from_ids(const uint32_t* ids, int width, int height, const Scene& scene,
-                    std::vector<BoundingBox>* boxes) {
+                    std::vector<BoundingBox>* boxes, const float* instance_distance) {
   struct Extent {
     int x_min = INT_MAX, y_min = INT_MAX, x_max = -1, y_max = -1;
     uint32_t count = 0;
@@ -59,6 +59,7 @@ void boxes_from_ids(const uint32_t* ids, int width, int height, const Scene& sce
     auto [it, inserted] = by_model.try_emplace(
         model, BoundingBox{model, instances[i].class_id, e.x_min, e.y_min, e.x_max, e.y_max, 0});
     BoundingBox& b = it->second;
+    if (instance_distance) b.distance = std::min(b.distance, instance_distance[i]);
     b.x_min = std::min(b.x_min, e.x_min);
     b.y_min = std::min(b.y_min, e.y_min);
     b.x_max = std::max(b.x_max, e.x_max);

@@ -15,8 +15,9 @@ void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels);
 
 // The bounding boxes of `scene`'s labelled models in an id image: ids[y * width + x] is the
 // index + 1 of the instance seen at that pixel, 0 where none is. One box per model_id != 0,
-// by increasing model_id.
+// by increasing model_id. `instance_distance` (by instance index, optional) gives each box's
+// distance: the least of its visible instances'.
 void boxes_from_ids(const uint32_t* ids, int width, int height, const Scene& scene,
-                    std::vector<BoundingBox>* boxes);
+                    std::vector<BoundingBox>* boxes, const float* instance_distance = nullptr);
 
 }  // namespace convoy::render

@@ -82,6 +82,7 @@ struct Renderer::Impl {
   GpuSceneCache scenes;
   RenderTargetCache targets;
   std::map<ProgramKey, SurfaceProgram> programs;  // built when first needed
+  PrecipitationProgram precipitation;             // built when first needed
   uint64_t frame_number = 0;
   std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
@@ -93,6 +94,7 @@ struct Renderer::Impl {
   std::vector<uint8_t> rgba;
   std::vector<uint32_t> ids;  // bytes r, g, b, a of the id attachment: the id, little-endian
   std::vector<float> distance_rgba;
+  std::vector<float> instance_distance;  // by instance: metres to its bounds' centre (drawn ones)
 
   ~Impl() {
     try {
@@ -101,7 +103,9 @@ struct Renderer::Impl {
       return;  // another thread holds the context: leak the GL objects rather than crash
     }
     for (auto& [key, p] : programs) destroy_program(&p);
+    if (precipitation.id) glDeleteProgram(precipitation.id);
   }
+  void draw_precipitation(const Atmosphere& a, int width, int height);
 
   const SurfaceProgram& program(const ProgramKey& key) {
     auto it = programs.find(key);
@@ -120,6 +124,18 @@ void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene&
                                            const glm::dmat4& view, const CameraSpec& spec) {
   glUniformMatrix4fv(p.projection, 1, GL_FALSE, glm::value_ptr(glm::mat4(projection(spec))));
   glUniform3fv(p.scene_ambient, 1, scene.ambient().data());
+  const Atmosphere& a = scene.atmosphere();
+  if (p.fog_k >= 0) {
+    glUniform1f(p.fog_k, static_cast<float>(3.912 / a.visibility));
+    glUniform3fv(p.fog_color, 1, a.fog_color.data());
+  }
+  if (p.up >= 0) {
+    const glm::vec3 up(glm::normalize(glm::dmat3(view) * glm::dvec3(0, 0, 1)));
+    glUniform3fv(p.up, 1, glm::value_ptr(up));
+    glUniform1f(p.wetness, a.wetness);
+    glUniform1f(p.snow, a.snow_cover);
+    glUniform3fv(p.sky, 1, a.sky.data());
+  }
   const auto& lights = scene.lights();
   const int n = static_cast<int>(lights.size());
   std::vector<glm::vec4> direction(n);
@@ -162,6 +178,7 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
   const double nx = std::sqrt(1 + tx * tx), ny = std::sqrt(1 + ty * ty);
   draws.clear();
   const auto& instances = scene.instances();
+  instance_distance.assign(instances.size(), std::numeric_limits<float>::infinity());
   for (int i = 0; i < static_cast<int>(instances.size()); ++i) {
     const Scene::Instance& inst = instances[i];
     if (!inst.visible) continue;
@@ -171,6 +188,7 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
     const double scale = std::max({glm::length(glm::dvec3(mv[0])), glm::length(glm::dvec3(mv[1])),
                                    glm::length(glm::dvec3(mv[2]))});
     const double r = b.radius * scale;
+    instance_distance[i] = static_cast<float>(glm::length(c));
     // Eye space looks down -z; each side plane passes through the eye.
     if (c.z - r > -spec.near_clip || -c.z - r > spec.far_clip) continue;
     if ((std::abs(c.x) + c.z * tx) / nx > r || (std::abs(c.y) + c.z * ty) / ny > r) continue;
@@ -277,6 +295,33 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
   if (!culling) glEnable(GL_CULL_FACE);
 }
 
+// Rain or snow over the colour image only (depth and ids keep the scene's).
+void Renderer::Impl::draw_precipitation(const Atmosphere& a, int width, int height) {
+  if (!precipitation.id) precipitation = build_precipitation_program();
+  const GLenum colour_only[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
+  glDrawBuffers(3, colour_only);
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glUseProgram(precipitation.id);
+  glUniform2f(precipitation.size, static_cast<float>(width), static_cast<float>(height));
+  // A new pattern for each frame time, the same for the same seed and time.
+  const uint64_t ms = static_cast<uint64_t>(std::llround(a.time * 1000.0));
+  uint32_t seed = a.seed * 0x9e3779b9u ^ static_cast<uint32_t>(ms * 0x85ebca6bULL) ^
+                  static_cast<uint32_t>(ms >> 32);
+  glUniform1ui(precipitation.seed, seed);
+  glUniform1f(precipitation.amount, std::clamp(a.precipitation, 0.0f, 1.0f));
+  glUniform1i(precipitation.snow, a.snow ? 1 : 0);
+  glUniform1f(precipitation.slant, a.fall_slant);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glDisable(GL_BLEND);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_CULL_FACE);
+}
+
 Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   // llvmpipe allocates its per-frame bins afresh each frame; returned to the system they
   // would fault in again every frame (4x slower at 100k triangles).
@@ -316,6 +361,8 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   }
   key.depth = want_depth;
   key.ids = want_boxes;
+  key.fog = scene.atmosphere().fog();
+  key.surface_weather = scene.atmosphere().surface_weather();
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
   glViewport(0, 0, w, h);
@@ -345,6 +392,7 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   glActiveTexture(GL_TEXTURE0);
   s.collect_draws(scene, view, spec);
   s.draw(key, scene, view, spec, gpu);
+  if (scene.atmosphere().precipitation > 0) s.draw_precipitation(scene.atmosphere(), w, h);
 
   // Read back. Rows come top first thanks to the flipped projection.
   const size_t pixels = static_cast<size_t>(w) * h;
@@ -377,7 +425,7 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
     s.ids.resize(pixels);
     glReadBuffer(GL_COLOR_ATTACHMENT2);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, s.ids.data());
-    boxes_from_ids(s.ids.data(), w, h, scene, &out->boxes);
+    boxes_from_ids(s.ids.data(), w, h, scene, &out->boxes, s.instance_distance.data());
   } else {
     out->boxes.clear();
   }

@@ -4,6 +4,7 @@
 // frame. Rendering is OpenGL ES 3 through EGL without a display (Mesa's llvmpipe on a plain
 // CPU machine): Blinn-Phong lighting per pixel (per vertex on meshes whose triangles cover
 // under kPerVertexLightingBelow pixels), textures multiplying the diffuse and ambient colours.
+// Weather (Scene::set_atmosphere): fog, wet and snowy surfaces, rain and snow over the image.
 // Not drawn: shadows, transparency (alpha is ignored), anti-aliasing, sky boxes. The output is
 // deterministic: the same scene, pose and spec give the same bytes on the same machine.
 //
@@ -25,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,6 +52,8 @@ struct BoundingBox {
   uint32_t class_id;               // that of the model's first instance (lowest index)
   int x_min, y_min, x_max, y_max;  // inclusive pixel coordinates, y = 0 the top row
   uint32_t pixel_count;            // visible pixels
+  // Metres from the camera to the nearest bounding-sphere centre of its visible instances.
+  float distance = std::numeric_limits<float>::infinity();
 };
 
 struct Frame {

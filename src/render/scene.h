@@ -15,6 +15,8 @@
 #pragma once
 
 #include <array>
+#include <cmath>
+#include <limits>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -60,6 +62,31 @@ struct Light {
   float spot_outer_angle = 1.0f;
   float spot_falloff = 1.0f;
   bool cast_shadows = false;  // accepted and ignored: the renderer draws no shadows
+};
+
+// The weather as a camera sees it (the world engine sets it from the weather datapack).
+// Fog: a surface at distance d keeps exp(-3.912 d / visibility) of its own light and takes the
+// rest from fog_color (Koschmieder: a black object's contrast against the fog is 2 % at the
+// visibility distance); the background is not fogged (set it to the fog's colour in fog).
+// Wetness and snow cover act on up-facing surfaces lit per pixel: wet ones darken and mirror
+// `sky` at grazing angles, snowy ones turn white. Precipitation draws rain streaks or snow
+// flakes over the image, slanted by `fall_slant` (image x per image y), a new pattern for each
+// (seed, time): the same seed and time give the same frame.
+struct Atmosphere {
+  float visibility = std::numeric_limits<float>::infinity();  // m
+  Rgba fog_color{0.78f, 0.8f, 0.82f, 1.0f};
+  float wetness = 0;     // 0-1
+  float snow_cover = 0;  // 0-1
+  Rgba sky{0.55f, 0.7f, 0.9f, 1.0f};
+  float precipitation = 0;  // 0-1
+  bool snow = false;        // flakes instead of streaks
+  float fall_slant = 0;
+  uint32_t seed = 0;
+  double time = 0;  // s
+
+  bool fog() const { return std::isfinite(visibility); }
+  bool surface_weather() const { return wetness > 0 || snow_cover > 0; }
+  bool operator==(const Atmosphere&) const = default;
 };
 
 class Scene {
@@ -120,6 +147,7 @@ class Scene {
   void clear_lights() { lights_.clear(); }
   void set_ambient(const Rgba& rgba) { ambient_ = rgba; }
   void set_background(const Rgba& rgba) { background_ = rgba; }
+  void set_atmosphere(const Atmosphere& a) { atmosphere_ = a; }
 
   // Read access for the renderer.
   uint64_t uid() const { return uid_; }  // unique per Scene object in this process
@@ -132,6 +160,7 @@ class Scene {
   const std::vector<Light>& lights() const { return lights_; }
   const Rgba& ambient() const { return ambient_; }
   const Rgba& background() const { return background_; }
+  const Atmosphere& atmosphere() const { return atmosphere_; }
 
  private:
   Instance& instance_at(int index, const char* what);
@@ -146,6 +175,7 @@ class Scene {
   std::vector<Light> lights_;
   Rgba ambient_{0.4f, 0.4f, 0.4f, 1.0f};     // SDF <scene><ambient> default
   Rgba background_{0.7f, 0.7f, 0.7f, 1.0f};  // SDF <scene><background> default
+  Atmosphere atmosphere_;                     // none: clear air
 };
 
 }  // namespace convoy::render

@@ -535,6 +535,8 @@ class Example(PedCase):
         for name in ("simulation_config.json", "neighbours_tf.py"):
             with open(os.path.join(ex, name)) as f:
                 text = f.read()
+            text = text.replace("../common/weather_tf.py",
+                                os.path.join(root, "common", "weather_tf.py"))
             self.write(name, text.replace("../city_traffic/city.xodr", CITY))
         r = self.run_convoy(timeout=120)
         self.assertExit(r, 0)

@@ -189,6 +189,57 @@ class Idm(AgentCase):
         self.assertGreater(cars[-1]["x"], LENGTH - 10)
 
 
+class Weather(AgentCase):
+    WEATHER = ('    w = JsonDataPack("weather", "car")\n'
+               '    w.data["mu"] = {mu}\n'
+               '    w.data["visibility_m"] = 20000.0\n'
+               '    out.append(w)\n')
+
+    def steady_gap(self, mu):
+        out = self.experiment(agent={"InitialSpeed": 10.0, "LaneChanges": False},
+                              others=[("leader", 40.0, -1.75, 10.0)], timeout=60.0,
+                              lights=self.WEATHER.format(mu=mu))
+        r = self.run_convoy(timeout=120)
+        self.assertExit(r, 0)
+        rows = [row for row in self.stream(out) if "car" in row and "leader" in row]
+        tail = rows[-200:]  # the last 10 s
+        gaps = [rear(row["leader"]) - front(row["car"]) for row in tail]
+        return sum(gaps) / len(gaps), tail[-1]["car"]["speed"]
+
+    def test_gap_grows_on_a_wet_road(self):
+        # IDM's steady gap (s0 + v T) / sqrt(1 - (v/v0)^4) with the weather's T and v0: dry
+        # (mu 0.8) T 1.5 s, v0 20 m/s; wet (mu 0.5) T 1.78 s, v0 17 m/s.
+        v = 10.0
+        dry, v_dry = self.steady_gap(0.8)
+        wet, v_wet = self.steady_gap(0.5)
+        expected_dry = (2.0 + v * 1.5) / math.sqrt(1 - (v / 20.0) ** 4)
+        expected_wet = (2.0 + v * 1.5 * 1.1875) / math.sqrt(1 - (v / 17.0) ** 4)
+        self.assertLess(abs(dry - expected_dry) / expected_dry, 0.05, (dry, expected_dry))
+        self.assertLess(abs(wet - expected_wet) / expected_wet, 0.05, (wet, expected_wet))
+        self.assertGreater(wet, 1.15 * dry, (dry, wet))
+        self.assertLess(abs(v_dry - v), 0.2)
+        self.assertLess(abs(v_wet - v), 0.2)
+
+    def test_slower_on_ice_and_in_fog(self):
+        speeds = {}
+        for label, mu, vis in (("dry", 0.8, 20000.0), ("ice", 0.1, 20000.0), ("fog", 0.8, 60.0)):
+            code = self.WEATHER.format(mu=mu).replace("20000.0", repr(vis))
+            out = self.experiment(agent={"InitialSpeed": 15.0, "v0": 25.0, "LaneChanges": False},
+                                  timeout=40.0, timestep=0.1, lights=code)
+            r = self.run_convoy(timeout=120)
+            self.assertExit(r, 0)
+            cars = [row["car"] for row in self.stream(out) if "car" in row and not row["car"]["absent"]]
+            speeds[label] = max(u["speed"] for u in cars[-50:])
+            os.remove(out)
+        self.assertGreater(speeds["dry"], 24.0)
+        self.assertLess(speeds["ice"], 0.7 * 25.0 + 0.3)   # 25 x (1 - 0.4 x 0.875) = 16.25
+        self.assertGreater(speeds["ice"], 15.5)
+        # Fog of 60 m: it can stop within 60 m (1.5 s + braking at 0.5 mu g): 17.0 m/s.
+        grip = 0.5 * 0.8 * 9.81
+        v_fog = grip * (-1.5 + math.sqrt(1.5 ** 2 + 2 * 60.0 / grip))
+        self.assertLess(abs(speeds["fog"] - v_fog), 0.3, (speeds, v_fog))
+
+
 class Respawn(AgentCase):
     def test_starts_again_at_its_start_after_the_delay(self):
         out = self.experiment(agent={"InitialSpeed": 15.0, "v0": 25.0, "LaneChanges": False,
@@ -424,6 +475,9 @@ class Example(AgentCase):
         with open(os.path.join(self.dir, "simulation_config.json")) as f:
             cfg = json.load(f)
         cfg["SimulationTimeout"] = 45.0
+        for fn in cfg["DataPackProcessingFunctions"]:  # shared TFs, relative to the example
+            if fn["FileName"].startswith(".."):
+                fn["FileName"] = os.path.normpath(os.path.join(src, fn["FileName"]))
         for e in cfg["EngineConfigs"]:
             if e["EngineType"] == "vehicle_agent":
                 e["Map"] = CITY
