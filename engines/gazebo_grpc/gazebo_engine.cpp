@@ -9,7 +9,10 @@
 //   <camera plugin>::<sensor>, <model>::<link>::<sensor>  GazeboCameraDataPack, read
 //   ...::depth   JSON {"width", "height", "depth": float32 ndarray (metres)}
 //   ...::boxes   JSON {"width", "height", "boxes": [{"model", "class", "instance", "x_min",
-//                "y_min", "x_max", "y_max", "pixels"}]}: ground truth of visible models
+//                "y_min", "x_max", "y_max", "pixels", "distance", "visibility",
+//                "visible_fraction", "full_box"}]}: ground truth of visible models
+//   ...::instances  JSON {"width", "height", "ids": uint32 ndarray (the instance id at each
+//                pixel), "instances": {id: {"model", "class"}}}: instance masks
 //   <model>::road_user  RoadUserDataPack, read: each ego model's state (EgoModels)
 //   collisions          JSON list of {"t", "a", "b", "class_a", "class_b",
 //                       "relative_speed_mps"}: every contact so far, each once when it starts
@@ -162,9 +165,11 @@ class GazeboEngine final : public Engine {
         camera_dps_[base] = {c, kImage};
         camera_dps_[base + "::depth"] = {c, kDepth};
         camera_dps_[base + "::boxes"] = {c, kBoxes};
+        camera_dps_[base + "::instances"] = {c, kInstances};
         add(base, datapack::type_name<data::Camera>());
         add(base + "::depth", "json");
         add(base + "::boxes", "json");
+        add(base + "::instances", "json");
       }
     }
     // Ego models: those named, else every model with a joint controller plugin.
@@ -306,6 +311,8 @@ class GazeboEngine final : public Engine {
         cameras_->image_datapack(index, out);
       else if (kind == kDepth)
         cameras_->depth_datapack(index, out);
+      else if (kind == kInstances)
+        cameras_->instances_datapack(index, out);
       else
         cameras_->boxes_datapack(index, out);
       sent_frames_[id.name()] = cameras_->frames(index);
@@ -793,7 +800,7 @@ class GazeboEngine final : public Engine {
   world::WorldDesc desc_;
   std::unique_ptr<world::PhysicsWorld> physics_;
   std::unique_ptr<world::CameraSensors> cameras_;
-  enum CameraOutput { kImage, kDepth, kBoxes };
+  enum CameraOutput { kImage, kDepth, kBoxes, kInstances };
   std::unordered_map<std::string, std::pair<size_t, CameraOutput>> camera_dps_;
   std::vector<Controller> controllers_;
   std::vector<Brake> brakes_;

@@ -110,6 +110,7 @@ class Scene {
   struct Bounds {
     std::array<float, 3> centre;
     float radius;
+    std::array<float, 3> lo{}, hi{};  // the axis-aligned bounding box
   };
   // A coarser stand-in for a mesh and its geometric error (metres, in the mesh's frame).
   struct Lod {
