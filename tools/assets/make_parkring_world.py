@@ -68,8 +68,31 @@ def model(name, cls, x, y, yaw, visuals, collision=None):
             "    </model>\n" % (name, x, y, yaw, col, "".join(visuals), cls))
 
 
+ACTORS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                      "engines", "gazebo_grpc", "actors")
+
+def _models(*prefixes):
+    return sorted(f[:-4] for f in os.listdir(ACTORS) if f.endswith(".sdf") and f.startswith(prefixes))
+
+
+CAR_MODELS = _models("sedan_", "hatchback_", "suv_", "van_")
+BUS_MODELS = _models("bus_")
+PEOPLE = _models("pedestrian_")
+
+
+def actor_parts(name):
+    """The collision and visuals of the road-user model actors/<name>.sdf (made by
+    make_road_users.py), its meshes as model://convoy_actors/meshes/ (the build copies them)."""
+    with open(os.path.join(ACTORS, name + ".sdf")) as f:
+        text = f.read()
+    link = text[text.index("<link name='link'>") + len("<link name='link'>"):text.index("</link>")]
+    return [line.replace("<uri>meshes/", "<uri>model://convoy_actors/meshes/") + "\n"
+            for line in link.strip("\n").split("\n") if line.strip()]
+
+
 def main():
     rng = random.Random(2026)
+    looks = random.Random(7)  # which model each road user gets (apart from rng: same layout)
     with open(sys.argv[1]) as f:
         lane = [(float(r["x"]), float(r["y"]), float(r["heading"])) for r in csv.DictReader(f)]
 
@@ -112,9 +135,7 @@ def main():
     # a bus at a stop
     x, y, h = at(60, 8.0)
     if clear(x, y, 1.3, 5.5) and free(x, y, 6.3):
-        add("bus", x, y, h, 6.3, [visual("body", box(12, 2.5, 2.9), (0.95, 0.75, 0.1), "0 0 1.75 0 0 0"),
-                                  visual("windows", box(10, 2.55, 0.8), (0.15, 0.2, 0.3), "0.5 0 2.4 0 0 0")],
-            ("0 0 1.75 0 0 0", box(12, 2.5, 2.9)))
+        add("bus", x, y, h, 6.3, actor_parts(looks.choice(BUS_MODELS)))
     # trees and shrubs on the verges
     for i in range(2, len(lane), 6):
         for side in (1, -1):
@@ -138,22 +159,16 @@ def main():
         for k in range(rng.randint(2, 4)):
             x, y, h = at(i + 3 * k, 10.5)
             if clear(x, y, 2.4, 7.0) and free(x, y, 2.4):
-                col = rng.choice([(0.8, 0.1, 0.1), (0.1, 0.2, 0.7), (0.85, 0.85, 0.85), (0.1, 0.1, 0.1), (0.2, 0.5, 0.2)])
-                add("car", x, y, h, 2.4, [visual("body", box(4.2, 1.8, 0.8), col, "0 0 0.6 0 0 0"),
-                                          visual("cabin", box(2.2, 1.6, 0.6), tuple(c * 0.8 for c in col),
-                                                 "-0.2 0 1.3 0 0 0")],
-                    ("0 0 0.8 0 0 0", box(4.2, 1.8, 1.6)))
+                rng.choice(range(5))  # (was a colour: keeps the layout's draws)
+                add("car", x, y, h, 2.4, actor_parts(looks.choice(CAR_MODELS)))
     # pedestrians on the sidewalks
     for i in range(5, len(lane), 13):
         side = rng.choice((1, -1))
         off = rng.uniform(3.6, 4.8) if side > 0 else -rng.uniform(7.0, 8.2)
         x, y, h = at(i, off)
         if clear(x, y, 0.3, 3.0) and free(x, y, 0.3):
-            shirt = rng.choice([(0.8, 0.2, 0.2), (0.2, 0.3, 0.8), (0.9, 0.8, 0.2), (0.3, 0.6, 0.3), (0.9, 0.9, 0.9)])
-            add("pedestrian", x, y, rng.uniform(-3.1, 3.1), 0.3, [
-                visual("legs", box(0.3, 0.35, 0.85), (0.2, 0.2, 0.3), "0 0 0.43 0 0 0"),
-                visual("torso", box(0.3, 0.45, 0.65), shirt, "0 0 1.18 0 0 0"),
-                visual("head", "<sphere><radius>0.12</radius></sphere>", (0.85, 0.7, 0.55), "0 0 1.65 0 0 0")])
+            rng.choice(range(5))  # (was a shirt colour: keeps the layout's draws)
+            add("pedestrian", x, y, rng.uniform(-3.1, 3.1), 0.3, actor_parts(looks.choice(PEOPLE)))
     out.append("  </world>\n</sdf>\n")
     with open(OUT, "w") as f:
         f.write("".join(out))

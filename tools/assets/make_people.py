@@ -1,0 +1,519 @@
+"""People for the road-user actors (see make_road_users.py): pedestrians (four figures,
+standing and in a walking mid-stride pose) and a cyclist on a bicycle.
+
+A figure is a skeleton (joint positions in a standing rest pose, scaled to its height) and
+one mesh part per bone: pelvis, torso, neck, head (+ hair), upper_arm_l/r, lower_arm_l/r,
+hand_l/r, upper_leg_l/r, lower_leg_l/r, foot_l/r. Limbs are lofts of elliptical rings with
+domed ends, so that they stay closed at bent joints. A pose moves each part rigidly: its
+pivot joint to the posed joint, its bone turned onto the posed bone. Each part is an OBJ
+group of that name; the rest-pose skeleton is written next to the standing meshes
+(<figure>_stand_skeleton.json: joints, and each part's pivot and end joint) for a later
+step that articulates them. Materials are slots (skin, hair, top, bottom, shoes; the
+cyclist's frame) whose colours the SDF variants set.
+Frame: x forward, y left, z up; the origin at the centre of the bounding box's base."""
+import math
+
+from meshkit import Mesh, add, cross, dot, lerp, mat_vec, mul, norm, rot_y, sub
+
+SLOTS = ["skin", "hair", "top", "bottom", "shoes"]
+
+# Fixed materials (the bicycle's).
+MATERIALS = {
+    "tyre": {"kd": (0.04, 0.04, 0.04), "ks": (0.05, 0.05, 0.05), "ns": 6},
+    "metal": {"kd": (0.62, 0.63, 0.65), "ks": (0.5, 0.5, 0.5), "ns": 60},
+    "saddle": {"kd": (0.05, 0.05, 0.05), "ks": (0.1, 0.1, 0.1), "ns": 10},
+    "reflector": {"kd": (0.7, 0.05, 0.03), "ks": (0.4, 0.4, 0.4), "ns": 60, "ke": (0.2, 0.0, 0.0)},
+}
+
+SKIN = [(0.93, 0.76, 0.64), (0.8, 0.6, 0.45), (0.56, 0.38, 0.26), (0.36, 0.24, 0.17)]
+HAIR = {"black": (0.04, 0.035, 0.03), "brown": (0.24, 0.14, 0.07), "blonde": (0.74, 0.58, 0.33),
+        "grey": (0.58, 0.58, 0.58), "auburn": (0.42, 0.16, 0.07)}
+CLOTH = {"red": (0.7, 0.08, 0.08), "navy": (0.08, 0.1, 0.28), "white": (0.88, 0.88, 0.86),
+         "green": (0.12, 0.42, 0.2), "yellow": (0.9, 0.72, 0.12), "grey": (0.45, 0.45, 0.47),
+         "black": (0.06, 0.06, 0.07), "lightblue": (0.45, 0.62, 0.85), "orange": (0.9, 0.42, 0.08),
+         "jeans": (0.14, 0.2, 0.36), "khaki": (0.55, 0.48, 0.33), "brown": (0.3, 0.2, 0.12),
+         "beige": (0.76, 0.68, 0.52), "purple": (0.38, 0.15, 0.45), "teal": (0.08, 0.45, 0.48)}
+SHOES = {"black": (0.05, 0.05, 0.05), "white": (0.85, 0.85, 0.85), "brown": (0.28, 0.17, 0.09)}
+
+# Figures: height (m), shoulder and hip half-widths, build (girth factor), chest (bust),
+# hair style, sleeves (long or short), legwear (trousers, shorts or skirt), coat (top down
+# over the hips).
+FIGURES = {
+    "man": dict(h=1.78, shoulder=0.195, hip=0.088, build=1.0, bust=0.0, hair="short",
+                sleeves="long", legs="trousers", coat=False),
+    "woman": dict(h=1.66, shoulder=0.172, hip=0.092, build=0.92, bust=0.025, hair="long",
+                  sleeves="short", legs="trousers", coat=False),
+    "tall_man": dict(h=1.88, shoulder=0.205, hip=0.09, build=1.05, bust=0.0, hair="short",
+                     sleeves="short", legs="shorts", coat=False),
+    "woman_coat": dict(h=1.62, shoulder=0.17, hip=0.092, build=0.95, bust=0.02, hair="bun",
+                       sleeves="long", legs="skirt", coat=True),
+}
+
+# Colour variants per figure: (skin, hair, top, bottom, shoes).
+VARIANTS = {
+    "man": [(0, "brown", "navy", "jeans", "black"), (2, "black", "red", "khaki", "brown"),
+            (1, "grey", "grey", "black", "black")],
+    "woman": [(0, "blonde", "red", "jeans", "white"), (3, "black", "yellow", "black", "black"),
+              (1, "auburn", "teal", "beige", "brown")],
+    "tall_man": [(1, "black", "white", "khaki", "white"), (0, "blonde", "green", "navy", "black"),
+                 (2, "black", "orange", "jeans", "white")],
+    "woman_coat": [(0, "brown", "beige", "black", "black"), (2, "black", "purple", "grey", "black"),
+                   (1, "grey", "lightblue", "navy", "brown")],
+}
+
+DEFAULT_WALKER = "walker_man_1"
+DEFAULT_PEDESTRIAN = "pedestrian_woman_1"
+DEFAULT_CYCLIST = "cyclist_1"
+
+
+# ---------------------------------------------------------------- skeleton
+def skeleton(f):
+    """Joint positions of the standing rest pose (feet on z = 0, facing +x)."""
+    H = f["h"]
+    s = H / 1.75
+    sh, hh = f["shoulder"], f["hip"]
+    j = {"hip_c": (0.0, 0.0, 0.52 * H), "waist": (0.0, 0.0, 0.6 * H),
+         "neck_base": (0.0, 0.0, 0.822 * H), "head_base": (0.008, 0.0, 0.868 * H),
+         "head_top": (0.0, 0.0, H)}
+    for side, k in ((1, "l"), (-1, "r")):
+        j["shoulder_" + k] = (-0.005, side * (sh - 0.008 * s), 0.8 * H)
+        j["elbow_" + k] = (-0.015, side * (sh + 0.02 * s), 0.628 * H)
+        j["wrist_" + k] = (0.005, side * (sh + 0.022 * s), 0.483 * H)
+        j["fingertip_" + k] = (0.02, side * (sh + 0.02 * s), 0.375 * H)
+        j["hip_" + k] = (0.0, side * hh, 0.515 * H)
+        j["knee_" + k] = (0.012, side * hh * 0.95, 0.285 * H)
+        j["ankle_" + k] = (-0.01, side * hh * 0.92, 0.047 * H)
+        j["toe_" + k] = (0.155 * H * 0.92, side * (hh * 0.92 + 0.012), 0.02 * H)
+    return j
+
+
+# part: (pivot joint, end joint, slot of the rings... decided per figure)
+BONES = {
+    "pelvis": ("hip_c", "waist"), "torso": ("waist", "neck_base"), "neck": ("neck_base", "head_base"),
+    "head": ("head_base", "head_top"), "hair": ("head_base", "head_top"),
+}
+for _k in ("l", "r"):
+    BONES.update({"upper_arm_" + _k: ("shoulder_" + _k, "elbow_" + _k),
+                  "lower_arm_" + _k: ("elbow_" + _k, "wrist_" + _k),
+                  "hand_" + _k: ("wrist_" + _k, "fingertip_" + _k),
+                  "upper_leg_" + _k: ("hip_" + _k, "knee_" + _k),
+                  "lower_leg_" + _k: ("knee_" + _k, "ankle_" + _k),
+                  "foot_" + _k: ("ankle_" + _k, "toe_" + _k)})
+
+
+def limb(m, a, b, radii, slices=8, materials=None, dome=(0.5, 0.5), flatten=1.0, forward=(1, 0, 0)):
+    """A limb from a to b: rings of radii [(t, rx, ry)] (rx along `forward`), domed ends.
+    materials: [(t_max, material)] per span, by the span's mid t."""
+    axis = sub(b, a)
+    length = math.sqrt(dot(axis, axis))
+    z = norm(axis)
+    x = norm(sub(forward, mul(z, dot(forward, z))))
+    y = cross(z, x)
+
+    def ring(t, rx, ry, off=0.0):
+        c = add(a, mul(z, t * length + off))
+        return [add(c, add(mul(x, rx * math.cos(2 * math.pi * k / slices)),
+                           mul(y, ry * flatten * math.sin(2 * math.pi * k / slices))))
+                for k in range(slices)]
+
+    t0, rx0, ry0 = radii[0]
+    t1, rx1, ry1 = radii[-1]
+    rings, ts = [], []
+    if dome[0]:
+        d = dome[0] * min(rx0, ry0)
+        rings += [[add(a, mul(z, t0 * length - d))] * slices, ring(t0, 0.7 * rx0, 0.7 * ry0, -0.7 * d)]
+        ts += [t0, t0]
+    for t, rx, ry in radii:
+        rings.append(ring(t, rx, ry))
+        ts.append(t)
+    if dome[1]:
+        d = dome[1] * min(rx1, ry1)
+        rings += [ring(t1, 0.7 * rx1, 0.7 * ry1, 0.7 * d), [add(a, mul(z, t1 * length + d))] * slices]
+        ts += [t1, t1]
+
+    def material_of(i, j):
+        if not materials:
+            return None
+        tm = 0.5 * (ts[i] + ts[i + 1])
+        for t_max, mat in materials:
+            if tm <= t_max + 1e-9:
+                return mat
+        return materials[-1][1]
+
+    m.loft(rings, material_of=material_of)
+
+
+def build_figure(f):
+    """The rest-pose figure: a Mesh whose parts are the bones (materials = slots)."""
+    j = skeleton(f)
+    H, g = f["h"], f["build"]
+    s = H / 1.75
+    m = Mesh()
+    top, bottom = "top", "bottom"
+    # pelvis (hips to waist); a coat covers it
+    m.begin("pelvis", top if f["coat"] else bottom).smooth(60)
+    a, b = (0.0, 0.0, 0.455 * H), j["waist"]
+    hip_r = 0.165 * g * s + 0.01 * (f["hip"] - 0.088) / 0.01
+    limb(m, a, b, [(0.0, 0.085 * g * s, 0.1 * g * s), (0.3, 0.1 * g * s, hip_r),
+                   (0.65, 0.1 * g * s, 0.155 * g * s), (1.0, 0.098 * g * s, 0.142 * g * s)],
+         slices=12, dome=(0.4, 0))
+    if f["coat"]:  # the coat's skirt, flared so that the legs stay inside when walking
+        m.begin("pelvis", top).smooth(50)
+        limb(m, j["waist"], (0.0, 0.0, 0.34 * H),
+             [(0.0, 0.1 * g * s, 0.146 * g * s), (0.35, 0.135 * g * s, 0.19 * g * s),
+              (1.0, 0.22 * g * s, 0.225 * g * s)], slices=12, dome=(0, 0))
+    # torso (waist to the base of the neck), closed over the shoulders
+    m.begin("torso", top).smooth(60)
+    bust = f["bust"]
+    limb(m, j["waist"], j["neck_base"],
+         [(0.0, 0.098 * g * s, 0.142 * g * s), (0.25, 0.102 * g * s, 0.148 * g * s),
+          (0.52, (0.118 + bust) * g * s, 0.162 * g * s), (0.78, 0.112 * g * s, f["shoulder"] * 0.92),
+          (0.93, 0.095 * g * s, f["shoulder"] * 0.9), (1.0, 0.06 * s, f["shoulder"] * 0.55)],
+         slices=12, dome=(0, 0.3))
+    # neck, head
+    m.begin("neck", "skin").smooth(60)
+    limb(m, j["neck_base"], j["head_base"], [(-0.3, 0.052 * s, 0.052 * s), (1.2, 0.048 * s, 0.048 * s)],
+         slices=8, dome=(0, 0))
+    m.begin("head", "skin").smooth(70)
+    hc = (0.012 * s, 0.0, 0.935 * H)
+    m.ellipsoid(hc, (0.098 * s, 0.077 * s, 0.118 * s), stacks=7, slices=10)
+    # a nose, so that the face has a front
+    m.begin("head", "skin").flat()
+    nz = hc[2] - 0.01 * s
+    tip = (hc[0] + 0.108 * s, 0, nz - 0.012 * s)
+    p1, p2, p3 = (hc[0] + 0.088 * s, 0.014 * s, nz - 0.03 * s), (hc[0] + 0.088 * s, -0.014 * s, nz - 0.03 * s), (hc[0] + 0.09 * s, 0, nz + 0.025 * s)
+    m.tri(tip, p3, p1)
+    m.tri(tip, p2, p3)
+    m.tri(tip, p1, p2)
+    # hair (or a helmet)
+    m.begin("hair", "hair").smooth(60)
+    hs = f["hair"]
+    if hs == "helmet":
+        m.ellipsoid((hc[0] - 0.02 * s, 0.0, hc[2] + 0.03 * s), (0.125 * s, 0.098 * s, 0.118 * s),
+                    stacks=4, slices=10, zcut=0.05)
+    else:
+        m.ellipsoid((hc[0] - 0.016 * s, 0.0, hc[2] + 0.014 * s), (0.102 * s, 0.083 * s, 0.118 * s),
+                    stacks=5, slices=10, zcut=-0.05)
+    if hs == "long":
+        m.ellipsoid((hc[0] - 0.055 * s, 0.0, hc[2] - 0.085 * s), (0.06 * s, 0.088 * s, 0.13 * s), stacks=4, slices=8)
+    elif hs == "bun":
+        m.ellipsoid((hc[0] - 0.1 * s, 0.0, hc[2] + 0.03 * s), (0.045 * s, 0.045 * s, 0.045 * s), stacks=4, slices=8)
+    # arms
+    for k in ("l", "r"):
+        lower_arm = top if f["sleeves"] == "long" else "skin"
+        m.begin("upper_arm_" + k, top).smooth(60)
+        mats = [(1.0, top)] if f["sleeves"] == "long" else [(0.55, top), (1.0, "skin")]
+        limb(m, j["shoulder_" + k], j["elbow_" + k],
+             [(0.0, 0.052 * g * s, 0.05 * g * s), (0.5, 0.046 * g * s, 0.044 * g * s), (1.0, 0.039 * g * s, 0.038 * g * s)],
+             materials=mats, dome=(0.35, 0.5))
+        m.begin("lower_arm_" + k, lower_arm).smooth(60)
+        limb(m, j["elbow_" + k], j["wrist_" + k],
+             [(0.0, 0.039 * g * s, 0.038 * g * s), (0.35, 0.038 * g * s, 0.036 * g * s), (1.0, 0.027 * s, 0.024 * s)],
+             dome=(0.5, 0.3))
+        m.begin("hand_" + k, "skin").smooth(60)
+        w, t = j["wrist_" + k], j["fingertip_" + k]
+        c = lerp(w, t, 0.45)
+        m.ellipsoid(c, (0.045 * s, 0.022 * s, 0.058 * s), stacks=4, slices=6)
+    # legs
+    for k in ("l", "r"):
+        legs = f["legs"]
+        m.begin("upper_leg_" + k, bottom).smooth(60)
+        if legs == "skirt":  # a skirt over bare legs, or a coat over trousers
+            mats = [(1.0, bottom)] if f["coat"] else [(0.45, bottom), (1.0, "skin")]
+        elif legs == "shorts":
+            mats = [(0.6, bottom), (1.0, "skin")]
+        else:
+            mats = [(1.0, bottom)]
+        coat_r = 1.0
+        limb(m, j["hip_" + k], j["knee_" + k],
+             [(-0.05, 0.085 * g * s * coat_r, 0.08 * g * s * coat_r), (0.4, 0.075 * g * s * coat_r, 0.07 * g * s * coat_r),
+              (1.0, 0.052 * g * s, 0.05 * g * s)], materials=mats, dome=(0.4, 0.5))
+        m.begin("lower_leg_" + k, bottom if legs == "trousers" or f["coat"] else "skin").smooth(60)
+        limb(m, j["knee_" + k], j["ankle_" + k],
+             [(0.0, 0.052 * g * s, 0.05 * g * s), (0.3, 0.056 * g * s, 0.048 * g * s), (1.0, 0.036 * s, 0.034 * s)],
+             dome=(0.5, 0.4))
+        m.begin("foot_" + k, "shoes").smooth(50)
+        foot(m, j["ankle_" + k], j["toe_" + k], s)
+    return m, j
+
+
+def foot(m, ankle, toe, s):
+    """A shoe: a loft along the foot from heel to toe, the ankle on top of the heel."""
+    d = norm((toe[0] - ankle[0], toe[1] - ankle[1], 0.0))
+    side = (-d[1], d[0], 0.0)
+    heel = add(ankle, mul(d, -0.05 * s))
+    length = 0.26 * s
+    rings = []
+    for t, hgt, w in ((0.0, 0.075, 0.036), (0.02, 0.09, 0.045), (0.35, 0.085, 0.05), (0.7, 0.05, 0.052),
+                      (0.95, 0.035, 0.04), (1.0, 0.02, 0.02)):
+        c = add((heel[0], heel[1], 0.0), mul(d, t * length))
+        h, ww = hgt * s, w * s
+        # section: bottom-left, bottom-right, top-right, top-left... counter-clockwise about d
+        pts = [(-ww, 0.0), (ww, 0.0), (ww * 0.95, h * 0.8), (ww * 0.5, h), (-ww * 0.5, h), (-ww * 0.95, h * 0.8)]
+        ring = [add(c, add(mul(side, u), (0, 0, v))) for u, v in pts]
+        rings.append(ring)
+    m.loft(rings, cap_start=True, cap_end=True)
+
+
+# ---------------------------------------------------------------- posing
+def rotation_between(a, b):
+    """The smallest rotation taking direction a onto direction b (Rodrigues)."""
+    a, b = norm(a), norm(b)
+    v = cross(a, b)
+    c = dot(a, b)
+    s2 = dot(v, v)
+    if s2 < 1e-12:
+        return ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+    k = (1 - c) / s2
+    vx = ((0, -v[2], v[1]), (v[2], 0, -v[0]), (-v[1], v[0], 0))
+    vx2 = tuple(tuple(sum(vx[i][n] * vx[n][jj] for n in range(3)) for jj in range(3)) for i in range(3))
+    return tuple(tuple((1 if i == jj else 0) + vx[i][jj] + k * vx2[i][jj] for jj in range(3)) for i in range(3))
+
+
+def apply_pose(m, rest, posed):
+    """Moves each part rigidly: its pivot onto the posed pivot, its bone onto the posed bone."""
+    for i, (part, mat, st, tri) in enumerate(m.tris):
+        base = part.split(":")[0]
+        if base not in BONES:
+            continue
+        p, e = BONES[base]
+        r = rotation_between(sub(rest[e], rest[p]), sub(posed[e], posed[p]))
+        m.tris[i] = (part, mat, st, tuple(add(posed[p], mat_vec(r, sub(v, rest[p]))) for v in tri))
+
+
+def swing(v, angle):
+    """v turned forward (towards +x, about +y... i.e. a hanging limb swings to +x) by angle."""
+    return mat_vec(rot_y(-angle), v)
+
+
+def pose_walk(rest, f):
+    """A mid-stride walking pose: left heel strikes, right toes push off, arms opposite."""
+    j = dict(rest)
+    lean = math.radians(4)
+    # torso and everything above it lean forward about the waist
+    w = rest["waist"]
+    for k in ("neck_base", "head_base", "head_top", "shoulder_l", "shoulder_r"):
+        j[k] = add(w, swing(sub(rest[k], w), -lean))  # (swing turns upward vectors back)
+    j["head_top"] = add(j["head_base"], sub(rest["head_top"], rest["head_base"]))  # head level
+    legs = {"l": (math.radians(14), math.radians(4), math.radians(7)),
+            "r": (math.radians(-10), None, math.radians(-20))}
+
+    def leg(k, thigh, knee, foot_angle):
+        hip = rest["hip_" + k]
+        kn = add(hip, swing(sub(rest["knee_" + k], hip), thigh))
+        an = add(kn, swing(sub(rest["ankle_" + k], rest["knee_" + k]), thigh - knee))
+        to = add(an, swing(sub(rest["toe_" + k], rest["ankle_" + k]), foot_angle))
+        return kn, an, to
+
+    # left: heel strike; right: knee bent so that its toe is as low as the left heel
+    kl, al, tl = leg("l", *legs["l"])
+    heel_l = al[2] - 0.045 * f["h"] * 1.0
+    lo, hi = 0.0, math.radians(60)
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        kr, ar, tr = leg("r", legs["r"][0], mid, legs["r"][2])
+        if tr[2] < heel_l + 0.012:
+            lo = mid
+        else:
+            hi = mid
+    kr, ar, tr = leg("r", legs["r"][0], 0.5 * (lo + hi), legs["r"][2])
+    j.update({"knee_l": kl, "ankle_l": al, "toe_l": tl, "knee_r": kr, "ankle_r": ar, "toe_r": tr})
+    # arms swing against the legs, elbows bent
+    for k, sw, el in (("l", -15, 15), ("r", 13, 22)):
+        sh = j["shoulder_" + k]
+        sw, el = math.radians(sw), math.radians(el)
+        e = add(sh, swing(sub(rest["elbow_" + k], rest["shoulder_" + k]), sw))
+        wr = add(e, swing(sub(rest["wrist_" + k], rest["elbow_" + k]), sw + el))
+        ft = add(wr, swing(sub(rest["fingertip_" + k], rest["wrist_" + k]), sw + el))
+        j.update({"elbow_" + k: e, "wrist_" + k: wr, "fingertip_" + k: ft})
+    return j
+
+
+def pose_stand(rest, f):
+    j = dict(rest)
+    for k, sw in (("l", 3), ("r", -2)):
+        sw = math.radians(sw)
+        sh = rest["shoulder_" + k]
+        e = add(sh, swing(sub(rest["elbow_" + k], sh), sw))
+        wr = add(e, swing(sub(rest["wrist_" + k], rest["elbow_" + k]), sw + math.radians(10)))
+        ft = add(wr, swing(sub(rest["fingertip_" + k], rest["wrist_" + k]), sw + math.radians(10)))
+        j.update({"elbow_" + k: e, "wrist_" + k: wr, "fingertip_" + k: ft})
+    return j
+
+
+def two_bone(a, target, la, lb, pole):
+    """The middle joint of a two-bone chain from a reaching `target`, bending towards pole."""
+    d = sub(target, a)
+    dist = math.sqrt(dot(d, d))
+    dist = min(dist, la + lb - 1e-4)
+    u = norm(d)
+    along = (la * la - lb * lb + dist * dist) / (2 * dist)
+    h = math.sqrt(max(0.0, la * la - along * along))
+    v = norm(sub(pole, mul(u, dot(pole, u))))
+    return add(add(a, mul(u, along)), mul(v, h)), add(a, mul(u, dist))
+
+
+# ---------------------------------------------------------------- the cyclist
+def bicycle(m):
+    """A city bicycle; returns the points the rider uses (saddle, grips, pedals)."""
+    R = 0.34
+    rear, front = (-0.52, 0.0, R), (0.52, 0.0, R)
+    bb = (-0.06, 0.0, 0.28)
+    seat = (-0.24, 0.0, 0.86)
+    head_top, head_bot = (0.36, 0.0, 0.86), (0.41, 0.0, 0.7)
+    m.begin("bicycle", "frame").smooth(50)
+    tr = 0.017
+    m.tube(seat, head_top, tr, n=6)            # top tube
+    m.tube(head_bot, bb, 0.02, n=6)            # down tube
+    m.tube(bb, seat, tr, n=6)                  # seat tube
+    m.tube(head_bot, head_top, 0.022, n=6)     # head tube
+    for s in (1, -1):
+        m.tube((bb[0], s * 0.02, bb[2]), (rear[0], s * 0.06, rear[2]), 0.011, n=5)    # chain stays
+        m.tube((seat[0], s * 0.015, seat[2] - 0.02), (rear[0], s * 0.06, rear[2]), 0.01, n=5)  # seat stays
+        m.tube((head_bot[0], s * 0.02, head_bot[2]), (front[0], s * 0.05, front[2]), 0.012, n=5)  # fork
+    # mudguards (frame colour): arcs over the wheels
+    for c in (rear, front):
+        pts = []
+        for k in range(9):
+            a = math.radians(20 + 140 * k / 8) if c is rear else math.radians(40 + 130 * k / 8)
+            pts.append((c[0] - (R + 0.03) * math.cos(a) * (1 if c is rear else -1), 0.0, c[2] + (R + 0.03) * math.sin(a)))
+        for p0, p1 in zip(pts, pts[1:]):
+            m.quad((p0[0], 0.03, p0[2]), (p0[0], -0.03, p0[2]), (p1[0], -0.03, p1[2]), (p1[0], 0.03, p1[2]))
+            m.quad((p1[0], 0.03, p1[2] - 0.002), (p1[0], -0.03, p1[2] - 0.002), (p0[0], -0.03, p0[2] - 0.002), (p0[0], 0.03, p0[2] - 0.002))
+    m.begin("bicycle", "metal").smooth(50)
+    stem_top = (0.38, 0.0, 0.98)
+    m.tube(head_top, stem_top, 0.014, n=6)
+    bar = [(0.3, 0.27, 0.99), (0.38, 0.22, 0.99), (0.38, -0.22, 0.99), (0.3, -0.27, 0.99)]
+    for p0, p1 in zip(bar, bar[1:]):
+        m.tube(p0, p1, 0.012, n=5)
+    m.tube(seat, (seat[0] - 0.03, 0.0, seat[2] + 0.1), 0.013, n=5)  # seat post
+    # cranks and pedals (left forward, right back)
+    crank = 0.17
+    pedals = {}
+    for s, ang in ((1, math.radians(-10)), (-1, math.radians(170))):
+        p = (bb[0] + crank * math.cos(ang), s * 0.09, bb[2] + crank * math.sin(ang))
+        m.tube((bb[0], s * 0.06, bb[2]), p, 0.011, n=5)
+        m.use("saddle")
+        m.box((p[0], s * 0.12, p[2]), (0.1, 0.08, 0.025))
+        m.use("metal")
+        pedals["l" if s > 0 else "r"] = (p[0], s * 0.12, p[2] + 0.02)
+    m.begin("bicycle", "saddle").smooth(50)
+    sd = (seat[0] - 0.03, 0.0, seat[2] + 0.125)
+    m.ellipsoid(sd, (0.13, 0.075, 0.035), stacks=3, slices=8)
+    for s in (1, -1):
+        m.tube((0.27, s * 0.27, 0.99), (0.31, s * 0.245, 0.99), 0.018, n=6)  # grips
+    m.use("reflector")
+    m.box((rear[0] - 0.05, 0.0, R + 0.36), (0.01, 0.06, 0.03))
+    # wheels: a tyre (torus: black outside, grey rim inside), hub
+    for c in (rear, front):
+        n, tube_pts = 20, [(R - 0.012, 0.018, "tyre"), (R, 0.0, "tyre"), (R - 0.012, -0.018, "tyre"), (R - 0.035, -0.008, "metal"), (R - 0.035, 0.008, "metal")]
+        m.begin("bicycle", "tyre").smooth(60)
+        rings = []
+        for k in range(n + 1):
+            a = 2 * math.pi * k / n - math.pi / 2
+            rings.append([(c[0] + r * math.cos(a), c[1] + y, c[2] + r * math.sin(a)) for r, y, _ in tube_pts])
+        mats = [mt for _, _, mt in tube_pts]
+        m.loft(rings, material_of=lambda i, jj: mats[jj] if mats[jj] == mats[(jj + 1) % len(mats)] else "tyre")
+        m.use("metal").flat()
+        m.tube((c[0], -0.05, c[2]), (c[0], 0.05, c[2]), 0.025, n=6)
+    return {"saddle": sd, "grips": {"l": (0.29, 0.26, 1.0), "r": (0.29, -0.26, 1.0)}, "pedals": pedals,
+            "rear_axle": rear}
+
+
+def pose_cyclist(rest, f, bike):
+    """Seated on the saddle, leaning forward, hands on the grips, feet on the pedals."""
+    j = dict(rest)
+    # the pelvis: the hips just above and ahead of the saddle's top
+    hip_c = (bike["saddle"][0] + 0.02, 0.0, bike["saddle"][2] + 0.07)
+    shift = sub(hip_c, rest["hip_c"])
+    lean = math.radians(38)
+    pel_tilt = math.radians(20)
+    hc = rest["hip_c"]
+    for k in list(j):
+        j[k] = add(rest[k], shift)
+    # the pelvis tips forward; the torso leans about the waist
+    for k in ("waist", "hip_l", "hip_r"):
+        j[k] = add(hip_c, swing(sub(rest[k], hc), -pel_tilt))
+    w0, w = rest["waist"], j["waist"]
+    for k in ("neck_base", "head_base", "head_top", "shoulder_l", "shoulder_r"):
+        j[k] = add(w, swing(sub(rest[k], w0), -lean))
+    j["head_top"] = add(j["head_base"], swing(sub(rest["head_top"], rest["head_base"]), -math.radians(12)))
+    # legs and arms by two-bone reaching
+    for k in ("l", "r"):
+        la = dist(rest["hip_" + k], rest["knee_" + k])
+        lb = dist(rest["knee_" + k], rest["ankle_" + k])
+        target = add(bike["pedals"][k], (-0.02, 0.0, 0.08))
+        target = (target[0], j["hip_" + k][1] * 1.05, target[2])
+        knee, ankle = two_bone(j["hip_" + k], target, la, lb, (1.0, 0.0, 0.4))
+        j["knee_" + k], j["ankle_" + k] = knee, ankle
+        foot_dir = sub(rest["toe_" + k], rest["ankle_" + k])
+        j["toe_" + k] = add(ankle, swing(foot_dir, math.radians(-12)))
+        ua = dist(rest["shoulder_" + k], rest["elbow_" + k])
+        fa = dist(rest["elbow_" + k], rest["wrist_" + k])
+        grip = bike["grips"][k]
+        wrist_t = add(grip, (-0.03, 0.0, 0.01))
+        side = 1 if k == "l" else -1
+        elbow, wrist = two_bone(j["shoulder_" + k], wrist_t, ua, fa, (-0.6, side * 0.8, -0.6))
+        j["elbow_" + k], j["wrist_" + k] = elbow, wrist
+        hand = sub(rest["fingertip_" + k], rest["wrist_" + k])
+        j["fingertip_" + k] = add(wrist, mat_vec(rotation_between(sub(rest["wrist_" + k], rest["elbow_" + k]), sub(wrist, elbow)), hand))
+    return j
+
+
+def dist(a, b):
+    d = sub(a, b)
+    return math.sqrt(dot(d, d))
+
+
+# ---------------------------------------------------------------- all people
+def slot_colours(variant):
+    skin, hair, top, bottom, shoes = variant
+    return {"skin": SKIN[skin], "hair": HAIR[hair], "top": CLOTH[top], "bottom": CLOTH[bottom],
+            "shoes": SHOES[shoes]}
+
+
+def build_all():
+    """Yields (model name, Mesh, meta) for every person model; the first model of a mesh
+    writes it (meta["write"])."""
+    for fig, f in FIGURES.items():
+        for pose_name, pose, prefix in (("stand", pose_stand, "pedestrian"), ("walk", pose_walk, "walker")):
+            m, rest = build_figure(f)
+            posed = pose(rest, f)
+            apply_pose(m, rest, posed)
+            lo, hi = m.bounds()
+            shift = ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, lo[2])
+            m.fit()
+            mesh = "%s_%s" % (fig, pose_name)
+            skel = None
+            if pose_name == "stand":
+                skel = {"joints": {k: [round(v[i] - shift[i], 4) for i in range(3)] for k, v in posed.items()},
+                        "parts": {p: {"pivot": a, "end": b} for p, (a, b) in BONES.items()}}
+            for k, variant in enumerate(VARIANTS[fig]):
+                cols = slot_colours(variant)
+                yield ("%s_%s_%d" % (prefix, fig, k + 1), m, {
+                    "cls": "pedestrian", "mesh": mesh, "write": k == 0, "mesh_slots": SLOTS,
+                    "colours": cols, "parts": sorted({t[0] for t in m.tris}), "fixed": False,
+                    "length_offset": 0, "skeleton": skel if k == 0 else None,
+                    "comment": "A pedestrian actor: %s, %s, %.2f m tall" % (fig.replace("_", " "),
+                                                                           "walking (mid-stride)" if pose_name == "walk" else "standing", f["h"])})
+    # the cyclist
+    f = dict(FIGURES["man"], h=1.76, sleeves="long", legs="trousers", hair="helmet")
+    m, rest = build_figure(f)
+    bike = bicycle(m)
+    posed = pose_cyclist(rest, f, bike)
+    apply_pose(m, rest, posed)
+    lo, hi = m.bounds()
+    rear_x = bike["rear_axle"][0] - (lo[0] + hi[0]) / 2
+    m.fit()
+    cyclist_variants = [((1, "red", "navy", "jeans", "black"), "blue"), ((0, "white", "yellow", "black", "white"), "black"),
+                        ((2, "black", "red", "grey", "black"), "silver"), ((3, "blue", "green", "jeans", "brown"), "red")]
+    frame_colours = {"blue": (0.1, 0.25, 0.6), "black": (0.06, 0.06, 0.07), "silver": (0.62, 0.63, 0.65), "red": (0.65, 0.06, 0.05)}
+    helmet = {"red": (0.75, 0.08, 0.06), "white": (0.9, 0.9, 0.9), "black": (0.06, 0.06, 0.06), "blue": (0.1, 0.3, 0.75)}
+    for k, ((skin, hel, top, bottom, shoes), frame) in enumerate(cyclist_variants):
+        cols = {"skin": SKIN[skin], "hair": helmet[hel], "top": CLOTH[top], "bottom": CLOTH[bottom],
+                "shoes": SHOES[shoes], "frame": frame_colours[frame]}
+        yield ("cyclist_%d" % (k + 1), m, {
+            "cls": "cyclist", "mesh": "cyclist", "write": k == 0, "mesh_slots": SLOTS + ["frame"],
+            "colours": cols, "parts": sorted({t[0] for t in m.tris}), "fixed": True,
+            "length_offset": round(-rear_x, 3), "skeleton": None,
+            "comment": "A cyclist actor: a rider in a helmet on a city bicycle"})
