@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <cstdlib>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -401,8 +401,7 @@ const std::map<std::string, BackendFactory>& backends() {
          o.model_path = config.value("ModelPath", std::string());
          const std::filesystem::path dir = std::filesystem::path(o.model_path).parent_path();
          std::ifstream in(dir / "model.json");
-         if (!in)
-           throw std::runtime_error("Backend convoy: no model.json next to " + o.model_path);
+         if (!in) throw std::runtime_error("Backend convoy: no model.json next to " + o.model_path);
          nlohmann::json meta;
          try {
            meta = nlohmann::json::parse(in);

@@ -85,7 +85,7 @@ class CameraSensors {
     int depth_channels = 3;
     std::vector<int16_t> noise;         // mean + stddev * N(0,1) in 0..255 units, a fixed table
     const int16_t* noise_at = nullptr;  // the current frame's samples (null: no noise)
-    bool want_ids = false;  // instances asked for once
+    bool want_ids = false;              // instances asked for once
     bool want_image = false, want_depth = false, want_boxes = false;  // asked for once:
                                                                       // rendered from then on
     bool has_depth = false, has_boxes = false, has_ids = false;       // the current frame has them

@@ -33,8 +33,8 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <random>
 #include <optional>
+#include <random>
 #include <set>
 #include <unordered_map>
 
@@ -360,7 +360,7 @@ class GazeboEngine final : public Engine {
     double radius = -1;               // m; -1: not yet found
     double last_command = 0;          // in the previous physics step
     double last_omega = 0;            // the wheel's spin (rad/s, forward) in the previous step
-    double integral = 0;  // ABS: the PI controller's integral torque
+    double integral = 0;              // ABS: the PI controller's integral torque
   };
 
   void take_weather(const datapack::View& dp) {

@@ -40,6 +40,7 @@ class Script(EngineScript):
         self.path = []
         self.per_class = {}
         self.scored_frames = []  # {"gt", "detections"} per new frame (convoy_perception)
+        self.inference_ms = []
         self.ground_truth_detector = None
         self.wall0 = None  # wall clock at the first step: start-up is not counted
         self.lane = relateAngle_computation.load_waypoints()
@@ -86,6 +87,8 @@ class Script(EngineScript):
         if key != self.last_frame_key:
             self.last_frame_key = key
             dets = det.get("detections", [])
+            if "inference_ms" in det:
+                self.inference_ms.append(det["inference_ms"])
             if self.ground_truth_detector is None and "ground_truth" in det:
                 self.ground_truth_detector = bool(det["ground_truth"])
             for d in dets:
@@ -176,6 +179,7 @@ class Script(EngineScript):
             "detector_map50_per_class": {c: v["ap50"] for c, v in score.get("classes", {}).items()},
             "detector_scored_objects": score.get("scored_gt"),
             "detector_is_ground_truth": self.ground_truth_detector,
+            "detector_inference_ms_median": float(np.median(self.inference_ms)) if self.inference_ms else None,
             "iou_match": IOU_MATCH,
         }
         with open(os.path.join(self.dir, "summary.json"), "w") as f:

@@ -16,8 +16,8 @@
 
 #include <array>
 #include <cmath>
-#include <limits>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -176,7 +176,7 @@ class Scene {
   std::vector<Light> lights_;
   Rgba ambient_{0.4f, 0.4f, 0.4f, 1.0f};     // SDF <scene><ambient> default
   Rgba background_{0.7f, 0.7f, 0.7f, 1.0f};  // SDF <scene><background> default
-  Atmosphere atmosphere_;                     // none: clear air
+  Atmosphere atmosphere_;                    // none: clear air
 };
 
 }  // namespace convoy::render

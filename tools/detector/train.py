@@ -11,7 +11,7 @@ training.json (the recipe: arguments, data, per-epoch loss, the validation mAP).
 seed, data and arguments give the same weights (torch's CPU kernels, one thread order).
 
 Recipe: letterboxed input (pad 114, as the detector engine does), random horizontal flip,
-random zoom 0.75-1.33 with a random placement, brightness and contrast jitter; FCOS-style
+random zoom 0.75-2 with a random placement, brightness and contrast jitter; FCOS-style
 assignment (a cell is positive for a box when its centre lies in the box and within 2.5
 strides of the box centre, on the level whose size range holds the box's longer side: < 64,
 64-128, >= 128 px, the cell under the centre always; the smallest box wins a cell);
@@ -90,7 +90,7 @@ def sample(item, size, rng, augment):
     path, boxes, classes = item
     image = cv2.imread(path)[:, :, ::-1]  # RGB
     if augment:
-        jitter = math.exp(rng.uniform(math.log(0.75), math.log(1.33)))
+        jitter = math.exp(rng.uniform(math.log(0.75), math.log(2.0)))
         canvas, s, ox, oy = letterbox(image, size, jitter, rng)
     else:
         canvas, s, ox, oy = letterbox(image, size)
