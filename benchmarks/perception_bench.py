@@ -74,15 +74,8 @@ def detect(net, meta, image_rgb, conf=0.001, nms=0.6):
 def heldout_map(model_dir, folder, classes=("car", "bus", "pedestrian")):
     from convoy_perception.evaluation import evaluate
     net, meta = load_model(model_dir)
-    with open(os.path.join(folder, "annotations.json")) as f:
-        doc = json.load(f)
-    cats = {c["id"]: c["name"] for c in doc["categories"]}
-    gts = {img["id"]: [] for img in doc["images"]}
-    for a in doc["annotations"]:
-        x, y, w, h = a["bbox"]
-        gts[a["image_id"]].append({"class": cats[a["category_id"]], "x_min": x, "y_min": y,
-                                   "x_max": x + w - 1, "y_max": y + h - 1,
-                                   "visible_fraction": a.get("visible_fraction", 1.0)})
+    from train import read_ground_truth
+    doc, gts = read_ground_truth(folder)
     frames = []
     for img in doc["images"]:
         image = cv2.imread(os.path.join(folder, img["file_name"]))[:, :, ::-1]

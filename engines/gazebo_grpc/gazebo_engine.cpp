@@ -318,24 +318,22 @@ class GazeboEngine final : public Engine {
       sent_frames_[id.name()] = cameras_->frames(index);
       return;
     }
-    if (auto it = brake_dps_.find(id.name()); it != brake_dps_.end()) {
-      const Brake& b = brakes_[it->second];
-      auto s = physics_->joint_state(b.joint);
+    // A joint's state; a brake's effort is the torque its ABS applies.
+    auto write_joint = [&](int joint, const double* effort) {
+      auto s = physics_->joint_state(joint);
       data::Joint j;
       j.set_position(static_cast<float>(s.position));
       j.set_velocity(static_cast<float>(s.velocity));
-      j.set_effort(static_cast<float>(b.applied));
+      j.set_effort(static_cast<float>(effort ? *effort : s.effort));
       datapack::write_proto(out, j);
+    };
+    if (auto it = brake_dps_.find(id.name()); it != brake_dps_.end()) {
+      const Brake& b = brakes_[it->second];
+      write_joint(b.joint, &b.applied);
       return;
     }
     if (auto it = joint_dps_.find(id.name()); it != joint_dps_.end()) {
-      const auto& c = controllers_[it->second];
-      auto s = physics_->joint_state(c.joint);
-      data::Joint j;
-      j.set_position(static_cast<float>(s.position));
-      j.set_velocity(static_cast<float>(s.velocity));
-      j.set_effort(static_cast<float>(s.effort));
-      datapack::write_proto(out, j);
+      write_joint(controllers_[it->second].joint, nullptr);
       return;
     }
     if (auto it = link_dps_.find(id.name()); it != link_dps_.end()) {

@@ -7,23 +7,11 @@
 #include <string>
 
 #include "render/renderer.h"
+#include "shared_renderer.h"
 
 namespace convoy::render {
 namespace {
 
-Renderer* shared_renderer() {
-  static std::unique_ptr<Renderer> renderer;
-  static std::string error;
-  if (!renderer && error.empty()) {
-    try {
-      renderer = std::make_unique<Renderer>();
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-  }
-  if (!renderer) ADD_FAILURE() << "cannot start the renderer: " << error;
-  return renderer.get();
-}
 
 Material plain(float r, float g, float b) {
   Material m;

@@ -56,6 +56,10 @@ def main():
     ap.add_argument("--camera", default="smart_camera::camera")
     ap.add_argument("--world", default="gazebo", help="the world engine's name")
     ap.add_argument("--randomize", action="store_true", help="draw weather and time of day per run")
+    ap.add_argument("--set", action="append", default=[], metavar="ENGINE.KEY=JSON",
+                    help="set an engine's config key (the value read as JSON, else as a string)")
+    ap.add_argument("--env", action="append", default=[], metavar="ENGINE:VAR=VALUE",
+                    help="add an environment variable to an engine's EngineEnvParams")
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
     args = ap.parse_args()
 
@@ -102,6 +106,23 @@ def main():
             if e["EngineName"] == "weather":
                 e["Seed"] = seed
                 e.update(weather)
+        for item in args.set:
+            key, _, value = item.partition("=")
+            engine, _, field = key.partition(".")
+            try:
+                value = json.loads(value)
+            except ValueError:
+                pass
+            match = [e for e in cfg["EngineConfigs"] if e["EngineName"] == engine]
+            if not match or not field:
+                sys.exit("make_dataset: --set %s: no engine '%s' in %s" % (item, engine, config_path))
+            match[0][field] = value
+        for item in args.env:
+            engine, _, var = item.partition(":")
+            match = [e for e in cfg["EngineConfigs"] if e["EngineName"] == engine]
+            if not match or "=" not in var:
+                sys.exit("make_dataset: --env %s: expected ENGINE:VAR=VALUE with an engine of %s" % (item, config_path))
+            match[0].setdefault("EngineEnvParams", []).append(var)
         # Relative paths in the config are relative to its folder: the derived config goes
         # next to it for the run, and is removed after.
         derived = os.path.join(os.path.dirname(config_path), ".dataset_%d_%d.json" % (os.getpid(), seed))

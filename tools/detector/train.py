@@ -44,6 +44,22 @@ LEVEL_RANGES = ((0, 64), (64, 128), (128, 1e9))
 PAD = 114
 
 
+def read_ground_truth(folder):
+    """The COCO document of `folder` and, per image id, its road users as
+    convoy_perception.evaluation's ground truth (inclusive pixel boxes, visible_fraction)."""
+    with open(os.path.join(folder, "annotations.json")) as f:
+        doc = json.load(f)
+    cats = {c["id"]: c["name"] for c in doc["categories"]}
+    gts = {img["id"]: [] for img in doc["images"]}
+    for a in doc["annotations"]:
+        name = cats[a["category_id"]]
+        if name in CLASSES:
+            x, y, w, h = a["bbox"]
+            gts[a["image_id"]].append({"class": name, "x_min": x, "y_min": y, "x_max": x + w - 1,
+                                       "y_max": y + h - 1, "visible_fraction": a.get("visible_fraction", 1.0)})
+    return doc, gts
+
+
 def load_coco(folders, min_height=8):
     """[(image path, boxes N x 4 (x0, y0, x1, y1 edges), classes N)] from COCO folders."""
     items = []
@@ -208,16 +224,7 @@ def detect(model, x, conf=0.001, nms=0.6, max_det=300):
 def evaluate_folder(model, folder, size):
     """mAP on a COCO folder with the project's rules (convoy_perception.evaluation)."""
     from convoy_perception.evaluation import evaluate
-    with open(os.path.join(folder, "annotations.json")) as f:
-        doc = json.load(f)
-    cats = {c["id"]: c["name"] for c in doc["categories"]}
-    gts = {img["id"]: [] for img in doc["images"]}
-    for a in doc["annotations"]:
-        name = cats[a["category_id"]]
-        if name in CLASSES:
-            x, y, w, h = a["bbox"]
-            gts[a["image_id"]].append({"class": name, "x_min": x, "y_min": y, "x_max": x + w - 1,
-                                       "y_max": y + h - 1, "visible_fraction": a.get("visible_fraction", 1.0)})
+    doc, gts = read_ground_truth(folder)
     model.eval()
     frames = []
     for img in doc["images"]:
