@@ -21,7 +21,6 @@
 namespace convoy::render {
 namespace {
 
-
 #define GET_RENDERER(r)            \
   Renderer* r = shared_renderer(); \
   ASSERT_NE(r, nullptr)

@@ -12,7 +12,6 @@
 namespace convoy::render {
 namespace {
 
-
 Material plain(float r, float g, float b) {
   Material m;
   m.diffuse = {r, g, b, 1};
