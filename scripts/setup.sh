@@ -16,6 +16,7 @@ PACKAGES=(
   clang libfuzzer-14-dev
   python3-grpcio mosquitto libmosquitto-dev
   sumo sumo-tools
+  python3-torch
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then

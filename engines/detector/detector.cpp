@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -391,6 +392,32 @@ const std::map<std::string, BackendFactory>& backends() {
        [](const nlohmann::json&, std::vector<std::string>) -> std::unique_ptr<Backend> {
          return std::make_unique<HogDetector>();
        }},
+      // Convoy's own detector (models/detector, trained by tools/detector/train.py): YOLOv8
+      // layout, its input size from model.json, its classes from classes.txt.
+      {"convoy",
+       [](const nlohmann::json& config,
+          std::vector<std::string> names) -> std::unique_ptr<Backend> {
+         YoloOptions o;
+         o.model_path = config.value("ModelPath", std::string());
+         const std::filesystem::path dir = std::filesystem::path(o.model_path).parent_path();
+         std::ifstream in(dir / "model.json");
+         if (!in) throw std::runtime_error("Backend convoy: no model.json next to " + o.model_path);
+         nlohmann::json meta;
+         try {
+           meta = nlohmann::json::parse(in);
+           o.input_size = meta.at("input_width").get<int>();
+           if (meta.at("input_height").get<int>() != o.input_size)
+             throw std::runtime_error("input_width and input_height differ");
+         } catch (const std::exception& e) {
+           throw std::runtime_error("Backend convoy: " + (dir / "model.json").string() + ": " +
+                                    e.what());
+         }
+         o.class_names = std::move(names);
+         o.conf_threshold = config.value("ConfidenceThreshold", 0.25f);
+         o.nms_threshold = config.value("NmsThreshold", 0.45f);
+         o.version = YoloVersion::kV8;
+         return std::make_unique<YoloDetector>(std::move(o));
+       }},
   };
   return table;
 }
@@ -402,8 +429,30 @@ std::vector<std::string> backend_names() {
   return out;
 }
 
-std::unique_ptr<Backend> make_backend(const nlohmann::json& config) {
-  const std::string name = config.value("Backend", std::string("ground_truth"));
+std::string convoy_model_dir() {
+  const char* share = std::getenv("CONVOY_SHARE_DIR");
+  return (std::filesystem::path(share && *share ? share : CONVOY_DEFAULT_SHARE_DIR) / "models" /
+          "detector")
+      .string();
+}
+
+std::unique_ptr<Backend> make_backend(const nlohmann::json& in) {
+  nlohmann::json config = in;
+  const std::string name = config.value("Backend", std::string("convoy"));
+  if (name == "convoy") {
+    // Convoy's model and its class names, unless the config names others.
+    if (!config.contains("ModelPath"))
+      config["ModelPath"] = convoy_model_dir() + "/convoy_detector.onnx";
+    if (!config.contains("ClassNamesFile")) {
+      const std::string model = config["ModelPath"].get<std::string>();
+      config["ClassNamesFile"] =
+          (std::filesystem::path(model).parent_path() / "classes.txt").string();
+    }
+    if (!std::filesystem::exists(config["ModelPath"].get<std::string>()))
+      throw std::runtime_error("Backend convoy: no model at " +
+                               config["ModelPath"].get<std::string>() +
+                               " (tools/detector/train.py makes one; docs/perception.md)");
+  }
   auto it = backends().find(name);
   if (it == backends().end()) {
     std::string known;

@@ -40,6 +40,7 @@ class DetectorEngine final : public Engine {
                                              int64_t timestep_ns) override {
     name_ = name;
     backend_ = detector::make_backend(config);
+    backend_name_ = config.value("Backend", std::string("convoy"));
     std::vector<engine::DataPackId> ids;
     auto add = [&](const char* dp_name, std::string_view type) {
       engine::DataPackId id;
@@ -77,6 +78,8 @@ class DetectorEngine final : public Engine {
                {"width", width_},
                {"height", height_},
                {"inference_ms", std::chrono::duration<double, std::milli>(t1 - t0).count()},
+               {"backend", backend_name_},
+               {"ground_truth", backend_->input() == detector::BackendInput::kGroundTruth},
                {"detections", detector::detections_json(dets)}};
     return time_ns_;
   }
@@ -146,6 +149,7 @@ class DetectorEngine final : public Engine {
   nlohmann::json pending_boxes_;
   int width_ = 0, height_ = 0;
   nlohmann::json result_;
+  std::string backend_name_;
 };
 
 }  // namespace convoy::engines

@@ -52,9 +52,9 @@ VehicleExtent vehicle_extent(const ModelDesc& model) {
         for (int sx : {-1, 1})
           for (int sy : {-1, 1})
             for (int sz : {-1, 1}) {
-              const Eigen::Vector3d p = t * Eigen::Vector3d(sx * c.shape.size.x() / 2,
-                                                            sy * c.shape.size.y() / 2,
-                                                            sz * c.shape.size.z() / 2);
+              const Eigen::Vector3d p =
+                  t * Eigen::Vector3d(sx * c.shape.size.x() / 2, sy * c.shape.size.y() / 2,
+                                      sz * c.shape.size.z() / 2);
               front = any ? std::max(front, p.x()) : p.x();
               bottom = any ? std::min(bottom, p.z()) : p.z();
               any = true;
@@ -139,8 +139,9 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
     light.attenuation_quadratic = static_cast<float>(l.quadratic);
     if (static_cast<int>(scene_.lights().size()) < render::Scene::kMaxLights) {
       scene_.add_light(light);
-      street_light_.push_back(l.type != LightDesc::kDirectional &&
-                              (l.name.rfind("street_light", 0) == 0 || l.name.rfind("lamp", 0) == 0));
+      street_light_.push_back(
+          l.type != LightDesc::kDirectional &&
+          (l.name.rfind("street_light", 0) == 0 || l.name.rfind("lamp", 0) == 0));
     }
   }
   if (desc.lights.empty()) {
@@ -163,8 +164,8 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
           if (&c == cam.desc) cam.own_model = model_id;
     }
     if (!model.is_static && !model.links.empty() && is_vehicle_class(class_of(model)))
-      vehicles_.push_back({model_id, physics_.link_index(model.links.front().name), -1,
-                           vehicle_extent(model)});
+      vehicles_.push_back(
+          {model_id, physics_.link_index(model.links.front().name), -1, vehicle_extent(model)});
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
       add_visuals(link, link.pose, label, &tracked);
@@ -298,10 +299,12 @@ void CameraSensors::render(Camera& cam) {
   const Eigen::Isometry3d camera_pose = physics_.link_pose(cam.link) * d.pose;
   if (has_weather_) apply_weather(cam, camera_pose);
   render::Pose pose = to_pose(camera_pose);
-  renderer_->render(scene_, pose, spec, &cam.frame, cam.want_depth, cam.want_boxes);
+  cam.frame.keep_ids = cam.want_ids;
+  renderer_->render(scene_, pose, spec, &cam.frame, cam.want_depth, cam.want_boxes || cam.want_ids);
   ++cam.frames;
   cam.has_depth = cam.want_depth;
-  cam.has_boxes = cam.want_boxes;
+  cam.has_boxes = cam.want_boxes || cam.want_ids;
+  cam.has_ids = cam.want_ids;
   draw_noise(cam);
   cam.rendered = true;
 }
@@ -350,8 +353,10 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
       l.type = render::Light::kSpot;
       const Eigen::Vector3d p = pose * Eigen::Vector3d(e.front + 0.05, side, 0.7 - e.height);
       const Eigen::Vector3d d = pose.linear() * Eigen::Vector3d(0.995, 0, -0.1).normalized();
-      l.position = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
-      l.direction = {static_cast<float>(d.x()), static_cast<float>(d.y()), static_cast<float>(d.z())};
+      l.position = {static_cast<float>(p.x()), static_cast<float>(p.y()),
+                    static_cast<float>(p.z())};
+      l.direction = {static_cast<float>(d.x()), static_cast<float>(d.y()),
+                     static_cast<float>(d.z())};
       l.diffuse = {3.5f, 3.3f, 3.0f, 1};
       l.specular = {0.3f, 0.3f, 0.3f, 1};
       l.range = 80;
@@ -398,7 +403,8 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
   const render::Rgba fog = scaled(render::Rgba{0.75f, 0.77f, 0.8f, 1}, 0.04 + 0.96 * day);
   render::Atmosphere a;
   const bool foggy = std::isfinite(w.visibility_m) && w.visibility_m < 1e6;
-  a.visibility = foggy ? static_cast<float>(w.visibility_m) : std::numeric_limits<float>::infinity();
+  a.visibility =
+      foggy ? static_cast<float>(w.visibility_m) : std::numeric_limits<float>::infinity();
   a.fog_color = fog;
   a.wetness = static_cast<float>(w.wetness);
   a.snow_cover = static_cast<float>(w.snow_cover);
@@ -488,8 +494,48 @@ void CameraSensors::depth_datapack(size_t i, datapack::Builder& out) {
                              {"depth", datapack::ndarray_json(out, "<f4", shape, bytes)}});
 }
 
+namespace {
+double visible_fraction(const render::BoundingBox& b) {
+  const double full =
+      static_cast<double>(b.full_x_max - b.full_x_min) * (b.full_y_max - b.full_y_min);
+  const double seen = static_cast<double>(b.x_max - b.x_min + 1) * (b.y_max - b.y_min + 1);
+  if (!(full > 0)) return 1.0;
+  return std::clamp(seen / full, 0.0, 1.0);
+}
+}  // namespace
+
+void CameraSensors::instances_datapack(size_t i, datapack::Builder& out) {
+  Camera& cam = cameras_[i];
+  cam.want_ids = true;
+  if (!cam.rendered)
+    first_render(cam);
+  else if (!cam.has_ids)
+    render(cam);
+  const size_t pixels = static_cast<size_t>(cam.frame.width) * cam.frame.height;
+  ids_.resize(pixels);
+  for (size_t p = 0; p < pixels && p < cam.frame.model_ids.size(); ++p) {
+    const uint32_t id = cam.frame.model_ids[p];
+    ids_[p] = id == cam.own_model ? 0 : id;
+  }
+  nlohmann::json instances = nlohmann::json::object();
+  for (const auto& b : cam.frame.boxes) {
+    if (b.model_id == cam.own_model) continue;
+    instances[std::to_string(b.model_id)] = {{"model", model_names_[b.model_id - 1]},
+                                             {"class", model_classes_[b.model_id - 1]}};
+  }
+  const uint64_t shape[2] = {static_cast<uint64_t>(cam.frame.height),
+                             static_cast<uint64_t>(cam.frame.width)};
+  const std::string_view bytes(reinterpret_cast<const char*>(ids_.data()),
+                               ids_.size() * sizeof(uint32_t));
+  datapack::write_json(out, {{"width", cam.frame.width},
+                             {"height", cam.frame.height},
+                             {"ids", datapack::ndarray_json(out, "<u4", shape, bytes)},
+                             {"instances", instances}});
+}
+
 double CameraSensors::visibility(double distance) const {
-  if (!has_weather_ || !std::isfinite(weather_.visibility_m) || !std::isfinite(distance)) return 1.0;
+  if (!has_weather_ || !std::isfinite(weather_.visibility_m) || !std::isfinite(distance))
+    return 1.0;
   return std::exp(-3.912 * distance / weather_.visibility_m);
 }
 
@@ -512,7 +558,9 @@ void CameraSensors::boxes_datapack(size_t i, datapack::Builder& out) {
                      {"y_max", b.y_max},
                      {"pixels", b.pixel_count},
                      {"distance", std::isfinite(b.distance) ? b.distance : -1.0f},
-                     {"visibility", visibility(b.distance)}});
+                     {"visibility", visibility(b.distance)},
+                     {"visible_fraction", visible_fraction(b)},
+                     {"full_box", {b.full_x_min, b.full_y_min, b.full_x_max, b.full_y_max}}});
   }
   datapack::write_json(
       out, {{"width", cam.frame.width}, {"height", cam.frame.height}, {"boxes", boxes}});

@@ -62,7 +62,15 @@ class CameraSensors {
   // visible model but the ground and the camera's own. distance: metres from the camera to
   // the model's nearest visible part's centre; visibility: the share of its contrast the fog
   // leaves, exp(-3.912 distance / visibility_m) (1 without fog).
+  // visible_fraction: the visible box's area over the model's full projected box's (which
+  // may reach outside the image): 1 for a model in full view, less where something in front
+  // or the image's edge cuts it off (an estimate: a thin pole across it does not count).
   double visibility(double distance) const;
+  // The latest instance image as a JSON datapack {"width", "height", "ids": uint32 ndarray
+  // H x W (the ground-truth instance id at each pixel, 0 for none: as "instance" in the
+  // boxes), "instances": {"<id>": {"model", "class"}}} (the camera's own model and the
+  // ground are 0).
+  void instances_datapack(size_t i, datapack::Builder& out);
   void boxes_datapack(size_t i, datapack::Builder& out);
 
  private:
@@ -77,9 +85,10 @@ class CameraSensors {
     int depth_channels = 3;
     std::vector<int16_t> noise;         // mean + stddev * N(0,1) in 0..255 units, a fixed table
     const int16_t* noise_at = nullptr;  // the current frame's samples (null: no noise)
+    bool want_ids = false;              // instances asked for once
     bool want_image = false, want_depth = false, want_boxes = false;  // asked for once:
                                                                       // rendered from then on
-    bool has_depth = false, has_boxes = false;                        // the current frame has them
+    bool has_depth = false, has_boxes = false, has_ids = false;       // the current frame has them
   };
   struct Tracked {
     int link;                    // physics link index
@@ -125,6 +134,7 @@ class CameraSensors {
   double now_ = 0;
   std::vector<render::Light> base_lights_;
   std::vector<bool> street_light_;  // by base light
+  std::vector<uint32_t> ids_;       // instances_datapack's, reused
   render::Rgba base_ambient_{}, base_background_{};
   std::vector<Vehicle> vehicles_;
   bool has_weather_ = false;

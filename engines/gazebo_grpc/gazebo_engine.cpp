@@ -9,7 +9,10 @@
 //   <camera plugin>::<sensor>, <model>::<link>::<sensor>  GazeboCameraDataPack, read
 //   ...::depth   JSON {"width", "height", "depth": float32 ndarray (metres)}
 //   ...::boxes   JSON {"width", "height", "boxes": [{"model", "class", "instance", "x_min",
-//                "y_min", "x_max", "y_max", "pixels"}]}: ground truth of visible models
+//                "y_min", "x_max", "y_max", "pixels", "distance", "visibility",
+//                "visible_fraction", "full_box"}]}: ground truth of visible models
+//   ...::instances  JSON {"width", "height", "ids": uint32 ndarray (the instance id at each
+//                pixel), "instances": {id: {"model", "class"}}}: instance masks
 //   <model>::road_user  RoadUserDataPack, read: each ego model's state (EgoModels)
 //   collisions          JSON list of {"t", "a", "b", "class_a", "class_b",
 //                       "relative_speed_mps"}: every contact so far, each once when it starts
@@ -30,8 +33,8 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <random>
 #include <optional>
+#include <random>
 #include <set>
 #include <unordered_map>
 
@@ -162,9 +165,11 @@ class GazeboEngine final : public Engine {
         camera_dps_[base] = {c, kImage};
         camera_dps_[base + "::depth"] = {c, kDepth};
         camera_dps_[base + "::boxes"] = {c, kBoxes};
+        camera_dps_[base + "::instances"] = {c, kInstances};
         add(base, datapack::type_name<data::Camera>());
         add(base + "::depth", "json");
         add(base + "::boxes", "json");
+        add(base + "::instances", "json");
       }
     }
     // Ego models: those named, else every model with a joint controller plugin.
@@ -306,29 +311,29 @@ class GazeboEngine final : public Engine {
         cameras_->image_datapack(index, out);
       else if (kind == kDepth)
         cameras_->depth_datapack(index, out);
+      else if (kind == kInstances)
+        cameras_->instances_datapack(index, out);
       else
         cameras_->boxes_datapack(index, out);
       sent_frames_[id.name()] = cameras_->frames(index);
       return;
     }
-    if (auto it = brake_dps_.find(id.name()); it != brake_dps_.end()) {
-      const Brake& b = brakes_[it->second];
-      auto s = physics_->joint_state(b.joint);
+    // A joint's state; a brake's effort is the torque its ABS applies.
+    auto write_joint = [&](int joint, const double* effort) {
+      auto s = physics_->joint_state(joint);
       data::Joint j;
       j.set_position(static_cast<float>(s.position));
       j.set_velocity(static_cast<float>(s.velocity));
-      j.set_effort(static_cast<float>(b.applied));
+      j.set_effort(static_cast<float>(effort ? *effort : s.effort));
       datapack::write_proto(out, j);
+    };
+    if (auto it = brake_dps_.find(id.name()); it != brake_dps_.end()) {
+      const Brake& b = brakes_[it->second];
+      write_joint(b.joint, &b.applied);
       return;
     }
     if (auto it = joint_dps_.find(id.name()); it != joint_dps_.end()) {
-      const auto& c = controllers_[it->second];
-      auto s = physics_->joint_state(c.joint);
-      data::Joint j;
-      j.set_position(static_cast<float>(s.position));
-      j.set_velocity(static_cast<float>(s.velocity));
-      j.set_effort(static_cast<float>(s.effort));
-      datapack::write_proto(out, j);
+      write_joint(controllers_[it->second].joint, nullptr);
       return;
     }
     if (auto it = link_dps_.find(id.name()); it != link_dps_.end()) {
@@ -353,7 +358,7 @@ class GazeboEngine final : public Engine {
     double radius = -1;               // m; -1: not yet found
     double last_command = 0;          // in the previous physics step
     double last_omega = 0;            // the wheel's spin (rad/s, forward) in the previous step
-    double integral = 0;  // ABS: the PI controller's integral torque
+    double integral = 0;              // ABS: the PI controller's integral torque
   };
 
   void take_weather(const datapack::View& dp) {
@@ -793,7 +798,7 @@ class GazeboEngine final : public Engine {
   world::WorldDesc desc_;
   std::unique_ptr<world::PhysicsWorld> physics_;
   std::unique_ptr<world::CameraSensors> cameras_;
-  enum CameraOutput { kImage, kDepth, kBoxes };
+  enum CameraOutput { kImage, kDepth, kBoxes, kInstances };
   std::unordered_map<std::string, std::pair<size_t, CameraOutput>> camera_dps_;
   std::vector<Controller> controllers_;
   std::vector<Brake> brakes_;

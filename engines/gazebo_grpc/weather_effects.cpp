@@ -30,8 +30,8 @@ Weather weather_from_json(const nlohmann::json& j) {
   if (j.contains("precipitation_type")) {
     const auto& t = j["precipitation_type"];
     if (!t.is_string() || (t != "rain" && t != "snow" && t != "none"))
-      throw std::invalid_argument("precipitation_type: expected \"rain\", \"snow\" or \"none\", got " +
-                                  t.dump());
+      throw std::invalid_argument(
+          "precipitation_type: expected \"rain\", \"snow\" or \"none\", got " + t.dump());
     w.snow = t == "snow";
     if (t == "none") w.precipitation = 0;
   }

@@ -251,19 +251,22 @@ class Loader {
           if (tag == "abs") {
             const std::string v = j->GetValue() ? j->GetValue()->GetAsString() : "";
             if (v != "true" && v != "false" && v != "1" && v != "0")
-              throw std::runtime_error(file_.string() + ": " + where + ": <abs> must be true or false, got '" + v + "'");
+              throw std::runtime_error(file_.string() + ": " + where +
+                                       ": <abs> must be true or false, got '" + v + "'");
             bp.abs = v == "true" || v == "1";
           } else if (tag == "slip") {
             bp.slip = number(j->GetValue() ? j->GetValue()->GetAsString() : "", "<slip>");
             if (!(bp.slip > 0 && bp.slip < 1))
-              throw std::runtime_error(file_.string() + ": " + where + ": <slip> must be in (0, 1)");
+              throw std::runtime_error(file_.string() + ": " + where +
+                                       ": <slip> must be in (0, 1)");
           } else {
             BrakeDesc b;
             b.joint = model_name + "::" + tag;
             bool known = false;
             for (const auto& jd : model->joints) known |= jd.name == b.joint;
             if (!known)
-              throw std::runtime_error(file_.string() + ": " + where + ": unknown joint '" + tag + "'");
+              throw std::runtime_error(file_.string() + ": " + where + ": unknown joint '" + tag +
+                                       "'");
             const std::string t = attr(j, "MaxTorque");
             if (!t.empty()) b.max_torque = number(t, "joint '" + tag + "': MaxTorque");
             if (!(b.max_torque > 0))

@@ -16,7 +16,8 @@ using nlohmann::json;
 
 double number(const json& obj, const char* k, const std::string& key) {
   const json& v = obj.at(k);
-  if (!v.is_number() || !std::isfinite(v.get<double>())) bad(key, "expected a number, got " + v.dump());
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    bad(key, "expected a number, got " + v.dump());
   return v.get<double>();
 }
 
@@ -86,14 +87,16 @@ WeatherModel::WeatherModel(const json& config) {
       c->to[k] = v;
     };
     if (strict) {
-      static const char* known[] = {"Time", "Transition", "Precipitation", "PrecipitationType",
-                                    "Visibility", "Surface", "SunAltitude", "SunAzimuth",
-                                    "TimeOfDay", "WindSpeed", "WindDirection"};
+      static const char* known[] = {
+          "Time",       "Transition", "Precipitation", "PrecipitationType",
+          "Visibility", "Surface",    "SunAltitude",   "SunAzimuth",
+          "TimeOfDay",  "WindSpeed",  "WindDirection"};
       for (const auto& [k, v] : obj.items()) {
         if (std::find(std::begin(known), std::end(known), k) == std::end(known))
-          bad(key(k), "unknown key (Time, Transition, Precipitation, PrecipitationType, "
-                      "Visibility, Surface, SunAltitude, SunAzimuth, TimeOfDay, WindSpeed, "
-                      "WindDirection)");
+          bad(key(k),
+              "unknown key (Time, Transition, Precipitation, PrecipitationType, "
+              "Visibility, Surface, SunAltitude, SunAzimuth, TimeOfDay, WindSpeed, "
+              "WindDirection)");
       }
     }
     if (obj.contains("Precipitation")) {
@@ -125,7 +128,8 @@ WeatherModel::WeatherModel(const json& config) {
       if (obj.contains("SunAltitude") || obj.contains("SunAzimuth"))
         bad(key("TimeOfDay"), "give either TimeOfDay or SunAltitude/SunAzimuth, not both");
       const double h = number(obj, "TimeOfDay", key("TimeOfDay"));
-      if (h < 0 || h > 24) bad(key("TimeOfDay"), "must be in [0, 24] hours, got " + obj["TimeOfDay"].dump());
+      if (h < 0 || h > 24)
+        bad(key("TimeOfDay"), "must be in [0, 24] hours, got " + obj["TimeOfDay"].dump());
       auto [alt, az] = sun_at(h);
       set(kAltitude, alt);
       set(kAzimuth, az);
@@ -196,7 +200,8 @@ WeatherModel::WeatherModel(const json& config) {
       for (int k = 0; k < kKeys; ++k) {
         if (!c.has[k]) continue;
         c.from[k] = value_at(k, c.time, i);
-        if (k == kAzimuth || k == kWindDirection) c.to[k] = c.from[k] + wrap180(c.to[k] - c.from[k]);
+        if (k == kAzimuth || k == kWindDirection)
+          c.to[k] = c.from[k] + wrap180(c.to[k] - c.from[k]);
       }
     }
   }

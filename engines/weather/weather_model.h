@@ -34,8 +34,10 @@ struct SurfaceInfo {
   const char* name;
   double mu, wetness, snow_cover;
 };
-inline constexpr SurfaceInfo kSurfaces[] = {
-    {"dry", 0.8, 0.0, 0.0}, {"wet", 0.5, 1.0, 0.0}, {"snow", 0.25, 0.2, 1.0}, {"ice", 0.1, 0.6, 0.0}};
+inline constexpr SurfaceInfo kSurfaces[] = {{"dry", 0.8, 0.0, 0.0},
+                                            {"wet", 0.5, 1.0, 0.0},
+                                            {"snow", 0.25, 0.2, 1.0},
+                                            {"ice", 0.1, 0.6, 0.0}};
 
 // Meteorological visibility of clear air (m): fog is visibility below 1000 m.
 inline constexpr double kClearVisibility = 20000.0;
@@ -71,8 +73,18 @@ class WeatherModel {
   static std::pair<double, double> sun_at(double hours);
 
  private:
-  enum Key { kPrecipitation, kVisibility, kMu, kWetness, kSnow, kAltitude, kAzimuth, kWindSpeed,
-             kWindDirection, kKeys };
+  enum Key {
+    kPrecipitation,
+    kVisibility,
+    kMu,
+    kWetness,
+    kSnow,
+    kAltitude,
+    kAzimuth,
+    kWindSpeed,
+    kWindDirection,
+    kKeys
+  };
   struct Change {
     double time = 0, transition = 0;
     bool has[kKeys] = {};

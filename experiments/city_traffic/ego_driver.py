@@ -23,9 +23,13 @@ STEER_GAIN = 1.2
 START_X = -150.0     # the ego's start in city_world.sdf: the route is followed from there
 
 
-def load_route(path):
+def load_route(path, skip=None):
+    """The route's points from the ego's start: past START_X (the shipped route), or after
+    `skip` points (another route, $CONVOY_EGO_ROUTE_SKIP)."""
     with open(path) as f:
         pts = [(float(r["x"]), float(r["y"])) for r in csv.DictReader(f)]
+    if skip is not None:
+        return pts[skip:]
     return [p for p in pts if p[0] >= START_X]
 
 
@@ -36,7 +40,11 @@ class Script(EngineScript):
         self._registerDataPack("state_location")
         self._setDataPack("state_location", {"location_x": 0, "location_y": 0, "qtn_x": 0, "qtn_y": 0,
                                              "qtn_z": 0, "qtn_w": 0})
-        self.points = load_route(os.path.join(HERE, "ego_route.csv"))
+        # $CONVOY_EGO_ROUTE: another route (a CSV as convoy-odr route writes), e.g. the
+        # held-out camera path of tools/dataset (city_world_west.sdf starts the car on it).
+        route = os.environ.get("CONVOY_EGO_ROUTE")
+        self.points = (load_route(os.path.join(HERE, route), int(os.environ.get("CONVOY_EGO_ROUTE_SKIP", "0")))
+                       if route else load_route(os.path.join(HERE, "ego_route.csv")))
         self.trajectory = relateAngle_computation.Trajectory(self.points)
         self.arrived_s = None
 

@@ -140,7 +140,7 @@ def config():
         {"EngineType": "python_json", "EngineName": "planner",
          "PythonFileName": "../ego_planner/ego_planner_engine.py", "EngineTimestep": WORLD_DT,
          "EngineEnvParams": ["CONVOY_EGO_PLANNER_CONFIG=../city_traffic/ego_planner.json"]},
-        {"EngineType": "detector", "EngineName": "yolo_detector", "Backend": "ground_truth",
+        {"EngineType": "detector", "EngineName": "yolo_detector", "Backend": "convoy",
          "EngineTimestep": DETECTOR_DT},
         {"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
          "Map": MAP, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0},

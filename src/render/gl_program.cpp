@@ -230,6 +230,35 @@ GLuint compile(GLenum stage, const std::string& source) {
   return shader;
 }
 
+// Compiles and links a program of the two stages; throws with the driver's log.
+GLuint link(const std::string& vertex, const std::string& fragment) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex);
+  GLuint fs = 0;
+  try {
+    fs = compile(GL_FRAGMENT_SHADER, fragment);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  const GLuint id = glCreateProgram();
+  glAttachShader(id, vs);
+  glAttachShader(id, fs);
+  glLinkProgram(id);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetProgramiv(id, GL_INFO_LOG_LENGTH, &length);
+    std::vector<char> log(length + 1, '\0');
+    glGetProgramInfoLog(id, length, nullptr, log.data());
+    glDeleteProgram(id);
+    throw std::runtime_error(std::string("render: shader program does not link: ") + log.data());
+  }
+  return id;
+}
+
 }  // namespace
 
 SurfaceProgram build_surface_program(const ProgramKey& key) {
@@ -252,31 +281,8 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
     std::string s = replace_all(source, "LIGHTING_CODE", lights_here ? kLighting : "");
     return header + replace_all(s, "LIGHT_CALLS", lights_here ? calls : "");
   };
-  const GLuint vs = compile(GL_VERTEX_SHADER, stage(kVertexShader, key.per_vertex));
-  GLuint fs = 0;
-  try {
-    fs = compile(GL_FRAGMENT_SHADER, stage(kFragmentShader, !key.per_vertex));
-  } catch (...) {
-    glDeleteShader(vs);
-    throw;
-  }
   SurfaceProgram p;
-  p.id = glCreateProgram();
-  glAttachShader(p.id, vs);
-  glAttachShader(p.id, fs);
-  glLinkProgram(p.id);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    GLint length = 0;
-    glGetProgramiv(p.id, GL_INFO_LOG_LENGTH, &length);
-    std::vector<char> log(length + 1, '\0');
-    glGetProgramInfoLog(p.id, length, nullptr, log.data());
-    glDeleteProgram(p.id);
-    throw std::runtime_error(std::string("render: shader program does not link: ") + log.data());
-  }
+  p.id = link(stage(kVertexShader, key.per_vertex), stage(kFragmentShader, !key.per_vertex));
   auto at = [&](const char* name) { return glGetUniformLocation(p.id, name); };
   p.model_view = at("u_model_view");
   p.normal_matrix = at("u_normal_matrix");
@@ -367,27 +373,8 @@ void main() {
 }  // namespace
 
 PrecipitationProgram build_precipitation_program() {
-  const GLuint vs = compile(GL_VERTEX_SHADER, kFullScreenVertexShader);
-  GLuint fs = 0;
-  try {
-    fs = compile(GL_FRAGMENT_SHADER, kPrecipitationShader);
-  } catch (...) {
-    glDeleteShader(vs);
-    throw;
-  }
   PrecipitationProgram p;
-  p.id = glCreateProgram();
-  glAttachShader(p.id, vs);
-  glAttachShader(p.id, fs);
-  glLinkProgram(p.id);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    glDeleteProgram(p.id);
-    throw std::runtime_error("render: the precipitation program does not link");
-  }
+  p.id = link(kFullScreenVertexShader, kPrecipitationShader);
   p.size = glGetUniformLocation(p.id, "u_size");
   p.seed = glGetUniformLocation(p.id, "u_seed");
   p.amount = glGetUniformLocation(p.id, "u_amount");

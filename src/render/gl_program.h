@@ -26,7 +26,7 @@ struct ProgramKey {
   bool ids = false;
   bool per_vertex = false;  // lighting in the vertex shader
   bool specular = true;     // false: the material has no specular colour (no highlights to compute)
-  bool fog = false;              // Atmosphere::fog()
+  bool fog = false;         // Atmosphere::fog()
   bool surface_weather = false;  // Atmosphere::surface_weather() (per-pixel programs only)
 
   auto operator<=>(const ProgramKey&) const = default;

@@ -56,6 +56,43 @@ void check_spec(const CameraSpec& s) {
   }
 }
 
+// Each box's full extent: the projection of its model's visible instances' bounding boxes
+// (BoundingBox::full_*).
+void full_extents(const Scene& scene, const glm::dmat4& view, const CameraSpec& spec,
+                  std::vector<BoundingBox>* boxes) {
+  if (boxes->empty()) return;
+  const double fx = spec.width / 2.0 / std::tan(spec.hfov / 2);
+  for (auto& b : *boxes) {
+    b.full_x_min = b.full_y_min = std::numeric_limits<float>::infinity();
+    b.full_x_max = b.full_y_max = -std::numeric_limits<float>::infinity();
+  }
+  const auto& instances = scene.instances();
+  for (const Scene::Instance& inst : instances) {
+    if (inst.model_id == 0 || !inst.visible) continue;
+    auto it = std::lower_bound(boxes->begin(), boxes->end(), inst.model_id,
+                               [](const BoundingBox& b, uint32_t id) { return b.model_id < id; });
+    if (it == boxes->end() || it->model_id != inst.model_id) continue;
+    const Scene::Bounds& bd = scene.mesh_bounds()[inst.mesh];
+    const glm::dmat4 mv = view * glm::make_mat4(inst.world_from_object.data());
+    for (int c = 0; c < 8; ++c) {
+      const glm::dvec4 corner((c & 1) ? bd.hi[0] : bd.lo[0], (c & 2) ? bd.hi[1] : bd.lo[1],
+                              (c & 4) ? bd.hi[2] : bd.lo[2], 1.0);
+      const glm::dvec3 e = mv * corner;
+      if (-e.z < spec.near_clip) {  // behind the camera: unbounded
+        it->full_x_min = it->full_y_min = -1e6f;
+        it->full_x_max = it->full_y_max = 1e6f;
+        continue;
+      }
+      const double u = spec.width / 2.0 + fx * e.x / -e.z;
+      const double v = spec.height / 2.0 - fx * e.y / -e.z;
+      it->full_x_min = std::min(it->full_x_min, static_cast<float>(u));
+      it->full_x_max = std::max(it->full_x_max, static_cast<float>(u));
+      it->full_y_min = std::min(it->full_y_min, static_cast<float>(v));
+      it->full_y_max = std::max(it->full_y_max, static_cast<float>(v));
+    }
+  }
+}
+
 // Triangles submitted between two glFlush calls (see Impl::draw).
 constexpr size_t kFlushEveryTriangles = 16384;
 
@@ -426,8 +463,20 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
     glReadBuffer(GL_COLOR_ATTACHMENT2);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, s.ids.data());
     boxes_from_ids(s.ids.data(), w, h, scene, &out->boxes, s.instance_distance.data());
+    full_extents(scene, view, spec, &out->boxes);
+    if (out->keep_ids) {
+      out->model_ids.resize(pixels);
+      const auto& instances = scene.instances();
+      for (size_t p = 0; p < pixels; ++p) {
+        const uint32_t v = s.ids[p];
+        out->model_ids[p] = v != 0 && v <= instances.size() ? instances[v - 1].model_id : 0;
+      }
+    } else {
+      out->model_ids.clear();
+    }
   } else {
     out->boxes.clear();
+    out->model_ids.clear();
   }
   if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
     char code[16];

@@ -54,6 +54,11 @@ struct BoundingBox {
   uint32_t pixel_count;            // visible pixels
   // Metres from the camera to the nearest bounding-sphere centre of its visible instances.
   float distance = std::numeric_limits<float>::infinity();
+  // Where the whole model would be in the image were nothing in front of it and the image
+  // unbounded: its instances' bounding boxes projected (pixels, may lie outside the image;
+  // +-1e6 where a part is behind the camera). With the visible box, a measure of occlusion
+  // and truncation.
+  float full_x_min = 0, full_y_min = 0, full_x_max = 0, full_y_max = 0;
 };
 
 struct Frame {
@@ -64,6 +69,10 @@ struct Frame {
   // cameras, straight into the outgoing shared memory) saves a copy of the frame.
   bool keep_rgba = false;
   std::vector<uint8_t> rgba;
+  // Set by the caller: with boxes, also keep `model_ids`: height x width, the model_id of the
+  // labelled model seen at each pixel (0: none, or an unlabelled one), row 0 = top.
+  bool keep_ids = false;
+  std::vector<uint32_t> model_ids;
   // height x width distances in metres along the optical axis (camera +X), row 0 = top;
   // +infinity where nothing lies within the clip range. Empty unless asked for.
   std::vector<float> depth;

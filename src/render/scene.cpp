@@ -33,6 +33,8 @@ Scene::Bounds bounds_of(const MeshData& mesh) {
     }
   }
   Scene::Bounds b{{(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2}, 0};
+  b.lo = {lo[0], lo[1], lo[2]};
+  b.hi = {hi[0], hi[1], hi[2]};
   double r2 = 0;
   for (size_t i = 0; i < mesh.positions.size(); i += 3) {
     double d2 = 0;

@@ -16,8 +16,8 @@
 
 #include <array>
 #include <cmath>
-#include <limits>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -110,6 +110,7 @@ class Scene {
   struct Bounds {
     std::array<float, 3> centre;
     float radius;
+    std::array<float, 3> lo{}, hi{};  // the axis-aligned bounding box
   };
   // A coarser stand-in for a mesh and its geometric error (metres, in the mesh's frame).
   struct Lod {
@@ -175,7 +176,7 @@ class Scene {
   std::vector<Light> lights_;
   Rgba ambient_{0.4f, 0.4f, 0.4f, 1.0f};     // SDF <scene><ambient> default
   Rgba background_{0.7f, 0.7f, 0.7f, 1.0f};  // SDF <scene><background> default
-  Atmosphere atmosphere_;                     // none: clear air
+  Atmosphere atmosphere_;                    // none: clear air
 };
 
 }  // namespace convoy::render

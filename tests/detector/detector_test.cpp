@@ -429,7 +429,7 @@ TEST_F(OnnxModels, EngineYoloRunsOncePerNewImage) {
 
 TEST(Engine, GroundTruthPassthrough) {
   engines::DetectorEngine e;
-  e.initialize("det", nlohmann::json::object(), 1000);
+  e.initialize("det", {{"Backend", "ground_truth"}}, 1000);
   nlohmann::json boxes = {{"width", 320},
                           {"height", 240},
                           {"boxes",
@@ -483,15 +483,27 @@ TEST(Engine, AnUnknownDatapackComesBackEmpty) {
 }
 
 TEST(Engine, BackendsComeFromOneTable) {
-  EXPECT_EQ(detector::backend_names(), (std::vector<std::string>{"ground_truth", "hog", "yolo"}));
-  auto truth = detector::make_backend(nlohmann::json::object());
+  EXPECT_EQ(detector::backend_names(),
+            (std::vector<std::string>{"convoy", "ground_truth", "hog", "yolo"}));
+  // The default: Convoy's own model (share/convoy/models/detector), from the image.
+  EXPECT_EQ(detector::make_backend(nlohmann::json::object())->input(),
+            detector::BackendInput::kImage);
+  auto truth = detector::make_backend({{"Backend", "ground_truth"}});
   EXPECT_EQ(truth->input(), detector::BackendInput::kGroundTruth);
+  try {
+    detector::make_backend({{"Backend", "convoy"}, {"ModelPath", "/nonexistent/model.onnx"}});
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no model at /nonexistent/model.onnx"), std::string::npos)
+        << e.what();
+  }
   EXPECT_EQ(detector::make_backend({{"Backend", "hog"}})->input(), detector::BackendInput::kImage);
   try {
     detector::make_backend({{"Backend", "ssd"}});
     FAIL();
   } catch (const std::runtime_error& e) {
-    EXPECT_STREQ(e.what(), "Backend 'ssd': must be one of \"ground_truth\", \"hog\", \"yolo\"");
+    EXPECT_STREQ(e.what(),
+                 "Backend 'ssd': must be one of \"convoy\", \"ground_truth\", \"hog\", \"yolo\"");
   }
 }
 

@@ -84,10 +84,32 @@ class Both(unittest.TestCase):
         self.assertGreater(s["camera_frames"], 80)  # 30 Hz for 3 s
         self.assertGreater(s["camera_frames_per_s"], 0)
         self.assertGreater(sum(s["detections_per_class"].values()), 0)
-        self.assertEqual(s["detector_precision"], 1.0)  # ground truth scored against itself
-        self.assertEqual(s["detector_recall"], 1.0)
+        # Convoy's trained detector by default, its classes from models/detector/classes.txt
+        self.assertIs(s["detector_is_ground_truth"], False)
+        self.assertTrue(set(s["detections_per_class"]) <= {"car", "truck", "bus", "pedestrian", "cyclist"},
+                        s["detections_per_class"])
+        self.assertGreater(s["detector_inference_ms_median"], 0)
+        self.assertIn("detector_map50", s)
         # the coordinator's, added on top
         self.assertEqual(s["exit_code"], 0)
         self.assertAlmostEqual(s["sim_time_s"], 3.0)
         self.assertGreater(s["loop_wall_s"], 0)
         self.assertGreater(s["real_time_factor"], 0)
+
+    def test_ground_truth_backend_scores_perfectly_and_says_so(self):
+        d = tempfile.mkdtemp(prefix="convoy-ad-")
+        self.addCleanup(shutil.rmtree, d, True)
+        run = os.path.join(d, "run")
+        with open(os.path.join(EXP, "simulation_config_both.json")) as f:
+            det = [e["EngineName"] for e in json.load(f)["EngineConfigs"]].index("yolo_detector")
+        r = subprocess.run([CONVOY, "run", "-q", "-c", os.path.join(EXP, "simulation_config_both.json"),
+                            "--run-dir", run, "-o", "SimulationTimeout=3",
+                            "-o", "EngineConfigs/%d/Backend=ground_truth" % det],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(run, "summary.json")) as f:
+            s = json.load(f)
+        self.assertIs(s["detector_is_ground_truth"], True)
+        self.assertEqual(s["detector_precision"], 1.0)  # ground truth scored against itself
+        self.assertEqual(s["detector_recall"], 1.0)
+        self.assertEqual(s["detector_map50"], 1.0)

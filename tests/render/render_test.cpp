@@ -16,23 +16,10 @@
 
 #include "render/image_io.h"
 #include "render/renderer.h"
+#include "shared_renderer.h"
 
 namespace convoy::render {
 namespace {
-
-Renderer* shared_renderer() {
-  static std::unique_ptr<Renderer> renderer;
-  static std::string error;
-  if (!renderer && error.empty()) {
-    try {
-      renderer = std::make_unique<Renderer>();
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-  }
-  if (!renderer) ADD_FAILURE() << "cannot start the renderer: " << error;
-  return renderer.get();
-}
 
 #define GET_RENDERER(r)            \
   Renderer* r = shared_renderer(); \

@@ -7,23 +7,10 @@
 #include <string>
 
 #include "render/renderer.h"
+#include "shared_renderer.h"
 
 namespace convoy::render {
 namespace {
-
-Renderer* shared_renderer() {
-  static std::unique_ptr<Renderer> renderer;
-  static std::string error;
-  if (!renderer && error.empty()) {
-    try {
-      renderer = std::make_unique<Renderer>();
-    } catch (const std::exception& e) {
-      error = e.what();
-    }
-  }
-  if (!renderer) ADD_FAILURE() << "cannot start the renderer: " << error;
-  return renderer.get();
-}
 
 Material plain(float r, float g, float b) {
   Material m;
@@ -43,8 +30,8 @@ double luminance(const Frame& f, int x, int y) {
 TEST(WeatherRenderTest, FogContrastFollowsKoschmieder) {
   Renderer* r = shared_renderer();
   ASSERT_NE(r, nullptr);
-  for (auto [d, v] : {std::pair{20.0, 100.0}, {50.0, 100.0}, {30.0, 300.0}, {80.0, 200.0},
-                      {10.0, 500.0}}) {
+  for (auto [d, v] :
+       {std::pair{20.0, 100.0}, {50.0, 100.0}, {30.0, 300.0}, {80.0, 200.0}, {10.0, 500.0}}) {
     Scene scene;
     Material black = plain(0, 0, 0);
     scene.add_instance(scene.add_mesh(make_box(1, 8, 8)), black, make_pose(d + 0.5, 0, 0));
@@ -140,8 +127,8 @@ TEST(WeatherRenderTest, GroundTruthBoxesGiveTheirDistance) {
   scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(1, 0, 0), make_pose(12, 0, 0), 3, 1);
   scene.add_light(Light{});
   Frame f;
-  shared_renderer()->render(scene, make_pose(0, 0, 0), CameraSpec{64, 48, 1.0, 0.1, 100}, &f,
-                            false, true);
+  shared_renderer()->render(scene, make_pose(0, 0, 0), CameraSpec{64, 48, 1.0, 0.1, 100}, &f, false,
+                            true);
   ASSERT_EQ(f.boxes.size(), 1u);
   EXPECT_NEAR(f.boxes[0].distance, 12.0, 1e-3);
 }

@@ -25,7 +25,8 @@ TEST(WeatherModel, DefaultsAreClearAndDry) {
 }
 
 TEST(WeatherModel, SurfacesGiveTheirFriction) {
-  for (const auto& [name, mu] : {std::pair{"dry", 0.8}, {"wet", 0.5}, {"snow", 0.25}, {"ice", 0.1}}) {
+  for (const auto& [name, mu] :
+       {std::pair{"dry", 0.8}, {"wet", 0.5}, {"snow", 0.25}, {"ice", 0.1}}) {
     WeatherModel m(json{{"Surface", name}});
     EXPECT_EQ(m.state().surface, name);
     EXPECT_DOUBLE_EQ(m.state().mu, mu) << name;
@@ -83,7 +84,8 @@ TEST(WeatherModel, SunFromTimeOfDayAndNight) {
   WeatherModel night(json{{"TimeOfDay", 23}});
   EXPECT_TRUE(night.state().night);
   EXPECT_DOUBLE_EQ(night.state().daylight, 0.0);
-  WeatherModel dusk(json::parse(R"({"TimeOfDay": 17, "Schedule": [{"Time": 0, "TimeOfDay": 19, "Transition": 100}]})"));
+  WeatherModel dusk(json::parse(
+      R"({"TimeOfDay": 17, "Schedule": [{"Time": 0, "TimeOfDay": 19, "Transition": 100}]})"));
   EXPECT_FALSE(dusk.advance(0).night);
   EXPECT_TRUE(dusk.advance(100).night);
   EXPECT_GT(dusk.advance(40).daylight, 0.0);
@@ -133,8 +135,8 @@ TEST(WeatherModel, BadInputNamesTheKey) {
   EXPECT_EQ(error_of(R"({"Surface": "mud"})").rfind("Surface: unknown surface \"mud\"", 0), 0u)
       << error_of(R"({"Surface": "mud"})");
   EXPECT_EQ(error_of(R"({"Visibility": -5})").rfind("Visibility: must be > 0", 0), 0u);
-  const std::string order =
-      error_of(R"({"Schedule": [{"Time": 30, "Precipitation": 1}, {"Time": 20, "Precipitation": 0}]})");
+  const std::string order = error_of(
+      R"({"Schedule": [{"Time": 30, "Precipitation": 1}, {"Time": 20, "Precipitation": 0}]})");
   EXPECT_EQ(order.rfind("Schedule[1].Time: the schedule is out of order", 0), 0u) << order;
   EXPECT_EQ(error_of(R"({"Schedule": [{"Time": 1, "Surface": "gravel"}]})")
                 .rfind("Schedule[0].Surface: unknown surface", 0),
@@ -142,11 +144,14 @@ TEST(WeatherModel, BadInputNamesTheKey) {
   EXPECT_EQ(error_of(R"({"Schedule": [{"Time": 1, "Visibility": 0}]})")
                 .rfind("Schedule[0].Visibility: must be > 0", 0),
             0u);
-  EXPECT_EQ(error_of(R"({"Schedule": [{"Time": 1, "Rain": 1}]})").rfind("Schedule[0].Rain: unknown key", 0),
+  EXPECT_EQ(error_of(R"({"Schedule": [{"Time": 1, "Rain": 1}]})")
+                .rfind("Schedule[0].Rain: unknown key", 0),
             0u);
   EXPECT_EQ(error_of(R"({"Precipitation": 2})").rfind("Precipitation: must be in [0, 1]", 0), 0u);
-  EXPECT_EQ(error_of(R"({"PrecipitationType": "hail"})").rfind("PrecipitationType: expected", 0), 0u);
-  EXPECT_EQ(error_of(R"({"Schedule": [{"Precipitation": 1}]})").rfind("Schedule[0]: expected an object with Time", 0),
+  EXPECT_EQ(error_of(R"({"PrecipitationType": "hail"})").rfind("PrecipitationType: expected", 0),
+            0u);
+  EXPECT_EQ(error_of(R"({"Schedule": [{"Precipitation": 1}]})")
+                .rfind("Schedule[0]: expected an object with Time", 0),
             0u);
   EXPECT_EQ(error_of(R"({"TimeOfDay": 25})").rfind("TimeOfDay: must be in [0, 24]", 0), 0u);
   EXPECT_EQ(error_of(R"({"WindSpeed": -1})").rfind("WindSpeed: must be >= 0", 0), 0u);

@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""Labelled data from any experiment: runs it --runs times, each with its own seed and (with
+--randomize) its own weather and time of day, and writes every --every-th frame of one camera
+with COCO ground truth (boxes, classes, instance ids, instance masks as RLE) and depth.
+
+  /usr/bin/python3 tools/dataset/make_dataset.py CONFIG --out DIR [--runs 4] [--seed 0]
+      [--every 15] [--seconds 60] [--camera smart_camera::camera] [--world gazebo]
+      [--randomize] [--build build]
+
+Writes DIR/annotations.json (all runs, COCO; each image's record has its seed, weather and
+time), DIR/images/*.jpg, DIR/depth/*.png (mm, uint16), DIR/runs.json (what each run drew).
+The experiment needs a world engine with the camera and a `weather` engine (every driving
+experiment has one). What it adds to the run: the dataset_writer engine and its TF
+(tools/dataset/). docs/perception.md has the details.
+"""
+import argparse
+import json
+import os
+import random
+import shutil
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(REPO, "python"))
+
+
+def draw_weather(rng):
+    """A weather for one run: clear most often, then rain, fog, snow, dusk and night."""
+    kind = rng.choices(["clear", "rain", "fog", "snow", "dusk", "night"],
+                       weights=[0.4, 0.15, 0.15, 0.1, 0.1, 0.1])[0]
+    w = {"TimeOfDay": round(rng.uniform(8.0, 16.5), 2)}
+    if kind == "rain":
+        w.update(Precipitation=round(rng.uniform(0.3, 1.0), 2), Surface="wet")
+    elif kind == "fog":
+        w.update(Visibility=round(rng.uniform(60, 400), 1))
+    elif kind == "snow":
+        w.update(Precipitation=round(rng.uniform(0.2, 0.8), 2), PrecipitationType="snow",
+                 Surface="snow")
+    elif kind == "dusk":
+        w.update(TimeOfDay=round(rng.uniform(17.3, 18.3), 2))
+    elif kind == "night":
+        w.update(TimeOfDay=round(rng.uniform(19.0, 23.5), 2))
+    return kind, w
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("config")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--runs", type=int, default=4)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--every", type=int, default=15, help="keep every n-th new camera frame")
+    ap.add_argument("--seconds", type=float, default=60.0, help="simulated seconds per run")
+    ap.add_argument("--camera", default="smart_camera::camera")
+    ap.add_argument("--world", default="gazebo", help="the world engine's name")
+    ap.add_argument("--randomize", action="store_true", help="draw weather and time of day per run")
+    ap.add_argument("--set", action="append", default=[], metavar="ENGINE.KEY=JSON",
+                    help="set an engine's config key (the value read as JSON, else as a string)")
+    ap.add_argument("--env", action="append", default=[], metavar="ENGINE:VAR=VALUE",
+                    help="add an environment variable to an engine's EngineEnvParams")
+    ap.add_argument("--build", default=os.path.join(REPO, "build"))
+    args = ap.parse_args()
+
+    config_path = os.path.abspath(args.config)
+    with open(config_path) as f:
+        base = json.load(f)
+    names = [e["EngineName"] for e in base["EngineConfigs"]]
+    for needed in (args.world, "weather"):
+        if needed not in names:
+            sys.exit("make_dataset: %s has no engine '%s'" % (config_path, needed))
+    world = base["EngineConfigs"][names.index(args.world)]
+    weather_index = names.index("weather")
+    out = os.path.abspath(args.out)
+    os.makedirs(os.path.join(out, "tf"), exist_ok=True)
+    with open(os.path.join(HERE, "dataset_tf.py.in")) as f:
+        template = f.read()
+    convoy = os.path.join(args.build, "bin", "convoy")
+    from convoy_perception.coco import CocoWriter  # noqa: E402 (after the path)
+
+    merged = CocoWriter(out)
+    runs = []
+    for k in range(args.runs):
+        seed = args.seed + k
+        rng = random.Random(seed)
+        kind, weather = draw_weather(rng) if args.randomize else ("as configured", {})
+        part = os.path.join(out, "parts", "run%03d" % seed)
+        shutil.rmtree(part, ignore_errors=True)
+        tf = os.path.join(out, "tf", "dataset_tf_%d.py" % seed)
+        with open(tf, "w") as f:
+            f.write(template.replace("@CAMERA@", args.camera).replace("@WORLD@", args.world)
+                    .replace("@EVERY@", str(args.every)))
+        cfg = json.loads(json.dumps(base))
+        cfg["SimulationTimeout"] = args.seconds
+        cfg["EngineConfigs"].append({
+            "EngineType": "python_json", "EngineName": "dataset_writer",
+            "PythonFileName": os.path.join(HERE, "dataset_writer.py"),
+            "EngineTimestep": world.get("EngineTimestep", 0.02),
+            "EngineEnvParams": ["CONVOY_DATASET_DIR=" + part, "CONVOY_DATASET_PREFIX=s%d" % seed,
+                                "CONVOY_DATASET_EXTRA=" + json.dumps({"seed": seed, "weather_kind": kind})]})
+        cfg["DataPackProcessingFunctions"].append({"Name": "dataset_tf", "FileName": tf})
+        for e in cfg["EngineConfigs"]:
+            if e["EngineName"] == args.world and e.get("EngineType", "").startswith("gazebo"):
+                e["GazeboRNGSeed"] = seed
+            if e["EngineName"] == "weather":
+                e["Seed"] = seed
+                e.update(weather)
+        for item in args.set:
+            key, _, value = item.partition("=")
+            engine, _, field = key.partition(".")
+            try:
+                value = json.loads(value)
+            except ValueError:
+                pass
+            match = [e for e in cfg["EngineConfigs"] if e["EngineName"] == engine]
+            if not match or not field:
+                sys.exit("make_dataset: --set %s: no engine '%s' in %s" % (item, engine, config_path))
+            match[0][field] = value
+        for item in args.env:
+            engine, _, var = item.partition(":")
+            match = [e for e in cfg["EngineConfigs"] if e["EngineName"] == engine]
+            if not match or "=" not in var:
+                sys.exit("make_dataset: --env %s: expected ENGINE:VAR=VALUE with an engine of %s" % (item, config_path))
+            match[0].setdefault("EngineEnvParams", []).append(var)
+        # Relative paths in the config are relative to its folder: the derived config goes
+        # next to it for the run, and is removed after.
+        derived = os.path.join(os.path.dirname(config_path), ".dataset_%d_%d.json" % (os.getpid(), seed))
+        with open(derived, "w") as f:
+            json.dump(cfg, f, indent=1)
+        try:
+            r = subprocess.run([convoy, "run", "-q", "-c", derived, "--run-dir",
+                                os.path.join(out, "runs", "run%03d" % seed)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        finally:
+            os.remove(derived)
+        if r.returncode != 0:
+            sys.exit("make_dataset: run %d failed (exit %d):\n%s" % (seed, r.returncode, r.stderr[-3000:]))
+        with open(os.path.join(part, "annotations.json")) as f:
+            doc = json.load(f)
+        # Merge: move the files up, renumber the ids.
+        remap = {}
+        for img in doc["images"]:
+            for key in ("file_name", "depth_file"):
+                if key in img:
+                    os.replace(os.path.join(part, img[key]), os.path.join(out, img[key]))
+            new_id = len(merged.images) + 1
+            remap[img["id"]] = new_id
+            merged.images.append(dict(img, id=new_id))
+        for a in doc["annotations"]:
+            merged.annotations.append(dict(a, id=len(merged.annotations) + 1, image_id=remap[a["image_id"]]))
+        shutil.rmtree(part, ignore_errors=True)
+        runs.append({"seed": seed, "weather_kind": kind, "weather": weather, "frames": len(doc["images"]),
+                     "annotations": len(doc["annotations"])})
+        print("run %d (seed %d, %s): %d frames, %d annotations" % (k, seed, kind, len(doc["images"]),
+                                                                   len(doc["annotations"])), flush=True)
+    merged.write({"config": config_path, "runs": runs})
+    shutil.rmtree(os.path.join(out, "parts"), ignore_errors=True)
+    with open(os.path.join(out, "runs.json"), "w") as f:
+        json.dump(runs, f, indent=1)
+    print("make_dataset: %d images, %d annotations in %s" % (len(merged.images), len(merged.annotations), out))
+
+
+if __name__ == "__main__":
+    main()
