@@ -82,6 +82,35 @@ class Dataset(unittest.TestCase):
         self.assertEqual(rle_encode(m)["counts"][:2], [0, 1])  # starts with a run of zeros
 
 
+class DatasetBadInput(unittest.TestCase):
+    def run_tool(self, config, *args):
+        d = tempfile.mkdtemp(prefix="convoy-dataset-bad-")
+        self.addCleanup(shutil.rmtree, d, True)
+        return subprocess.run([PY, MAKE_DATASET, config, "--out", d, "--build", os.path.dirname(BIN_DIR),
+                               "--runs", "1", "--seconds", "1"] + list(args),
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+
+    def test_an_experiment_without_a_weather_engine_is_named(self):
+        cfg = os.path.join(REPO, "experiments", "wheeled_robot", "simulation_config.json")
+        r = self.run_tool(cfg)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("has no engine 'weather'", r.stderr)
+        self.assertIn("wheeled_robot", r.stderr)
+
+    def test_an_unknown_engine_in_set_is_named(self):
+        r = self.run_tool(PARKRING, "--set", "nosuch.Key=1")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--set nosuch.Key=1: no engine 'nosuch'", r.stderr)
+
+    def test_a_failing_run_names_the_run_and_leaves_no_derived_config(self):
+        r = self.run_tool(PARKRING, "--set", "gazebo.GazeboWorldFile=missing_world.sdf")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("run 0 failed", r.stderr)
+        self.assertIn("missing_world.sdf", r.stderr)
+        left = [f for f in os.listdir(os.path.dirname(PARKRING)) if f.startswith(".dataset_")]
+        self.assertEqual(left, [])
+
+
 class Training(unittest.TestCase):
     def test_a_few_iterations_train_and_export_a_model_opencv_loads(self):
         d = tempfile.mkdtemp(prefix="convoy-train-")
