@@ -45,10 +45,10 @@ struct SurfaceProgram {
   GLint fog_k = -1, fog_color = -1, up = -1, wetness = -1, snow = -1, sky = -1;
 };
 
-// Draws rain streaks or snow flakes over the image (Atmosphere's precipitation), blended.
+// Draws rain streaks or snow flakes (precipitation.h's quads) over the image, blended.
 struct PrecipitationProgram {
-  GLuint id = 0;
-  GLint size = -1, seed = -1, amount = -1, snow = -1, slant = -1;
+  GLuint id = 0, vao = 0, vbo = 0;
+  GLint size = -1, snow = -1;
 };
 PrecipitationProgram build_precipitation_program();
 

@@ -17,6 +17,7 @@
 #include "render/egl_context.h"
 #include "render/gl_program.h"
 #include "render/gpu_resources.h"
+#include "render/precipitation.h"
 #include "render/readback.h"
 
 namespace convoy::render {
@@ -120,6 +121,7 @@ struct Renderer::Impl {
   RenderTargetCache targets;
   std::map<ProgramKey, SurfaceProgram> programs;  // built when first needed
   PrecipitationProgram precipitation;             // built when first needed
+  std::vector<PrecipitationVertex> precipitation_vertices;
   uint64_t frame_number = 0;
   std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
@@ -140,7 +142,11 @@ struct Renderer::Impl {
       return;  // another thread holds the context: leak the GL objects rather than crash
     }
     for (auto& [key, p] : programs) destroy_program(&p);
-    if (precipitation.id) glDeleteProgram(precipitation.id);
+    if (precipitation.id) {
+      glDeleteProgram(precipitation.id);
+      glDeleteVertexArrays(1, &precipitation.vao);
+      glDeleteBuffers(1, &precipitation.vbo);
+    }
   }
   void draw_precipitation(const Atmosphere& a, int width, int height);
 
@@ -334,6 +340,18 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
 
 // Rain or snow over the colour image only (depth and ids keep the scene's).
 void Renderer::Impl::draw_precipitation(const Atmosphere& a, int width, int height) {
+  // A new pattern for each frame time, the same for the same seed and time.
+  const uint64_t ms = static_cast<uint64_t>(std::llround(a.time * 1000.0));
+  PrecipitationParams params;
+  params.width = width;
+  params.height = height;
+  params.amount = a.precipitation;
+  params.snow = a.snow;
+  params.slant = a.fall_slant;
+  params.seed = a.seed * 0x9e3779b9u ^ static_cast<uint32_t>(ms * 0x85ebca6bULL) ^
+                static_cast<uint32_t>(ms >> 32);
+  make_precipitation(params, &precipitation_vertices);
+  if (precipitation_vertices.empty()) return;
   if (!precipitation.id) precipitation = build_precipitation_program();
   const GLenum colour_only[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
   glDrawBuffers(3, colour_only);
@@ -344,15 +362,15 @@ void Renderer::Impl::draw_precipitation(const Atmosphere& a, int width, int heig
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glUseProgram(precipitation.id);
   glUniform2f(precipitation.size, static_cast<float>(width), static_cast<float>(height));
-  // A new pattern for each frame time, the same for the same seed and time.
-  const uint64_t ms = static_cast<uint64_t>(std::llround(a.time * 1000.0));
-  uint32_t seed = a.seed * 0x9e3779b9u ^ static_cast<uint32_t>(ms * 0x85ebca6bULL) ^
-                  static_cast<uint32_t>(ms >> 32);
-  glUniform1ui(precipitation.seed, seed);
-  glUniform1f(precipitation.amount, std::clamp(a.precipitation, 0.0f, 1.0f));
   glUniform1i(precipitation.snow, a.snow ? 1 : 0);
-  glUniform1f(precipitation.slant, a.fall_slant);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(precipitation.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, precipitation.vbo);
+  glBufferData(GL_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(precipitation_vertices.size() * sizeof(PrecipitationVertex)),
+               precipitation_vertices.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(precipitation_vertices.size()));
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
   glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);

@@ -5,7 +5,7 @@ with COCO ground truth (boxes, classes, instance ids, instance masks as RLE) and
 
   /usr/bin/python3 tools/dataset/make_dataset.py CONFIG --out DIR [--runs 4] [--seed 0]
       [--every 15] [--seconds 60] [--camera smart_camera::camera] [--world gazebo]
-      [--randomize] [--build build]
+      [--randomize | --weather KIND[,KIND...]] [--build build]
 
 Writes DIR/annotations.json (all runs, COCO; each image's record has its seed, weather and
 time), DIR/images/*.jpg, DIR/depth/*.png (mm, uint16), DIR/runs.json (what each run drew).
@@ -26,10 +26,16 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(REPO, "python"))
 
 
-def draw_weather(rng):
-    """A weather for one run: clear most often, then rain, fog, snow, dusk and night."""
-    kind = rng.choices(["clear", "rain", "fog", "snow", "dusk", "night"],
-                       weights=[0.4, 0.15, 0.15, 0.1, 0.1, 0.1])[0]
+KINDS = ["clear", "rain", "fog", "snow", "dusk", "night"]
+
+
+def draw_weather(rng, kind=None):
+    """A weather for one run: clear most often, then rain, fog, snow, dusk and night; with
+    `kind`, that kind's parameters (still drawn from rng)."""
+    if kind is None:
+        kind = rng.choices(KINDS, weights=[0.4, 0.15, 0.15, 0.1, 0.1, 0.1])[0]
+    elif kind not in KINDS:
+        raise ValueError("unknown weather kind '%s' (%s)" % (kind, ", ".join(KINDS)))
     w = {"TimeOfDay": round(rng.uniform(8.0, 16.5), 2)}
     if kind == "rain":
         w.update(Precipitation=round(rng.uniform(0.3, 1.0), 2), Surface="wet")
@@ -56,6 +62,9 @@ def main():
     ap.add_argument("--camera", default="smart_camera::camera")
     ap.add_argument("--world", default="gazebo", help="the world engine's name")
     ap.add_argument("--randomize", action="store_true", help="draw weather and time of day per run")
+    ap.add_argument("--weather", metavar="KIND[,KIND...]",
+                    help="the weather kind of each run, taken in turn (%s, or all); its parameters are "
+                         "drawn from the run's seed" % ", ".join(KINDS))
     ap.add_argument("--set", action="append", default=[], metavar="ENGINE.KEY=JSON",
                     help="set an engine's config key (the value read as JSON, else as a string)")
     ap.add_argument("--env", action="append", default=[], metavar="ENGINE:VAR=VALUE",
@@ -63,6 +72,14 @@ def main():
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
     args = ap.parse_args()
 
+    kinds = None
+    if args.weather:
+        kinds = KINDS if args.weather == "all" else args.weather.split(",")
+        bad = [k for k in kinds if k not in KINDS]
+        if bad or args.randomize:
+            sys.exit("make_dataset: --weather %s: %s" % (
+                args.weather, "use either --weather or --randomize" if not bad else
+                "unknown kind '%s' (%s, or all)" % (bad[0], ", ".join(KINDS))))
     config_path = os.path.abspath(args.config)
     with open(config_path) as f:
         base = json.load(f)
@@ -84,7 +101,12 @@ def main():
     for k in range(args.runs):
         seed = args.seed + k
         rng = random.Random(seed)
-        kind, weather = draw_weather(rng) if args.randomize else ("as configured", {})
+        if kinds:
+            kind, weather = draw_weather(rng, kinds[k % len(kinds)])
+        elif args.randomize:
+            kind, weather = draw_weather(rng)
+        else:
+            kind, weather = "as configured", {}
         part = os.path.join(out, "parts", "run%03d" % seed)
         shutil.rmtree(part, ignore_errors=True)
         tf = os.path.join(out, "tf", "dataset_tf_%d.py" % seed)
