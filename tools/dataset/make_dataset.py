@@ -5,7 +5,8 @@ with COCO ground truth (boxes, classes, instance ids, instance masks as RLE) and
 
   /usr/bin/python3 tools/dataset/make_dataset.py CONFIG --out DIR [--runs 4] [--seed 0]
       [--every 15] [--seconds 60] [--camera smart_camera::camera] [--world gazebo]
-      [--randomize | --weather KIND[,KIND...]] [--build build]
+      [--randomize | --weather KIND[,KIND...]] [--vary-models car=0.6,bus=0.2,truck=0.2]
+      [--build build]
 
 Writes DIR/annotations.json (all runs, COCO; each image's record has its seed, weather and
 time), DIR/images/*.jpg, DIR/depth/*.png (mm, uint16), DIR/runs.json (what each run drew).
@@ -51,6 +52,31 @@ def draw_weather(rng, kind=None):
     return kind, w
 
 
+def actor_models():
+    """The world engine's actor table: model names by class ({"car": [...], "bus": [...], ...})."""
+    with open(os.path.join(REPO, "engines", "gazebo_grpc", "actors", "actor_models.json")) as f:
+        table = json.load(f)["models"]
+    by_class = {}
+    for name, entry in sorted(table.items()):
+        by_class.setdefault(entry["class"], []).append(name)
+    return by_class
+
+
+def vary_models(cfg, seed, shares):
+    """Gives each vehicle_agent of cfg a model drawn for this run: a class by `shares`
+    ({"car": 0.6, "bus": 0.2, "truck": 0.2}), then one of its variants. Its own random stream,
+    so that the weather drawn does not change it. Returns {engine: model}."""
+    rng = random.Random(seed * 7919 + 17)
+    by_class = actor_models()
+    classes = sorted(shares)
+    drawn = {}
+    for e in cfg["EngineConfigs"]:
+        if e.get("EngineType") == "vehicle_agent":
+            cls = rng.choices(classes, weights=[shares[c] for c in classes])[0]
+            e["Model"] = drawn[e["EngineName"]] = rng.choice(by_class[cls])
+    return drawn
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("config")
@@ -65,6 +91,9 @@ def main():
     ap.add_argument("--weather", metavar="KIND[,KIND...]",
                     help="the weather kind of each run, taken in turn (%s, or all); its parameters are "
                          "drawn from the run's seed" % ", ".join(KINDS))
+    ap.add_argument("--vary-models", metavar="CLASS=SHARE[,...]",
+                    help="give each vehicle_agent a model drawn per run: a class by these shares "
+                         "(e.g. car=0.6,bus=0.2,truck=0.2), then one of its colour variants")
     ap.add_argument("--set", action="append", default=[], metavar="ENGINE.KEY=JSON",
                     help="set an engine's config key (the value read as JSON, else as a string)")
     ap.add_argument("--env", action="append", default=[], metavar="ENGINE:VAR=VALUE",
@@ -80,6 +109,18 @@ def main():
             sys.exit("make_dataset: --weather %s: %s" % (
                 args.weather, "use either --weather or --randomize" if not bad else
                 "unknown kind '%s' (%s, or all)" % (bad[0], ", ".join(KINDS))))
+    shares = None
+    if args.vary_models:
+        try:
+            shares = {k: float(v) for k, v in (item.split("=") for item in args.vary_models.split(","))}
+        except ValueError:
+            sys.exit("make_dataset: --vary-models %s: expected CLASS=SHARE[,CLASS=SHARE...]" % args.vary_models)
+        known = actor_models()
+        bad = [c for c in shares if c not in known or shares[c] < 0]
+        if bad or sum(shares.values()) <= 0:
+            sys.exit("make_dataset: --vary-models %s: %s" % (
+                args.vary_models, "unknown class '%s' (%s)" % (bad[0], ", ".join(sorted(known))) if bad
+                else "the shares add up to 0"))
     config_path = os.path.abspath(args.config)
     with open(config_path) as f:
         base = json.load(f)
@@ -128,6 +169,7 @@ def main():
             if e["EngineName"] == "weather":
                 e["Seed"] = seed
                 e.update(weather)
+        models = vary_models(cfg, seed, shares) if shares else {}
         for item in args.set:
             key, _, value = item.partition("=")
             engine, _, field = key.partition(".")
@@ -172,7 +214,8 @@ def main():
         for a in doc["annotations"]:
             merged.annotations.append(dict(a, id=len(merged.annotations) + 1, image_id=remap[a["image_id"]]))
         shutil.rmtree(part, ignore_errors=True)
-        runs.append({"seed": seed, "weather_kind": kind, "weather": weather, "frames": len(doc["images"]),
+        runs.append({"seed": seed, "weather_kind": kind, "weather": weather, "models": models,
+                     "frames": len(doc["images"]),
                      "annotations": len(doc["annotations"])})
         print("run %d (seed %d, %s): %d frames, %d annotations" % (k, seed, kind, len(doc["images"]),
                                                                    len(doc["annotations"])), flush=True)
