@@ -181,13 +181,14 @@ void main() {
   LIGHT_CALLS
   color += g_diffuse * u_diffuse.rgb * tex + g_specular * u_specular.rgb;
 #ifdef SURFACE_WEATHER
-  {
+  float up = dot(n, u_up);
+  if (up > 0.6) {
     // Up-facing surfaces: snow turns them white; water darkens them and mirrors the sky at
     // grazing angles (Schlick's Fresnel term for water).
-    float flat_up = smoothstep(0.6, 0.9, dot(n, u_up));
+    float flat_up = smoothstep(0.6, 0.9, up);
     color = mix(color, 0.95 * (u_scene_ambient + g_diffuse), u_snow * flat_up);
-    float ndv = max(dot(n, -normalize(p)), 0.0);
-    float fresnel = 0.02 + 0.98 * pow(1.0 - ndv, 5.0);
+    float m = 1.0 - max(dot(n, -normalize(p)), 0.0), m2 = m * m;
+    float fresnel = 0.02 + 0.98 * m2 * m2 * m;
     float w = u_wetness * flat_up;
     color = color * (1.0 - 0.45 * w) + (w * fresnel) * u_sky;
   }
