@@ -52,28 +52,40 @@ def draw_weather(rng, kind=None):
     return kind, w
 
 
-def actor_models():
-    """The world engine's actor table: model names by class ({"car": [...], "bus": [...], ...})."""
+def actor_table():
+    """The world engine's actor table (engines/gazebo_grpc/actors/actor_models.json): model ->
+    {"class", "size": [length, width, height], "length_offset", ...}."""
     with open(os.path.join(REPO, "engines", "gazebo_grpc", "actors", "actor_models.json")) as f:
-        table = json.load(f)["models"]
+        return json.load(f)["models"]
+
+
+def actor_models():
+    """The actor table's model names by class ({"car": [...], "bus": [...], ...})."""
     by_class = {}
-    for name, entry in sorted(table.items()):
+    for name, entry in sorted(actor_table().items()):
         by_class.setdefault(entry["class"], []).append(name)
     return by_class
 
 
 def vary_models(cfg, seed, shares):
     """Gives each vehicle_agent of cfg a model drawn for this run: a class by `shares`
-    ({"car": 0.6, "bus": 0.2, "truck": 0.2}), then one of its variants. Its own random stream,
-    so that the weather drawn does not change it. Returns {engine: model}."""
+    ({"car": 0.6, "bus": 0.2, "truck": 0.2}), then one of its variants; the agent takes the
+    model's class as its Category and its size (Length, Width, Height, and a Wheelbase of twice
+    the model's length_offset: the reference point is the rear axle). Its own random stream, so
+    that the weather drawn does not change it. Returns {engine: model}."""
     rng = random.Random(seed * 7919 + 17)
+    table = actor_table()
     by_class = actor_models()
     classes = sorted(shares)
     drawn = {}
     for e in cfg["EngineConfigs"]:
         if e.get("EngineType") == "vehicle_agent":
             cls = rng.choices(classes, weights=[shares[c] for c in classes])[0]
-            e["Model"] = drawn[e["EngineName"]] = rng.choice(by_class[cls])
+            model = drawn[e["EngineName"]] = rng.choice(by_class[cls])
+            entry = table[model]
+            length, width, height = entry["size"]
+            e.update(Model=model, Category=entry["class"], Length=length, Width=width, Height=height,
+                     Wheelbase=round(2 * entry["length_offset"], 3))
     return drawn
 
 
