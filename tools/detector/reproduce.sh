@@ -48,4 +48,4 @@ done_ "$T/loop"  || $MD $C --out "$T/loop"  --runs 6 --seed 930 --seconds 60 --e
 done_ "$T/parkring" || $MD $P --out "$T/parkring" --runs 3 --seed 100 --seconds 180 --every 20 --weather ${W[4]} $B
 $PY tools/detector/train.py --data "$T/east" --data "$T/north" --data "$T/south" --data "$T/loop" --data "$T/parkring" \
   --val "$WORK/eval_clear" --val "$WORK/eval_rain" --val "$WORK/eval_fog" --val "$WORK/eval_night" \
-  --out "$WORK/model_$SET" --epochs 16 --batch 16 --input 448x288 --seed 0 --threads "${THREADS:-1}"
+  --out "$WORK/model_$SET" --epochs 12 --batch 16 --input 448x288 --seed 0 --threads "${THREADS:-1}"
