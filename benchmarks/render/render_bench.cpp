@@ -2,8 +2,8 @@
 // 100k triangles (spheres, cylinders and boxes on a ground plane, several materials, two
 // lights), for colour only, colour + depth, and colour + depth + bounding boxes, with the
 // renderer's levels of detail (Renderer::kLodPixelError); colour only at full detail; and all
-// three in rain with fog on a wet ground, and in snow on a snowy ground (render/scene.h's
-// Atmosphere).
+// three in rain with fog on a wet ground, in snow on a snowy ground (render/scene.h's
+// Atmosphere), and with sun shadows (Scene::set_shadows).
 // Each frame moves every object, renders and reads the images back.
 //
 //   render_bench [frames_per_run=300] [runs=5] [first_frame.ppm]
@@ -113,17 +113,22 @@ int main(int argc, char** argv) {
     bool depth, boxes;
     double lod_pixel_error;
     int weather;  // 0 clear, 1 rain 0.7 + fog 100 m + wet ground, 2 snow 0.5 + snowy ground
+    bool shadows = false;
   };
   const Mode modes[] = {{"rgb", false, false, Renderer::kLodPixelError, 0},
                         {"rgb+depth", true, false, Renderer::kLodPixelError, 0},
                         {"rgb+depth+boxes", true, true, Renderer::kLodPixelError, 0},
                         {"rgb, full detail", false, false, 0.0, 0},
                         {"all, rain+fog", true, true, Renderer::kLodPixelError, 1},
-                        {"all, snow", true, true, Renderer::kLodPixelError, 2}};
+                        {"all, snow", true, true, Renderer::kLodPixelError, 2},
+                        {"all, shadows", true, true, Renderer::kLodPixelError, 0, true}};
   long step = 0;
   for (const Mode& mode : modes) {
     std::vector<double> fps, cpu_ms;
     renderer.set_lod_pixel_error(mode.lod_pixel_error);
+    Shadows shadows;
+    shadows.enabled = mode.shadows;
+    scene.set_shadows(shadows);
     Atmosphere atmosphere;
     if (mode.weather == 1) {
       atmosphere.visibility = 100;

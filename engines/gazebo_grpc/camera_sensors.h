@@ -52,6 +52,8 @@ class CameraSensors {
   // lights (the world's point and spot lights named street_light* or lamp*), which are off by
   // day. Until the first call the world's own lights and sky hold.
   void set_weather(const Weather& weather);
+  // Sun shadows in every camera (render::Shadows; the engine's Shadows, ShadowDistance).
+  void set_shadows(const render::Shadows& shadows) { scene_.set_shadows(shadows); }
 
   // The latest frame as a convoy.data.Camera datapack.
   void image_datapack(size_t i, datapack::Builder& out);

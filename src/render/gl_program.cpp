@@ -41,7 +41,28 @@ float attenuation(int i, float dist) {
   return dist > u_light_direction[i].w ? 0.0 : 1.0 / max(a.x + (a.y + a.z * dist) * dist, 1e-6);
 }
 
-void directional(int i, vec3 p, vec3 n) { shade(i, p, n, -u_light_direction[i].xyz, 1.0); }
+#ifdef SHADOW_LIGHT
+// The light SHADOW_LIGHT's shadow map: depth-compared with bilinear filtering (2 x 2 PCF),
+// looked up a little along the normal (u_shadow_bias.x metres) and closer to the light
+// (u_shadow_bias.y, depth units) against self-shadowing. Outside the map: lit.
+uniform highp sampler2DShadow u_shadow_map;
+uniform highp mat4 u_shadow_matrix;  // eye space -> the map's [0, 1] cube
+uniform vec2 u_shadow_bias;
+float shadow_gain(vec3 p, vec3 n) {
+  vec4 s = u_shadow_matrix * vec4(p + n * u_shadow_bias.x, 1.0);
+  if (s.x <= 0.0 || s.x >= 1.0 || s.y <= 0.0 || s.y >= 1.0 || s.z >= 1.0) return 1.0;
+  return texture(u_shadow_map, vec3(s.xy, s.z - u_shadow_bias.y));
+}
+#endif
+
+void directional(int i, vec3 p, vec3 n) {
+#ifdef SHADOW_LIGHT
+  float gain = i == SHADOW_LIGHT ? shadow_gain(p, n) : 1.0;
+#else
+  float gain = 1.0;
+#endif
+  shade(i, p, n, -u_light_direction[i].xyz, gain);
+}
 
 void point(int i, vec3 p, vec3 n) {
   vec3 d = u_light_position[i] - p;
@@ -275,6 +296,8 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   if (key.specular) header += "#define SPECULAR\n";
   if (key.fog) header += "#define FOG\n";
   if (key.surface_weather && !key.per_vertex) header += "#define SURFACE_WEATHER\n";
+  if (key.shadow_light >= 0)
+    header += "#define SHADOW_LIGHT " + std::to_string(key.shadow_light) + "\n";
   std::string calls;
   for (size_t i = 0; i < key.lights.size(); ++i) {
     const char* f = key.lights[i] == 'D' ? "directional" : key.lights[i] == 'P' ? "point" : "spot";
@@ -311,8 +334,25 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   p.wetness = at("u_wetness");
   p.snow = at("u_snow");
   p.sky = at("u_sky");
+  p.shadow_matrix = at("u_shadow_matrix");
+  p.shadow_bias = at("u_shadow_bias");
   glUseProgram(p.id);
   if (key.textured) glUniform1i(at("u_texture"), 0);
+  if (key.shadow_light >= 0) glUniform1i(at("u_shadow_map"), 1);
+  return p;
+}
+
+ShadowProgram build_shadow_program() {
+  ShadowProgram p;
+  p.id = link(R"(#version 300 es
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_mvp;
+void main() { gl_Position = u_mvp * vec4(a_position, 1.0); }
+)",
+              R"(#version 300 es
+void main() {}
+)");
+  p.mvp = glGetUniformLocation(p.id, "u_mvp");
   return p;
 }
 
