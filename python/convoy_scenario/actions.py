@@ -35,7 +35,7 @@ from . import model as m
 from .weather import environment_to_weather
 
 SPEED_TOLERANCE = 0.1           # m/s
-TRAJECTORY_END_TOLERANCE = 1.0  # m
+TRAJECTORY_END_TOLERANCE = 0.5  # m
 TIME_EPS = 1e-9
 
 
