@@ -38,7 +38,8 @@ Rules:
   output is true fires the condition once, at the first step with time >= its time +
   delay. A trigger is the OR of its ConditionGroups, each the AND of its conditions.
 - Entity conditions: each triggering entity's value, combined by triggeringEntitiesRule
-  (any / all). Rules compare with EQUAL_TOLERANCE for equalTo / notEqualTo.
+  (any / all). Rules treat values within EQUAL_TOLERANCE (1e-6) as equal: greaterThan
+  is a > b and not equal, greaterOrEqual a > b or equal, and so on.
 """
 
 import math
@@ -90,15 +91,16 @@ class StepResult:
 
 
 def compare(a, rule, b):
-    if rule == "greaterThan":
-        return a > b
-    if rule == "lessThan":
-        return a < b
-    if rule == "greaterOrEqual":
-        return a >= b
-    if rule == "lessOrEqual":
-        return a <= b
+    """a rule b, where values within EQUAL_TOLERANCE of each other are equal."""
     equal = a == b or abs(a - b) <= EQUAL_TOLERANCE
+    if rule == "greaterThan":
+        return a > b and not equal
+    if rule == "lessThan":
+        return a < b and not equal
+    if rule == "greaterOrEqual":
+        return a > b or equal
+    if rule == "lessOrEqual":
+        return a < b or equal
     return equal if rule == "equalTo" else not equal
 
 
