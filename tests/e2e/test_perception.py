@@ -109,9 +109,13 @@ class DatasetBadInput(unittest.TestCase):
     def run_tool(self, config, *args):
         d = tempfile.mkdtemp(prefix="convoy-dataset-bad-")
         self.addCleanup(shutil.rmtree, d, True)
-        return subprocess.run([PY, MAKE_DATASET, config, "--out", d, "--build", os.path.dirname(BIN_DIR),
-                               "--runs", "1", "--seconds", "1"] + list(args),
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+        p = subprocess.Popen([PY, MAKE_DATASET, config, "--out", d, "--build", os.path.dirname(BIN_DIR),
+                              "--runs", "1", "--seconds", "1"] + list(args),
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        out, err = p.communicate(timeout=300)
+        r = subprocess.CompletedProcess(p.args, p.returncode, out, err)
+        r.pid = p.pid  # make_dataset names its derived configs .dataset_<pid>_<seed>.json
+        return r
 
     def test_an_experiment_without_a_weather_engine_is_named(self):
         cfg = os.path.join(REPO, "experiments", "wheeled_robot", "simulation_config.json")
@@ -144,7 +148,8 @@ class DatasetBadInput(unittest.TestCase):
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("run 0 failed", r.stderr)
         self.assertIn("missing_world.sdf", r.stderr)
-        left = [f for f in os.listdir(os.path.dirname(PARKRING)) if f.startswith(".dataset_")]
+        # (its own: other tests running at the same time may have theirs there)
+        left = [f for f in os.listdir(os.path.dirname(PARKRING)) if f.startswith(".dataset_%d_" % r.pid)]
         self.assertEqual(left, [])
 
 
