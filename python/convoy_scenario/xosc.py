@@ -28,7 +28,7 @@ import re
 from . import model as m
 from . import schema
 from .params import ParameterError, Scope, TYPES, convert, resolve
-from .xmltree import ScenarioError, parse_bytes, parse_file
+from .xmltree import Node, ScenarioError, parse_bytes, parse_file
 
 RULES = ("greaterThan", "lessThan", "equalTo", "greaterOrEqual", "lessOrEqual", "notEqualTo")
 ELEMENT_TYPES = ("story", "act", "maneuverGroup", "maneuver", "event", "action")
@@ -701,31 +701,10 @@ class _Override:
             os.path.basename(self.path), self.name, message))
 
 
-class _Stripped:
-    """A catalog entry's node without its ParameterDeclarations (already applied)."""
-
-    def __init__(self, node):
-        self._node = node
-        self.children = [c for c in node.children if c.tag != "ParameterDeclarations"]
-
-    def __getattr__(self, name):
-        return getattr(self._node, name)
-
-    def find(self, tag):
-        for c in self.children:
-            if c.tag == tag:
-                return c
-        return None
-
-    def findall(self, tag):
-        return [c for c in self.children if c.tag == tag]
-
-    def need(self, tag):
-        c = self.find(tag)
-        if c is None:
-            raise self._node.error("needs a <%s>" % tag)
-        return c
-
-
 def _without_declarations(node):
-    return _Stripped(node)
+    """A catalog entry's node without its ParameterDeclarations (already applied): a copy of
+    it (same tag, attributes, file and line) with the other children."""
+    stripped = Node(node.tag, node.attrib, node.path, node.line)
+    stripped.text = node.text
+    stripped.children = [c for c in node.children if c.tag != "ParameterDeclarations"]
+    return stripped

@@ -151,6 +151,24 @@ WORLD = """<?xml version="1.0"?>
 """
 
 
+def add_world_and_users(ex, users):
+    """The world engine on world.sdf with the actor table, and an engine sending `users` as
+    RoadUsers every step (forwarded to the world by a TF)."""
+    ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "world.sdf",
+                       "EngineTimestep": 0.02, "ActorModels": TABLE})
+    ex.engine("traffic", textwrap.dedent("""\
+        from nrp_core.engines.python_json import EngineScript
+        USERS = %r
+        class Script(EngineScript):
+            def initialize(self):
+                self._registerDataPack("road_users")
+                self._setDataPack("road_users", {"users": USERS})
+            def runLoop(self, timestep_ns):
+                self._setDataPack("road_users", {"users": USERS})
+        """ % users), timestep=0.02)
+    ex.function("forward", FORWARD)
+
+
 class Rendering(unittest.TestCase):
     def test_every_model_loads_and_is_seen_with_its_class(self):
         models = load_table()["models"]
@@ -161,19 +179,7 @@ class Rendering(unittest.TestCase):
         self.assertLessEqual(len(users), 80)
         ex = Experiment(self)
         ex.file("world.sdf", WORLD)
-        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "world.sdf",
-                           "EngineTimestep": 0.02, "ActorModels": TABLE})
-        ex.engine("traffic", textwrap.dedent("""\
-            from nrp_core.engines.python_json import EngineScript
-            USERS = %r
-            class Script(EngineScript):
-                def initialize(self):
-                    self._registerDataPack("road_users")
-                    self._setDataPack("road_users", {"users": USERS})
-                def runLoop(self, timestep_ns):
-                    self._setDataPack("road_users", {"users": USERS})
-            """ % users), timestep=0.02)
-        ex.function("forward", FORWARD)
+        add_world_and_users(ex, users)
         ex.function("record", RECORD)
         ex.run(0.1)
         seen = {}
@@ -233,19 +239,7 @@ class Golden(unittest.TestCase):
         users = []
         for key, x, y, yaw in STREET_USERS:
             users.append({"id": "a/" + key, "model": key, "x": x, "y": y, "yaw": yaw})
-        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "world.sdf",
-                           "EngineTimestep": 0.02, "ActorModels": TABLE})
-        ex.engine("traffic", textwrap.dedent("""\
-            from nrp_core.engines.python_json import EngineScript
-            USERS = %r
-            class Script(EngineScript):
-                def initialize(self):
-                    self._registerDataPack("road_users")
-                    self._setDataPack("road_users", {"users": USERS})
-                def runLoop(self, timestep_ns):
-                    self._setDataPack("road_users", {"users": USERS})
-            """ % users), timestep=0.02)
-        ex.function("forward", FORWARD)
+        add_world_and_users(ex, users)
         ex.function("grab", GRAB)
         ex.run(0.1)
         frame = np.load(os.path.join(ex.dir, "frame.npy"))[:, :, :3]
