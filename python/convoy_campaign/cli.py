@@ -47,7 +47,7 @@ def _parser():
     p.add_argument("--seconds", type=float, help="simulated seconds per run (default: the "
                                                  "config's SimulationTimeout)")
     p.add_argument("--build", help="Convoy's build folder, for bin/convoy (default "
-                                   "$CONVOY_BIN_DIR/.., else <repo>/build)")
+                                   "<repo>/build, or $CONVOY_BIN_DIR/convoy when set)")
     p.add_argument("--poll", type=float, default=1.0, help="seconds between Slurm polls")
     p.add_argument("--task", type=int, help=argparse.SUPPRESS)
     p.add_argument("--plan", help=argparse.SUPPRESS)

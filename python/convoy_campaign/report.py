@@ -67,7 +67,7 @@ def _ds(r):
     return float(v) if isinstance(v, (int, float)) else None
 
 
-def bar_chart(items, y_max, y_label, width=720, bar_h=None):
+def bar_chart(items, y_max, y_label, width=720):
     """Inline SVG: items [(label, value, low, high, points)] as vertical bars with whiskers
     from low to high and dots at points; None values are drawn as "n/a"."""
     height, left, bottom, top = 260, 56, 70, 16

@@ -9,7 +9,8 @@ A suite is a folder. If it holds `suite.json`, that file lists the entries:
 ("config" relative to suite.json's folder; "name" defaults to the config's name below;
 "overrides" to none; "type" to the entry type of the config's file suffix.) Otherwise every
 `*.json` file in the folder with an "EngineConfigs" list is an entry, in file-name order; other
-JSON files (a planner's parameters, say) are not. An entry's default name is its file's stem
+JSON files (a planner's parameters, say) are not; nor are files of a suffix no entry type
+takes (ENTRY_TYPES: ".json" today). An entry's default name is its file's stem
 without a leading "simulation_config_"; a bare "simulation_config" takes its folder's name
 (experiments/cut_in/simulation_config.json is "cut_in", experiments/autonomous_driving/
 simulation_config_rain.json is "rain"). Names must be unique and may hold letters, digits,
@@ -152,11 +153,12 @@ def load_suite(suite_dir):
     else:
         for f in sorted(os.listdir(suite_dir)):
             path = os.path.join(suite_dir, f)
-            if not f.endswith(".json") or not os.path.isfile(path):
+            suffix = _suffix(f)
+            if suffix not in ENTRY_TYPES or not os.path.isfile(path):
                 continue
-            if _is_simulation_config(_read_json(path, "a simulation config")):
+            if suffix != ".json" or _is_simulation_config(_read_json(path, "a simulation config")):
                 entries.append({"name": default_name(path), "config": path, "overrides": [],
-                                "type": ".json", "source": path})
+                                "type": suffix, "source": path})
         if not entries:
             raise SuiteError("suite folder %s holds no run definitions (a suite.json, or "
                              "simulation configs *.json)" % suite_dir)
