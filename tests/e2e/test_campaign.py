@@ -200,8 +200,7 @@ class Slurm(CampaignTest):
     def test_restart(self):
         out = os.path.join(self.dir, "out")
         suite = self.cut_in_suite()
-        args = [sys.executable if sys.executable.startswith("/usr/bin/") else "/usr/bin/python3",
-                CAMPAIGN, suite, "--backend", "slurm", "--out", out, "--poll", 0.3, "--seeds", 4,
+        args = ["/usr/bin/python3", CAMPAIGN, suite, "--backend", "slurm", "--out", out, "--poll", 0.3, "--seeds", 4,
                 "--workers", 1, "--seconds", 8]
         env = dict(os.environ, CONVOY_BIN_DIR=BIN_DIR, **self.env)
         p = subprocess.Popen([str(a) for a in args], env=env, stdin=subprocess.DEVNULL,
