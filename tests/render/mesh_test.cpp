@@ -321,7 +321,8 @@ TEST(MeshLevels, SimplifiedByVertexClustering) {
     EXPECT_LT(levels.errors[i], 0.5f) << i;  // a cell's diagonal: cells of at most 1/12 of 3.46 m
     ASSERT_EQ(m.normals.size(), m.positions.size());
     for (size_t v = 0; v < m.vertex_count(); ++v) {
-      const double r = std::hypot(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
+      const double r =
+          std::hypot(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
       EXPECT_LE(1.0 - r, levels.errors[i] + 1e-5) << "level " << i << " vertex " << v;
       EXPECT_LE(r, 1.0 + 1e-5);
     }
