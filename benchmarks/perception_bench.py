@@ -2,12 +2,15 @@
 """Perception benchmark: prints the figures of the perception issue (median of --runs).
 
   /usr/bin/python3 benchmarks/perception_bench.py [--runs 3] [--seconds 60]
-      [--heldout DIR] [--stock MODEL.onnx]
+      [--heldout [LABEL=]DIR ...] [--model [LABEL=]DIR ...] [--stock MODEL.onnx]
+      [--skip-speed] [--skip-loop]
 
   - Convoy's detector (models/detector) on a held-out render set (--heldout, a COCO folder
     from tools/dataset/make_dataset.py whose seeds and camera paths training never saw):
     mAP@0.5 and mAP@0.5:0.95 per class, by convoy_perception.evaluation (target mAP@0.5 >= 0.8
-    over car, bus, pedestrian)
+    over car, bus, pedestrian); with several --heldout sets (e.g. one per weather) and several
+    --model folders (e.g. trained on clear weather only and on all weathers), a table of mAP@0.5
+    by model and set
   - its milliseconds per 736x480 frame in OpenCV 4.6 DNN on this machine (letterbox, forward
     and decoding; the median of 200 frames; target <= 30 ms), as the detector engine runs it
   - the report's "both" experiment with Convoy's detector in the loop, every camera frame
@@ -47,12 +50,12 @@ def load_model(model_dir):
 
 def detect(net, meta, image_rgb, conf=0.001, nms=0.6):
     """The detector engine's steps in Python: letterbox (pad 114), forward, per-class NMS."""
-    size = meta["input_width"]
+    sw, sh = meta["input_width"], meta["input_height"]
     h, w = image_rgb.shape[:2]
-    s = min(size / w, size / h)
+    s = min(sw / w, sh / h)
     nw, nh = int(round(w * s)), int(round(h * s))
-    ox, oy = (size - nw) // 2, (size - nh) // 2
-    canvas = np.full((size, size, 3), 114, np.uint8)
+    ox, oy = (sw - nw) // 2, (sh - nh) // 2
+    canvas = np.full((sh, sw, 3), 114, np.uint8)
     canvas[oy:oy + nh, ox:ox + nw] = cv2.resize(image_rgb, (nw, nh), interpolation=cv2.INTER_LINEAR)
     net.setInput(cv2.dnn.blobFromImage(canvas, 1 / 255.0))
     out = net.forward()[0]
@@ -116,22 +119,39 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--seconds", type=float, default=60.0)
-    ap.add_argument("--heldout", help="COCO folder of held-out renders")
+    ap.add_argument("--heldout", action="append", default=[], metavar="[LABEL=]DIR",
+                    help="COCO folder of held-out renders (repeat for a table by set)")
     ap.add_argument("--stock", help="the stock COCO detector's ONNX (shared/tools/stock_detector)")
     ap.add_argument("--stock-seconds", type=float, default=185.0)
-    ap.add_argument("--model", default=MODEL_DIR)
+    ap.add_argument("--model", action="append", default=[], metavar="[LABEL=]DIR",
+                    help="detector folder (default models/detector; repeat for a table by model)")
+    ap.add_argument("--skip-speed", action="store_true", help="only the held-out figures")
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
     ap.add_argument("--skip-loop", action="store_true")
     args = ap.parse_args()
-    if args.heldout:
-        r, n = heldout_map(args.model, args.heldout)
-        for c, v in r["classes"].items():
-            print("Convoy detector, held-out %d frames, %-10s AP50 %s  AP50:95 %s  (scored %d)" % (
-                n, c, "%.3f" % v["ap50"] if v["ap50"] is not None else "-",
-                "%.3f" % v["ap50_95"] if v["ap50_95"] is not None else "-", v["scored_gt"]))
-        print("Convoy detector mAP@0.5 (held-out renders): %.3f  mAP@0.5:0.95 %.3f  target mAP@0.5 >= 0.8" % (
-            r["map50"], r["map50_95"]))
-    ms = [ms_per_frame(args.model) for _ in range(args.runs)]
+    labelled = lambda items: [(i.partition("=")[0], i.partition("=")[2]) if "=" in i else
+                              (os.path.basename(os.path.normpath(i)), i) for i in items]
+    models = labelled(args.model or [MODEL_DIR])
+    sets = labelled(args.heldout)
+    table = {}
+    for mlabel, mdir in models:
+        for slabel, folder in sets:
+            r, n = heldout_map(mdir, folder)
+            table[(mlabel, slabel)] = r["map50"]
+            for c, v in r["classes"].items():
+                print("%s on %s (%d frames), %-10s AP50 %s  AP50:95 %s  (scored %d)" % (
+                    mlabel, slabel, n, c, "%.3f" % v["ap50"] if v["ap50"] is not None else "-",
+                    "%.3f" % v["ap50_95"] if v["ap50_95"] is not None else "-", v["scored_gt"]))
+            print("%s mAP@0.5 on %s: %.3f  mAP@0.5:0.95 %.3f  target mAP@0.5 >= 0.8" % (
+                mlabel, slabel, r["map50"], r["map50_95"]), flush=True)
+    if len(table) > 1:
+        print("\nmAP@0.5 | " + " | ".join(label for label, _ in sets))
+        for mlabel, _ in models:
+            print("%s | %s" % (mlabel, " | ".join("%.3f" % table[(mlabel, sl)] for sl, _ in sets)))
+    if args.skip_speed:
+        return
+    model_dir = models[0][1]
+    ms = [ms_per_frame(model_dir) for _ in range(args.runs)]
     print("Convoy detector ms per 736x480 frame (2 cores, OpenCV DNN): median %.1f (runs: %s)  target <= 30" % (
         statistics.median(ms), ", ".join("%.1f" % m for m in ms)))
     work = tempfile.mkdtemp(prefix="convoy-perception-bench-")

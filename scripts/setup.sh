@@ -17,6 +17,7 @@ PACKAGES=(
   python3-grpcio mosquitto libmosquitto-dev
   sumo sumo-tools
   python3-torch
+  slurm-wlm slurmctld slurmd slurm-client munge
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then

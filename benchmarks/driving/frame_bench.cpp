@@ -7,7 +7,7 @@
 // detection. Prints the median over runs of frames per second and milliseconds per frame.
 //
 //   frame_bench WORLD.sdf [--backend ground_truth|hog|yolo] [--model M.onnx] [--frames 300]
-//               [--runs 5]
+//               [--runs 5] [--shadows 0|1]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -28,11 +28,12 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: frame_bench WORLD.sdf [--backend B] [--model M.onnx] [--frames N] "
-                 "[--runs R]\n");
+                 "[--runs R] [--shadows 0|1]\n");
     return 2;
   }
   std::string world_file = argv[1], backend = "ground_truth", model;
   int frames = 300, runs = 5;
+  bool shadows = false;
   for (int i = 2; i + 1 < argc; i += 2) {
     std::string k = argv[i], v = argv[i + 1];
     if (k == "--backend")
@@ -43,12 +44,17 @@ int main(int argc, char** argv) {
       frames = std::stoi(v);
     else if (k == "--runs")
       runs = std::stoi(v);
+    else if (k == "--shadows")
+      shadows = v == "1";
   }
   try {
     world::WorldDesc desc = world::load_world(world_file);
     world::PhysicsWorld physics(desc);
     world::CameraSensors cameras(desc, physics, 7);
     if (cameras.count() == 0) throw std::runtime_error(world_file + ": no camera");
+    render::Shadows shadow_settings;
+    shadow_settings.enabled = shadows;
+    cameras.set_shadows(shadow_settings);
     const world::CameraDesc& cam = cameras.camera(0);
     const double period = cam.update_rate > 0 ? 1.0 / cam.update_rate : 1.0 / 30;
     const int substeps = std::max(1, static_cast<int>(std::lround(period / physics.step_size())));
@@ -105,11 +111,11 @@ int main(int argc, char** argv) {
     std::sort(ms.begin(), ms.end());
     const double med = ms[ms.size() / 2];
     std::printf(
-        "standalone physics + render + detect (backend %s, %dx%d, %d physics steps a frame): "
+        "standalone physics + render + detect (backend %s, %dx%d, %d physics steps a frame%s): "
         "%.2f ms/frame, %.1f frames/s (median of %d runs of %d frames; %.1f detections a "
         "frame)\n",
-        backend.c_str(), cam.width, cam.height, substeps, med, 1e3 / med, runs, frames,
-        static_cast<double>(detections) / ((runs * frames) + 10));
+        backend.c_str(), cam.width, cam.height, substeps, shadows ? ", shadows" : "", med,
+        1e3 / med, runs, frames, static_cast<double>(detections) / ((runs * frames) + 10));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "frame_bench: %s\n", e.what());
     return 1;

@@ -1,7 +1,9 @@
 // Camera rendering benchmark: frames per second of a 736x480 camera over a scene of about
 // 100k triangles (spheres, cylinders and boxes on a ground plane, several materials, two
 // lights), for colour only, colour + depth, and colour + depth + bounding boxes, with the
-// renderer's levels of detail (Renderer::kLodPixelError); and colour only at full detail.
+// renderer's levels of detail (Renderer::kLodPixelError); colour only at full detail; and all
+// three in rain with fog on a wet ground, in snow on a snowy ground (render/scene.h's
+// Atmosphere), and with sun shadows (Scene::set_shadows).
 // Each frame moves every object, renders and reads the images back.
 //
 //   render_bench [frames_per_run=300] [runs=5] [first_frame.ppm]
@@ -110,15 +112,34 @@ int main(int argc, char** argv) {
     const char* name;
     bool depth, boxes;
     double lod_pixel_error;
+    int weather;  // 0 clear, 1 rain 0.7 + fog 100 m + wet ground, 2 snow 0.5 + snowy ground
+    bool shadows = false;
   };
-  const Mode modes[] = {{"rgb", false, false, Renderer::kLodPixelError},
-                        {"rgb+depth", true, false, Renderer::kLodPixelError},
-                        {"rgb+depth+boxes", true, true, Renderer::kLodPixelError},
-                        {"rgb, full detail", false, false, 0.0}};
+  const Mode modes[] = {{"rgb", false, false, Renderer::kLodPixelError, 0},
+                        {"rgb+depth", true, false, Renderer::kLodPixelError, 0},
+                        {"rgb+depth+boxes", true, true, Renderer::kLodPixelError, 0},
+                        {"rgb, full detail", false, false, 0.0, 0},
+                        {"all, rain+fog", true, true, Renderer::kLodPixelError, 1},
+                        {"all, snow", true, true, Renderer::kLodPixelError, 2},
+                        {"all, shadows", true, true, Renderer::kLodPixelError, 0, true}};
   long step = 0;
   for (const Mode& mode : modes) {
     std::vector<double> fps, cpu_ms;
     renderer.set_lod_pixel_error(mode.lod_pixel_error);
+    Shadows shadows;
+    shadows.enabled = mode.shadows;
+    scene.set_shadows(shadows);
+    Atmosphere atmosphere;
+    if (mode.weather == 1) {
+      atmosphere.visibility = 100;
+      atmosphere.wetness = 1;
+      atmosphere.precipitation = 0.7f;
+      atmosphere.fall_slant = 0.1f;
+    } else if (mode.weather == 2) {
+      atmosphere.snow_cover = 1;
+      atmosphere.precipitation = 0.5f;
+      atmosphere.snow = true;
+    }
     for (int run = -1; run < runs; ++run) {  // run -1 warms up
       const int n = run < 0 ? 30 : frames;
       const double cpu_start = cpu_seconds();
@@ -128,6 +149,8 @@ int main(int argc, char** argv) {
           const double t = 0.01 * step + b.phase;
           scene.set_pose(b.instance, make_pose(b.x, b.y, b.z + 0.1 * std::sin(t), 0, 0, t));
         }
+        atmosphere.time = 0.02 * static_cast<double>(step);
+        scene.set_atmosphere(atmosphere);
         renderer.render(scene, camera, spec, &frame, mode.depth, mode.boxes);
       }
       const double s =

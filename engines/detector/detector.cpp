@@ -68,19 +68,20 @@ std::vector<std::string> read_class_names(const std::string& path) {
   return names;
 }
 
-Letterbox compute_letterbox(int width, int height, int size) {
+Letterbox compute_letterbox(int width, int height, int size, int size_h) {
   Letterbox lb;
   lb.size = size;
-  lb.scale = std::min(static_cast<double>(size) / width, static_cast<double>(size) / height);
+  lb.size_h = size_h > 0 ? size_h : size;
+  lb.scale = std::min(static_cast<double>(size) / width, static_cast<double>(lb.size_h) / height);
   int new_w = static_cast<int>(std::lround(width * lb.scale));
   int new_h = static_cast<int>(std::lround(height * lb.scale));
   lb.pad_x = (size - new_w) / 2;
-  lb.pad_y = (size - new_h) / 2;
+  lb.pad_y = (lb.size_h - new_h) / 2;
   return lb;
 }
 
-cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb) {
-  *lb = compute_letterbox(image.cols, image.rows, size);
+cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_h) {
+  *lb = compute_letterbox(image.cols, image.rows, size, size_h);
   int new_w = static_cast<int>(std::lround(image.cols * lb->scale));
   int new_h = static_cast<int>(std::lround(image.rows * lb->scale));
   cv::Mat resized;
@@ -89,7 +90,7 @@ cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb) {
   else
     cv::resize(image, resized, cv::Size(new_w, new_h), 0, 0, cv::INTER_LINEAR);
   cv::Mat out;
-  cv::copyMakeBorder(resized, out, lb->pad_y, size - new_h - lb->pad_y, lb->pad_x,
+  cv::copyMakeBorder(resized, out, lb->pad_y, lb->size_h - new_h - lb->pad_y, lb->pad_x,
                      size - new_w - lb->pad_x, cv::BORDER_CONSTANT, cv::Scalar::all(114));
   return out;
 }
@@ -206,6 +207,9 @@ YoloDetector::YoloDetector(YoloOptions options) : options_(std::move(options)) {
   if (options_.input_size <= 0 || options_.input_size % 32 != 0)
     throw std::runtime_error("InputSize " + std::to_string(options_.input_size) +
                              ": must be a positive multiple of 32");
+  if (options_.input_height < 0 || options_.input_height % 32 != 0)
+    throw std::runtime_error("input height " + std::to_string(options_.input_height) +
+                             ": must be a positive multiple of 32");
   try {
     net_ = cv::dnn::readNetFromONNX(options_.model_path);
   } catch (const cv::Exception& e) {
@@ -223,7 +227,7 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& image) {
   cv::Mat rgb = image;
   if (image.channels() == 1) cv::cvtColor(image, rgb, cv::COLOR_GRAY2RGB);
   Letterbox lb;
-  cv::Mat input = letterbox_image(rgb, options_.input_size, &lb);
+  cv::Mat input = letterbox_image(rgb, options_.input_size, &lb, options_.input_height);
   cv::Mat blob =
       cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), false, false, CV_32F);
   net_.setInput(blob);
@@ -406,8 +410,10 @@ const std::map<std::string, BackendFactory>& backends() {
          try {
            meta = nlohmann::json::parse(in);
            o.input_size = meta.at("input_width").get<int>();
-           if (meta.at("input_height").get<int>() != o.input_size)
-             throw std::runtime_error("input_width and input_height differ");
+           o.input_height = meta.at("input_height").get<int>();
+           if (o.input_size <= 0 || o.input_size % 32 || o.input_height <= 0 || o.input_height % 32)
+             throw std::runtime_error(
+                 "input_width and input_height must be positive multiples of 32");
          } catch (const std::exception& e) {
            throw std::runtime_error("Backend convoy: " + (dir / "model.json").string() + ": " +
                                     e.what());

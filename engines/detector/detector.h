@@ -28,7 +28,8 @@ struct Letterbox {
   double scale = 1;  // network pixels per image pixel
   int pad_x = 0;     // left padding, network pixels
   int pad_y = 0;     // top padding
-  int size = 640;    // network input side
+  int size = 640;    // network input width
+  int size_h = 640;  // network input height
 };
 
 enum class YoloVersion { kAuto, kV5, kV8 };
@@ -39,11 +40,11 @@ const std::vector<std::string>& coco_class_names();
 // One name per line (blank lines at the end ignored); throws naming the file.
 std::vector<std::string> read_class_names(const std::string& path);
 
-// Letterbox transform for an image of `width` x `height` into a `size` square (keeps the
-// aspect ratio, centres the image).
-Letterbox compute_letterbox(int width, int height, int size);
+// Letterbox transform for an image of `width` x `height` into a `size` square, or a
+// `size` x `size_h` network input (keeps the aspect ratio, centres the image).
+Letterbox compute_letterbox(int width, int height, int size, int size_h = 0);
 // Resizes and pads `image` (pad value 114) per compute_letterbox.
-cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb);
+cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_h = 0);
 // Maps a box in network coordinates back to the original image, clipped to it.
 cv::Rect2f unletterbox(const cv::Rect2f& box, const Letterbox& lb, int width, int height);
 
@@ -62,7 +63,8 @@ void name_classes(std::vector<Detection>* dets, const std::vector<std::string>& 
 struct YoloOptions {
   std::string model_path;
   std::vector<std::string> class_names = coco_class_names();
-  int input_size = 640;
+  int input_size = 640;  // network input width
+  int input_height = 0;  // its height; 0: input_size (square)
   float conf_threshold = 0.25f;
   float nms_threshold = 0.45f;
   YoloVersion version = YoloVersion::kAuto;

@@ -2,10 +2,12 @@
 // camera image.
 //
 // Config keys (schema.json):
-//   Backend             "ground_truth" (default) | "yolo" | "hog"
-//   ModelPath           ONNX model, required for yolo (YOLOv5 or YOLOv8 export)
+//   Backend             "convoy" (default: Convoy's trained detector) | "ground_truth" |
+//                       "yolo" | "hog"
+//   ModelPath           ONNX model, required for yolo (YOLOv5 or YOLOv8 export); convoy's
+//                       default is share/convoy/models/detector/convoy_detector.onnx
 //   ClassNamesFile      one class name per line (default: the 80 COCO names)
-//   InputSize           network input side (default 640)
+//   InputSize           network input side for yolo (default 640; convoy: model.json's)
 //   ConfidenceThreshold default 0.25
 //   NmsThreshold        IoU threshold of the per-class NMS, default 0.45
 //   YoloVersion         "auto" (default, from the output shape) | "v5" | "v8"

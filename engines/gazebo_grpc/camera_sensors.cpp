@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -174,11 +175,35 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
   }
 }
 
+const std::vector<CameraSensors::FilePart>& CameraSensors::file_mesh(const std::string& path,
+                                                                     const Eigen::Vector3d& scale) {
+  char key_scale[96];
+  std::snprintf(key_scale, sizeof key_scale, "|%.9g|%.9g|%.9g", scale.x(), scale.y(), scale.z());
+  auto [it, fresh] = file_meshes_.try_emplace(path + key_scale);
+  if (!fresh) return it->second;
+  try {
+    for (auto& part :
+         render::load_mesh(path, {static_cast<float>(scale.x()), static_cast<float>(scale.y()),
+                                  static_cast<float>(scale.z())})) {
+      int texture = part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
+      render::Material material = part.material(texture);
+      it->second.push_back(
+          {scene_.add_mesh_levels(render::simplified_levels(std::move(part.mesh))), material});
+    }
+  } catch (...) {
+    file_meshes_.erase(it);
+    throw;
+  }
+  return it->second;
+}
+
 void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& placement,
                                 uint32_t label, Tracked* tracked) {
   for (const auto& v : link.visuals) {
-    std::vector<std::pair<render::MeshLevels, render::Material>> parts;
-    auto one = [](render::MeshData m) { return render::MeshLevels{{std::move(m)}, {0.0f}}; };
+    std::vector<std::pair<int, render::Material>> parts;  // Scene mesh, material
+    auto one = [this](render::MeshData m) {
+      return scene_.add_mesh_levels(render::MeshLevels{{std::move(m)}, {0.0f}});
+    };
     Eigen::Isometry3d offset = v.pose;
     render::Material material = to_material(v.material);
     switch (v.shape.kind) {
@@ -189,13 +214,16 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
       case Shape::kCylinder: {
         // Tessellation grows with size: thin posts need few segments.
         int segments = std::clamp(static_cast<int>(12 + 20 * v.shape.size.x()), 12, 32);
-        parts.emplace_back(render::cylinder_levels(v.shape.size.x(), v.shape.size.z(), segments),
+        parts.emplace_back(scene_.add_mesh_levels(render::cylinder_levels(
+                               v.shape.size.x(), v.shape.size.z(), segments)),
                            material);
         break;
       }
       case Shape::kSphere: {
         int stacks = std::clamp(static_cast<int>(8 + 2 * v.shape.size.x()), 8, 16);
-        parts.emplace_back(render::sphere_levels(v.shape.size.x(), stacks, 2 * stacks), material);
+        parts.emplace_back(
+            scene_.add_mesh_levels(render::sphere_levels(v.shape.size.x(), stacks, 2 * stacks)),
+            material);
         break;
       }
       case Shape::kPlane: {
@@ -209,14 +237,11 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
         break;
       }
       case Shape::kMesh:
-        for (auto& part :
-             render::load_mesh(v.shape.mesh.string(), {static_cast<float>(v.shape.scale.x()),
-                                                       static_cast<float>(v.shape.scale.y()),
-                                                       static_cast<float>(v.shape.scale.z())})) {
-          int texture = part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
-          render::Material m = v.material.has_material ? material : part.material(texture);
-          if (v.material.has_material && texture >= 0) m.texture = texture;
-          parts.emplace_back(one(std::move(part.mesh)), m);
+        for (const FilePart& part : file_mesh(v.shape.mesh.string(), v.shape.scale)) {
+          render::Material m = v.material.has_material ? material : part.file_material;
+          if (v.material.has_material && part.file_material.texture >= 0)
+            m.texture = part.file_material.texture;
+          parts.emplace_back(part.mesh, m);
         }
         break;
     }
@@ -224,8 +249,7 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
       int texture = scene_.add_texture_file(v.material.texture.string());
       for (auto& p : parts) p.second.texture = texture;
     }
-    for (auto& [mesh, mat] : parts) {
-      int mesh_index = scene_.add_mesh_levels(mesh);
+    for (auto& [mesh_index, mat] : parts) {
       render::Pose world = to_pose(placement * offset);
       int inst = scene_.add_instance(mesh_index, mat, world, label, label);
       tracked->instances.push_back(inst);

@@ -3,6 +3,7 @@
 // and ground-truth boxes, refreshed at the sensor's update_rate in simulated time.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <random>
 #include <span>
@@ -51,6 +52,8 @@ class CameraSensors {
   // lights (the world's point and spot lights named street_light* or lamp*), which are off by
   // day. Until the first call the world's own lights and sky hold.
   void set_weather(const Weather& weather);
+  // Sun shadows in every camera (render::Shadows; the engine's Shadows, ShadowDistance).
+  void set_shadows(const render::Shadows& shadows) { scene_.set_shadows(shadows); }
 
   // The latest frame as a convoy.data.Camera datapack.
   void image_datapack(size_t i, datapack::Builder& out);
@@ -110,6 +113,13 @@ class CameraSensors {
     std::vector<render::Pose> offsets;          // each instance in its link's frame
     std::vector<Eigen::Isometry3d> link_poses;  // its link in the actor's frame
   };
+  // A mesh file's parts, loaded, simplified into levels of detail and added to the scene once
+  // for every visual and actor that uses the file at that scale.
+  struct FilePart {
+    int mesh;                        // the Scene's mesh (with its coarser levels)
+    render::Material file_material;  // the file's material for it, with its texture
+  };
+  const std::vector<FilePart>& file_mesh(const std::string& path, const Eigen::Vector3d& scale);
   void build_scene(const WorldDesc& desc);
   // The scene's lights, sky and atmosphere for camera `cam` under weather_.
   void apply_weather(const Camera& cam, const Eigen::Isometry3d& camera_pose);
@@ -129,7 +139,8 @@ class CameraSensors {
   std::vector<Camera> cameras_;
   std::vector<Tracked> tracked_;
   std::vector<Actor> actors_;
-  std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
+  std::map<std::string, std::vector<FilePart>> file_meshes_;  // by path and scale
+  std::vector<std::string> model_names_, model_classes_;      // by model_id - 1
   std::mt19937_64 rng_;
   double now_ = 0;
   std::vector<render::Light> base_lights_;

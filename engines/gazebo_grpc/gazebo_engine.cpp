@@ -96,6 +96,8 @@ class GazeboEngine final : public Engine {
     actor_timeout_ = config.value("ActorTimeout", 1.0);
     actor_table_ = config.value("ActorModels", std::string());
     weather_dp_ = config.value("WeatherDataPack", std::string("weather"));
+    shadows_.enabled = config.value("Shadows", false);
+    shadows_.distance = config.value("ShadowDistance", 60.0);
     rng_.seed(seed_);
     const auto t0 = std::chrono::steady_clock::now();
     world::CacheResult cache;
@@ -106,6 +108,7 @@ class GazeboEngine final : public Engine {
                  world::to_string(cache), world::cache_dir().c_str());
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
     cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
+    cameras_->set_shadows(shadows_);
 
     std::vector<engine::DataPackId> ids;
     auto add = [&](const std::string& dp_name, const std::string& type) {
@@ -201,6 +204,7 @@ class GazeboEngine final : public Engine {
     cameras_.reset();
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
     cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
+    cameras_->set_shadows(shadows_);
     for (auto& c : controllers_) {
       c.target = c.initial_target;
       c.feed_forward = 0;
@@ -768,6 +772,7 @@ class GazeboEngine final : public Engine {
   }
 
   double actor_timeout_ = 1.0;
+  render::Shadows shadows_;
   std::string actor_table_;
   std::unique_ptr<world::ActorLibrary> library_;
   std::vector<std::pair<std::string, data::RoadUser>> pending_;  // datapack name, state

@@ -1,9 +1,12 @@
 """Detection input of the ego planner: the detector's boxes, ranged in the smart car's camera's
 depth image, in the ego's frame, labelled "detections". Velocities come from a tracker
 (convoy_traffic.ego_planner.Tracker) over the detector's frames. Also feeds the detector the
-camera's ground-truth boxes (its ground_truth backend: the only backend shipped without a
-trained model), poses the road user in the world and hands it the ego's state and the world's collisions."""
+camera's image (Convoy's trained detector, the config's backend) and its ground-truth boxes
+(for the ground_truth backend, should a config choose it), poses the road user in the world
+and hands it the ego's state and the world's collisions."""
 import math
+
+import numpy as np
 
 from nrp_core import *
 from nrp_core.data.nrp_json import JsonDataPack
@@ -17,13 +20,18 @@ _state = {"tracker": Tracker(), "frame": None, "objects": []}
 
 @EngineDataPack(keyword='ego', id=DataPackIdentifier('smart_car::road_user', 'gazebo'))
 @EngineDataPack(keyword='road_user', id=DataPackIdentifier('state', 'traffic'))
+@EngineDataPack(keyword='camera', id=DataPackIdentifier('smart_camera::camera', 'gazebo'))
 @EngineDataPack(keyword='boxes', id=DataPackIdentifier('smart_camera::camera::boxes', 'gazebo'))
 @EngineDataPack(keyword='depth', id=DataPackIdentifier('smart_camera::camera::depth', 'gazebo'))
 @EngineDataPack(keyword='detections', id=DataPackIdentifier('detections', 'detector'))
 @EngineDataPack(keyword='collisions', id=DataPackIdentifier('collisions', 'gazebo'))
 @TransceiverFunction("planner")
-def planner_input(ego, road_user, boxes, depth, detections, collisions):
+def planner_input(ego, road_user, camera, boxes, depth, detections, collisions):
     out = []
+    if not camera.isEmpty():
+        out.append(JsonDataPack("camera_img", "detector", {
+            "c_imageHeight": camera.data.image_height, "c_imageWidth": camera.data.image_width,
+            "current_image_frame": np.frombuffer(camera.data.image_data, np.uint8)}))
     if not collisions.isEmpty():  # the road user records them (the tests assert on them)
         out.append(JsonDataPack("collisions", "traffic", {"list": list(collisions.data)}))
     if not road_user.isEmpty():

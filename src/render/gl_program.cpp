@@ -1,8 +1,11 @@
 #include "render/gl_program.h"
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "render/precipitation.h"
 
 namespace convoy::render {
 namespace {
@@ -38,7 +41,28 @@ float attenuation(int i, float dist) {
   return dist > u_light_direction[i].w ? 0.0 : 1.0 / max(a.x + (a.y + a.z * dist) * dist, 1e-6);
 }
 
-void directional(int i, vec3 p, vec3 n) { shade(i, p, n, -u_light_direction[i].xyz, 1.0); }
+#ifdef SHADOW_LIGHT
+// The light SHADOW_LIGHT's shadow map: depth-compared with bilinear filtering (2 x 2 PCF),
+// looked up a little along the normal (u_shadow_bias.x metres) and closer to the light
+// (u_shadow_bias.y, depth units) against self-shadowing. Outside the map: lit.
+uniform highp sampler2DShadow u_shadow_map;
+uniform highp mat4 u_shadow_matrix;  // eye space -> the map's [0, 1] cube
+uniform vec2 u_shadow_bias;
+float shadow_gain(vec3 p, vec3 n) {
+  vec4 s = u_shadow_matrix * vec4(p + n * u_shadow_bias.x, 1.0);
+  if (s.x <= 0.0 || s.x >= 1.0 || s.y <= 0.0 || s.y >= 1.0 || s.z >= 1.0) return 1.0;
+  return texture(u_shadow_map, vec3(s.xy, s.z - u_shadow_bias.y));
+}
+#endif
+
+void directional(int i, vec3 p, vec3 n) {
+#ifdef SHADOW_LIGHT
+  float gain = i == SHADOW_LIGHT ? shadow_gain(p, n) : 1.0;
+#else
+  float gain = 1.0;
+#endif
+  shade(i, p, n, -u_light_direction[i].xyz, gain);
+}
 
 void point(int i, vec3 p, vec3 n) {
   vec3 d = u_light_position[i] - p;
@@ -178,13 +202,14 @@ void main() {
   LIGHT_CALLS
   color += g_diffuse * u_diffuse.rgb * tex + g_specular * u_specular.rgb;
 #ifdef SURFACE_WEATHER
-  {
+  float up = dot(n, u_up);
+  if (up > 0.6) {
     // Up-facing surfaces: snow turns them white; water darkens them and mirrors the sky at
     // grazing angles (Schlick's Fresnel term for water).
-    float flat_up = smoothstep(0.6, 0.9, dot(n, u_up));
+    float flat_up = smoothstep(0.6, 0.9, up);
     color = mix(color, 0.95 * (u_scene_ambient + g_diffuse), u_snow * flat_up);
-    float ndv = max(dot(n, -normalize(p)), 0.0);
-    float fresnel = 0.02 + 0.98 * pow(1.0 - ndv, 5.0);
+    float m = 1.0 - max(dot(n, -normalize(p)), 0.0), m2 = m * m;
+    float fresnel = 0.02 + 0.98 * m2 * m2 * m;
     float w = u_wetness * flat_up;
     color = color * (1.0 - 0.45 * w) + (w * fresnel) * u_sky;
   }
@@ -271,6 +296,8 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   if (key.specular) header += "#define SPECULAR\n";
   if (key.fog) header += "#define FOG\n";
   if (key.surface_weather && !key.per_vertex) header += "#define SURFACE_WEATHER\n";
+  if (key.shadow_light >= 0)
+    header += "#define SHADOW_LIGHT " + std::to_string(key.shadow_light) + "\n";
   std::string calls;
   for (size_t i = 0; i < key.lights.size(); ++i) {
     const char* f = key.lights[i] == 'D' ? "directional" : key.lights[i] == 'P' ? "point" : "spot";
@@ -307,65 +334,52 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   p.wetness = at("u_wetness");
   p.snow = at("u_snow");
   p.sky = at("u_sky");
+  p.shadow_matrix = at("u_shadow_matrix");
+  p.shadow_bias = at("u_shadow_bias");
   glUseProgram(p.id);
   if (key.textured) glUniform1i(at("u_texture"), 0);
+  if (key.shadow_light >= 0) glUniform1i(at("u_shadow_map"), 1);
+  return p;
+}
+
+ShadowProgram build_shadow_program() {
+  ShadowProgram p;
+  p.id = link(R"(#version 300 es
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_mvp;
+void main() { gl_Position = u_mvp * vec4(a_position, 1.0); }
+)",
+              R"(#version 300 es
+void main() {}
+)");
+  p.mvp = glGetUniformLocation(p.id, "u_mvp");
   return p;
 }
 
 namespace {
 
-// One triangle covering the viewport.
-const char* kFullScreenVertexShader = R"(#version 300 es
+// Rain streaks and snow flakes as small quads made on the CPU (precipitation.h): positions in
+// image pixels (row 0 at the top), a local coordinate across the streak or the flake, and the
+// particle's opacity. Only the pixels the particles cover are shaded.
+const char* kPrecipitationVertexShader = R"(#version 300 es
+uniform vec2 u_size;
+layout(location = 0) in vec2 a_pixel;
+layout(location = 1) in vec3 a_local;  // across x, across y, opacity
+out vec3 v_local;
 void main() {
-  vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
-  gl_Position = vec4(p, 0.0, 1.0);
+  v_local = a_local;
+  gl_Position = vec4(2.0 * a_pixel.x / u_size.x - 1.0, 1.0 - 2.0 * a_pixel.y / u_size.y, 0.0, 1.0);
 }
 )";
 
-// Rain: three layers of thin streaks (nearer layers longer, wider, brighter), each in cells
-// of its own size: a cell holds one streak with a probability that grows with the amount.
-// Snow: three layers of round flakes. The pattern is a hash of the cell and u_seed, so a new
-// seed (one per frame) gives a new pattern and the same seed the same one.
 const char* kPrecipitationShader = R"(#version 300 es
-precision highp float;
-precision highp int;
-uniform vec2 u_size;
-uniform uint u_seed;
-uniform float u_amount;
+precision mediump float;
 uniform bool u_snow;
-uniform float u_slant;
+in vec3 v_local;
 out vec4 out_color;
-uint hash(uint x) {
-  x ^= x >> 16u; x *= 0x7feb352du; x ^= x >> 15u; x *= 0x846ca68bu; x ^= x >> 16u;
-  return x;
-}
 void main() {
-  vec2 px = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y);
-  float alpha = 0.0;
-  for (int layer = 0; layer < 3; ++layer) {
-    float fl = float(layer);
-    vec2 cell = u_snow ? vec2(14.0 + 14.0 * fl) : vec2(7.0 + 5.0 * fl, 80.0 + 60.0 * fl);
-    vec2 q = vec2(px.x - u_slant * px.y, px.y);
-    vec2 c = floor(q / cell);
-    uint id = uint(int(c.x) + 8192) * 16384u + uint(int(c.y) + 8192);
-    uint key = hash(id ^ hash(u_seed + uint(layer) * 0x9e3779b9u));
-    float exists = float(key & 0xffffu) / 65535.0;
-    float p = u_amount * (u_snow ? 0.45 - 0.1 * fl : 0.4 - 0.1 * fl);
-    if (exists >= p) continue;
-    vec2 local = q - c * cell;
-    float rx = float((key >> 16) & 0xffu) / 255.0, ry = float(key >> 24) / 255.0;
-    if (u_snow) {
-      float radius = 0.7 + 0.9 * fl;
-      vec2 centre = vec2(radius) + vec2(rx, ry) * (cell - 2.0 * radius);
-      float d = length(local - centre);
-      alpha = max(alpha, 0.9 * (1.0 - smoothstep(0.5 * radius, radius, d)));
-    } else {
-      float x0 = rx * cell.x, len = cell.y * (0.3 + 0.15 * fl), y0 = ry * (cell.y - len);
-      float dx = abs(local.x - x0), width = 0.6 + 0.35 * fl;
-      if (dx < width && local.y > y0 && local.y < y0 + len)
-        alpha = max(alpha, (0.16 + 0.08 * fl) * (1.0 - 0.5 * dx / width));
-    }
-  }
+  float alpha = u_snow ? v_local.z * (1.0 - smoothstep(0.5, 1.0, length(v_local.xy)))
+                       : v_local.z * (1.0 - 0.5 * abs(v_local.x));
   out_color = vec4(u_snow ? vec3(0.96) : vec3(0.8, 0.83, 0.87), alpha);
 }
 )";
@@ -374,12 +388,21 @@ void main() {
 
 PrecipitationProgram build_precipitation_program() {
   PrecipitationProgram p;
-  p.id = link(kFullScreenVertexShader, kPrecipitationShader);
+  p.id = link(kPrecipitationVertexShader, kPrecipitationShader);
   p.size = glGetUniformLocation(p.id, "u_size");
-  p.seed = glGetUniformLocation(p.id, "u_seed");
-  p.amount = glGetUniformLocation(p.id, "u_amount");
   p.snow = glGetUniformLocation(p.id, "u_snow");
-  p.slant = glGetUniformLocation(p.id, "u_slant");
+  glGenVertexArrays(1, &p.vao);
+  glGenBuffers(1, &p.vbo);
+  glBindVertexArray(p.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, p.vbo);
+  const GLsizei stride = sizeof(PrecipitationVertex);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, stride, nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                        reinterpret_cast<const void*>(offsetof(PrecipitationVertex, across_x)));
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
   return p;
 }
 

@@ -28,6 +28,7 @@ struct ProgramKey {
   bool specular = true;     // false: the material has no specular colour (no highlights to compute)
   bool fog = false;         // Atmosphere::fog()
   bool surface_weather = false;  // Atmosphere::surface_weather() (per-pixel programs only)
+  int shadow_light = -1;         // the light whose shadow map is bound (texture unit 1), or -1
 
   auto operator<=>(const ProgramKey&) const = default;
 };
@@ -43,12 +44,20 @@ struct SurfaceProgram {
   GLint light_position = -1, light_direction = -1, light_diffuse = -1, light_specular = -1;
   GLint light_attenuation = -1, light_spot = -1;
   GLint fog_k = -1, fog_color = -1, up = -1, wetness = -1, snow = -1, sky = -1;
+  GLint shadow_matrix = -1, shadow_bias = -1;
 };
 
-// Draws rain streaks or snow flakes over the image (Atmosphere's precipitation), blended.
-struct PrecipitationProgram {
+// Depth only, for shadow maps: u_mvp takes object space to the light's clip space.
+struct ShadowProgram {
   GLuint id = 0;
-  GLint size = -1, seed = -1, amount = -1, snow = -1, slant = -1;
+  GLint mvp = -1;
+};
+ShadowProgram build_shadow_program();
+
+// Draws rain streaks or snow flakes (precipitation.h's quads) over the image, blended.
+struct PrecipitationProgram {
+  GLuint id = 0, vao = 0, vbo = 0;
+  GLint size = -1, snow = -1;
 };
 PrecipitationProgram build_precipitation_program();
 

@@ -1,8 +1,11 @@
 #include "render/mesh.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 namespace convoy::render {
 namespace {
@@ -155,6 +158,98 @@ MeshLevels cylinder_levels(float radius, float length, int segments) {
     out.errors.push_back(static_cast<float>(radius * (1 - std::cos(kPi / segments))));
     if (segments / 2 < 8) break;
     segments /= 2;
+  }
+  return out;
+}
+
+namespace {
+
+// One clustering pass over `mesh` (normals present) with cells of side `cell`; *error gets the
+// farthest a vertex moved.
+MeshData cluster(const MeshData& mesh, double cell, float* error) {
+  const size_t n = mesh.vertex_count();
+  const float* p = mesh.positions.data();
+  const float* nr = mesh.normals.data();
+  std::array<double, 3> lo{p[0], p[1], p[2]};
+  for (size_t i = 1; i < n; ++i)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], static_cast<double>(p[3 * i + k]));
+  // Key: the cell (21 bits an axis) and the normal's dominant axis and sign (3 bits).
+  std::unordered_map<uint64_t, uint32_t> id_of;
+  std::vector<uint32_t> vertex_cluster(n);
+  std::vector<std::array<double, 7>> sums;  // position, normal, count
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t key = 0;
+    for (int k = 0; k < 3; ++k) {
+      const auto c = static_cast<uint64_t>(std::floor((p[3 * i + k] - lo[k]) / cell));
+      key = (key << 21) | (c & 0x1fffff);
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(nr[3 * i + k]) > std::abs(nr[3 * i + axis])) axis = k;
+    key = (key << 3) | static_cast<uint64_t>(2 * axis + (nr[3 * i + axis] < 0 ? 1 : 0));
+    auto [it, fresh] = id_of.try_emplace(key, static_cast<uint32_t>(sums.size()));
+    if (fresh) sums.push_back({0, 0, 0, 0, 0, 0, 0});
+    vertex_cluster[i] = it->second;
+    auto& s = sums[it->second];
+    for (int k = 0; k < 3; ++k) s[k] += p[3 * i + k], s[3 + k] += nr[3 * i + k];
+    s[6] += 1;
+  }
+  MeshData out;
+  out.positions.reserve(3 * sums.size());
+  out.normals.reserve(3 * sums.size());
+  for (const auto& s : sums) {
+    push3(&out.positions, s[0] / s[6], s[1] / s[6], s[2] / s[6]);
+    const double len = std::sqrt(s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
+    if (len > 0)
+      push3(&out.normals, s[3] / len, s[4] / len, s[5] / len);
+    else
+      push3(&out.normals, 0, 0, 1);
+  }
+  double moved = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const float* q = &out.positions[3 * vertex_cluster[i]];
+    const double dx = p[3 * i] - q[0], dy = p[3 * i + 1] - q[1], dz = p[3 * i + 2] - q[2];
+    moved = std::max(moved, std::sqrt(dx * dx + dy * dy + dz * dz));
+  }
+  *error = static_cast<float>(moved);
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const uint32_t a = vertex_cluster[mesh.indices[t]], b = vertex_cluster[mesh.indices[t + 1]],
+                   c = vertex_cluster[mesh.indices[t + 2]];
+    if (a == b || b == c || a == c) continue;
+    out.indices.insert(out.indices.end(), {a, b, c});
+  }
+  return out;
+}
+
+}  // namespace
+
+MeshLevels simplified_levels(MeshData mesh) {
+  MeshLevels out;
+  if (mesh.normals.empty()) compute_normals(&mesh);
+  const bool textured = !mesh.uvs.empty();
+  const size_t n = mesh.vertex_count();
+  out.meshes.push_back(std::move(mesh));
+  out.errors.push_back(0.0f);
+  if (textured || n < 64) return out;
+  const MeshData& fine = out.meshes.front();
+  std::array<double, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], static_cast<double>(fine.positions[3 * i + k]));
+      hi[k] = std::max(hi[k], static_cast<double>(fine.positions[3 * i + k]));
+    }
+  const double diagonal =
+      std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  if (!(diagonal > 0)) return out;
+  for (double fraction : {1.0 / 48, 1.0 / 24, 1.0 / 12}) {
+    float error = 0;
+    MeshData coarse = cluster(out.meshes.front(), diagonal * fraction, &error);
+    if (coarse.triangle_count() == 0 ||
+        coarse.triangle_count() > 0.6 * out.meshes.back().triangle_count())
+      continue;
+    out.errors.push_back(std::max(error, out.errors.back()));
+    out.meshes.push_back(std::move(coarse));
   }
   return out;
 }

@@ -42,6 +42,14 @@ MeshLevels sphere_levels(float radius, int stacks, int slices);
 // make_cylinder(radius, length, segments), then segments halved while they stay >= 8.
 MeshLevels cylinder_levels(float radius, float length, int segments);
 
+// `mesh`, then coarser versions of it by vertex clustering, for meshes loaded from files:
+// the vertices in a grid cell that face the same way (the same dominant axis of their normal)
+// merge into their mean, and triangles that collapse go. Cells of 1/48, 1/24 and 1/12 of the
+// mesh's bounding-box diagonal; a level is kept only when it has at most 60 % of the previous
+// one's triangles. Its error is the farthest any vertex moved. A textured mesh (uvs) keeps its
+// one level: merging would tear its texture mapping.
+MeshLevels simplified_levels(MeshData mesh);
+
 // Fills `mesh->normals` with area-weighted smooth vertex normals.
 void compute_normals(MeshData* mesh);
 

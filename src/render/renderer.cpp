@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <map>
@@ -17,6 +18,7 @@
 #include "render/egl_context.h"
 #include "render/gl_program.h"
 #include "render/gpu_resources.h"
+#include "render/precipitation.h"
 #include "render/readback.h"
 
 namespace convoy::render {
@@ -120,6 +122,14 @@ struct Renderer::Impl {
   RenderTargetCache targets;
   std::map<ProgramKey, SurfaceProgram> programs;  // built when first needed
   PrecipitationProgram precipitation;             // built when first needed
+  std::vector<PrecipitationVertex> precipitation_vertices;
+  // Sun shadows (Scene::shadows): the depth program, the map and its framebuffer, and this
+  // frame's eye-to-map matrix and biases.
+  ShadowProgram shadow_program;
+  GLuint shadow_fbo = 0, shadow_texture = 0;
+  int shadow_size = 0;
+  glm::mat4 shadow_matrix{1.0f};
+  glm::vec2 shadow_bias{0.0f};
   uint64_t frame_number = 0;
   std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
@@ -140,9 +150,19 @@ struct Renderer::Impl {
       return;  // another thread holds the context: leak the GL objects rather than crash
     }
     for (auto& [key, p] : programs) destroy_program(&p);
-    if (precipitation.id) glDeleteProgram(precipitation.id);
+    if (shadow_program.id) glDeleteProgram(shadow_program.id);
+    if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
+    if (shadow_texture) glDeleteTextures(1, &shadow_texture);
+    if (precipitation.id) {
+      glDeleteProgram(precipitation.id);
+      glDeleteVertexArrays(1, &precipitation.vao);
+      glDeleteBuffers(1, &precipitation.vbo);
+    }
   }
   void draw_precipitation(const Atmosphere& a, int width, int height);
+  // Renders light `li`'s shadow map around the camera of `view` (world to eye); false when
+  // the light is too low to cast shadows.
+  bool render_shadow_map(const Scene& scene, int li, const glm::dmat4& view, const GpuScene& gpu);
 
   const SurfaceProgram& program(const ProgramKey& key) {
     auto it = programs.find(key);
@@ -172,6 +192,10 @@ void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene&
     glUniform1f(p.wetness, a.wetness);
     glUniform1f(p.snow, a.snow_cover);
     glUniform3fv(p.sky, 1, a.sky.data());
+  }
+  if (p.shadow_matrix >= 0) {
+    glUniformMatrix4fv(p.shadow_matrix, 1, GL_FALSE, glm::value_ptr(shadow_matrix));
+    glUniform2fv(p.shadow_bias, 1, glm::value_ptr(shadow_bias));
   }
   const auto& lights = scene.lights();
   const int n = static_cast<int>(lights.size());
@@ -332,8 +356,127 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
   if (!culling) glEnable(GL_CULL_FACE);
 }
 
+bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dmat4& view,
+                                       const GpuScene& gpu) {
+  const Light& sun = scene.lights()[li];
+  glm::dvec3 d(sun.direction[0], sun.direction[1], sun.direction[2]);
+  if (!(glm::length(d) > 0)) return false;
+  d = glm::normalize(d);
+  if (-d.z < std::sin(3.0 * std::numbers::pi / 180)) return false;  // the sun below 3 degrees
+  const Shadows& cfg = scene.shadows();
+  const int size = std::clamp(cfg.map_size, 64, max_size);
+  if (!shadow_program.id) shadow_program = build_shadow_program();
+  if (size != shadow_size) {
+    if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
+    if (shadow_texture) glDeleteTextures(1, &shadow_texture);
+    glGenTextures(1, &shadow_texture);
+    glBindTexture(GL_TEXTURE_2D, shadow_texture);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT24, size, size);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &shadow_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow_texture, 0);
+    const GLenum none = GL_NONE;
+    glDrawBuffers(1, &none);
+    glReadBuffer(GL_NONE);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("render: the shadow map's framebuffer is incomplete");
+    shadow_size = size;
+  }
+  // The map covers a square around the ground ahead of the camera, seen along the light; its
+  // centre snaps to whole texels so that shadows keep still as the camera moves.
+  const glm::dmat4 camera_world = glm::inverse(view);
+  const glm::dvec3 eye(camera_world[3]);
+  const glm::dvec3 forward = -glm::dvec3(camera_world[2]);
+  glm::dvec3 ahead(forward.x, forward.y, 0);
+  ahead = glm::length(ahead) > 1e-6 ? glm::normalize(ahead) : glm::dvec3(0);
+  const double half = 0.5 * cfg.distance, radius = 1.2 * half, depth = 300;
+  const glm::dvec3 up = std::abs(d.z) > 0.99 ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
+  const glm::dmat4 light_view = glm::lookAt(glm::dvec3(0), d, up);
+  glm::dvec3 c(light_view * glm::dvec4(eye + ahead * half, 1));
+  const double texel = 2 * radius / size;
+  c.x = std::floor(c.x / texel) * texel;
+  c.y = std::floor(c.y / texel) * texel;
+  const glm::dmat4 light_clip = glm::ortho(c.x - radius, c.x + radius, c.y - radius, c.y + radius,
+                                           -c.z - depth, -c.z + depth) *
+                                light_view;
+
+  glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+  glViewport(0, 0, size, size);
+  const float far_depth = 1.0f;
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+  glUseProgram(shadow_program.id);
+  // Only the faces turned away from the light: surfaces facing it do not shadow themselves.
+  glEnable(GL_CULL_FACE);
+  glFrontFace(GL_CCW);
+  glCullFace(GL_FRONT);
+  bool culling = true;
+  int bound_mesh = -1;
+  const auto& instances = scene.instances();
+  for (size_t i = 0; i < instances.size(); ++i) {
+    const Scene::Instance& inst = instances[i];
+    if (!inst.visible) continue;
+    const Scene::Bounds& b = scene.mesh_bounds()[inst.mesh];
+    const glm::dmat4 world = glm::make_mat4(inst.world_from_object.data());
+    const double scale =
+        std::max({glm::length(glm::dvec3(world[0])), glm::length(glm::dvec3(world[1])),
+                  glm::length(glm::dvec3(world[2]))});
+    const double r = b.radius * scale;
+    const glm::dvec3 lc(light_view * world * glm::dvec4(b.centre[0], b.centre[1], b.centre[2], 1));
+    if (std::abs(lc.x - c.x) > radius + r || std::abs(lc.y - c.y) > radius + r ||
+        std::abs(lc.z - c.z) > depth + r)
+      continue;
+    int mesh = inst.mesh;
+    for (const Scene::Lod& lod : scene.mesh_lods()[inst.mesh]) {
+      if (lod.error * scale > texel) break;
+      mesh = lod.mesh;
+    }
+    if (inst.material.double_sided == culling) {
+      culling = !inst.material.double_sided;
+      culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+    }
+    if (mesh != bound_mesh) {
+      glBindVertexArray(gpu.meshes[mesh].vao);
+      bound_mesh = mesh;
+    }
+    glUniformMatrix4fv(shadow_program.mvp, 1, GL_FALSE,
+                       glm::value_ptr(glm::mat4(light_clip * world)));
+    glDrawElements(GL_TRIANGLES, gpu.meshes[mesh].index_count, GL_UNSIGNED_INT, nullptr);
+  }
+  glBindVertexArray(0);
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_BACK);
+  // Eye space -> world -> the light's clip space -> the map's [0, 1] cube.
+  const glm::dmat4 to_unit = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5)) *
+                             glm::scale(glm::dmat4(1.0), glm::dvec3(0.5));
+  shadow_matrix = glm::mat4(to_unit * light_clip * camera_world);
+  shadow_bias = glm::vec2(static_cast<float>(1.5 * texel), static_cast<float>(0.05 / (2 * depth)));
+  return true;
+}
+
 // Rain or snow over the colour image only (depth and ids keep the scene's).
 void Renderer::Impl::draw_precipitation(const Atmosphere& a, int width, int height) {
+  // A new pattern for each frame time, the same for the same seed and time.
+  const uint64_t ms = static_cast<uint64_t>(std::llround(a.time * 1000.0));
+  PrecipitationParams params;
+  params.width = width;
+  params.height = height;
+  params.amount = a.precipitation;
+  params.snow = a.snow;
+  params.slant = a.fall_slant;
+  params.seed = a.seed * 0x9e3779b9u ^ static_cast<uint32_t>(ms * 0x85ebca6bULL) ^
+                static_cast<uint32_t>(ms >> 32);
+  make_precipitation(params, &precipitation_vertices);
+  if (precipitation_vertices.empty()) return;
   if (!precipitation.id) precipitation = build_precipitation_program();
   const GLenum colour_only[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
   glDrawBuffers(3, colour_only);
@@ -344,15 +487,15 @@ void Renderer::Impl::draw_precipitation(const Atmosphere& a, int width, int heig
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glUseProgram(precipitation.id);
   glUniform2f(precipitation.size, static_cast<float>(width), static_cast<float>(height));
-  // A new pattern for each frame time, the same for the same seed and time.
-  const uint64_t ms = static_cast<uint64_t>(std::llround(a.time * 1000.0));
-  uint32_t seed = a.seed * 0x9e3779b9u ^ static_cast<uint32_t>(ms * 0x85ebca6bULL) ^
-                  static_cast<uint32_t>(ms >> 32);
-  glUniform1ui(precipitation.seed, seed);
-  glUniform1f(precipitation.amount, std::clamp(a.precipitation, 0.0f, 1.0f));
   glUniform1i(precipitation.snow, a.snow ? 1 : 0);
-  glUniform1f(precipitation.slant, a.fall_slant);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(precipitation.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, precipitation.vbo);
+  glBufferData(GL_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(precipitation_vertices.size() * sizeof(PrecipitationVertex)),
+               precipitation_vertices.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(precipitation_vertices.size()));
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
   glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
@@ -400,6 +543,19 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   key.ids = want_boxes;
   key.fog = scene.atmosphere().fog();
   key.surface_weather = scene.atmosphere().surface_weather();
+  const glm::dmat4 view = glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
+  if (scene.shadows().enabled) {
+    const auto& lights = scene.lights();
+    for (int i = 0; i < static_cast<int>(lights.size()); ++i) {
+      if (lights[i].type != Light::kDirectional) continue;
+      if (s.render_shadow_map(scene, i, view, gpu)) {
+        key.shadow_light = i;
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, s.shadow_texture);
+      }
+      break;
+    }
+  }
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
   glViewport(0, 0, w, h);
@@ -425,7 +581,6 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   if (want_boxes) glClearBufferfv(GL_COLOR, 2, zero);
   glClearBufferfv(GL_DEPTH, 0, &far_depth);
 
-  const glm::dmat4 view = glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
   glActiveTexture(GL_TEXTURE0);
   s.collect_draws(scene, view, spec);
   s.draw(key, scene, view, spec, gpu);

@@ -89,6 +89,16 @@ struct Atmosphere {
   bool operator==(const Atmosphere&) const = default;
 };
 
+// Sun shadows: the first directional light, while it is at least 3 degrees above the horizon,
+// casts shadows through a shadow map of map_size x map_size texels covering the ground from
+// the camera to `distance` metres ahead of it (beyond, no shadows). Off by default.
+struct Shadows {
+  bool enabled = false;
+  double distance = 60;  // m
+  int map_size = 1024;
+  bool operator==(const Shadows&) const = default;
+};
+
 class Scene {
  public:
   // The renderer draws at most this many lights; add_light throws beyond it.
@@ -149,6 +159,7 @@ class Scene {
   void set_ambient(const Rgba& rgba) { ambient_ = rgba; }
   void set_background(const Rgba& rgba) { background_ = rgba; }
   void set_atmosphere(const Atmosphere& a) { atmosphere_ = a; }
+  void set_shadows(const Shadows& s) { shadows_ = s; }
 
   // Read access for the renderer.
   uint64_t uid() const { return uid_; }  // unique per Scene object in this process
@@ -162,6 +173,7 @@ class Scene {
   const Rgba& ambient() const { return ambient_; }
   const Rgba& background() const { return background_; }
   const Atmosphere& atmosphere() const { return atmosphere_; }
+  const Shadows& shadows() const { return shadows_; }
 
  private:
   Instance& instance_at(int index, const char* what);
@@ -177,6 +189,7 @@ class Scene {
   Rgba ambient_{0.4f, 0.4f, 0.4f, 1.0f};     // SDF <scene><ambient> default
   Rgba background_{0.7f, 0.7f, 0.7f, 1.0f};  // SDF <scene><background> default
   Atmosphere atmosphere_;                    // none: clear air
+  Shadows shadows_;
 };
 
 }  // namespace convoy::render

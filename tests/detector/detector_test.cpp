@@ -55,6 +55,20 @@ TEST(Letterbox, Geometry) {
   Letterbox d = compute_letterbox(320, 240, 640);
   EXPECT_DOUBLE_EQ(d.scale, 2.0);
   EXPECT_EQ(d.pad_y, 80);
+  // A rectangular network input (Convoy's detector): 736 x 480 into 448 x 288.
+  Letterbox e = compute_letterbox(736, 480, 448, 288);
+  EXPECT_NEAR(e.scale, 0.6, 1e-9);
+  EXPECT_EQ(e.pad_x, 3);
+  EXPECT_EQ(e.pad_y, 0);
+  cv::Mat img(480, 736, CV_8UC3, cv::Scalar(10, 20, 30));
+  Letterbox f;
+  cv::Mat out = letterbox_image(img, 448, &f, 288);
+  EXPECT_EQ(out.cols, 448);
+  EXPECT_EQ(out.rows, 288);
+  cv::Rect2f back = unletterbox({3.0f, 0.0f, 60.0f, 30.0f}, f, 736, 480);
+  EXPECT_NEAR(back.x, 0.0, 1e-3);
+  EXPECT_NEAR(back.width, 100.0, 1e-3);
+  EXPECT_NEAR(back.height, 50.0, 1e-3);
 }
 
 TEST(Letterbox, ImagePaddedWith114) {

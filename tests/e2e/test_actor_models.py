@@ -1,12 +1,14 @@
 """The road-user actor models (engines/gazebo_grpc/actors, written by
 tools/assets/make_road_users.py): the committed files are what the generator writes; each
-table entry's SDF and meshes agree with its size, class and triangle budget; and the world
-engine loads and renders every model.
+table entry's SDF and meshes agree with its size, class and triangle budget; the world
+engine loads and renders every model; and a street of them looks as its golden image
+(tests/e2e/golden/actor_models.png; CONVOY_UPDATE_GOLDEN=1 rewrites it).
 
 Run with Debian's /usr/bin/python3 -m unittest test_actor_models."""
 
 import filecmp
 import json
+import numpy as np
 import os
 import shutil
 import subprocess
@@ -149,6 +151,24 @@ WORLD = """<?xml version="1.0"?>
 """
 
 
+def add_world_and_users(ex, users):
+    """The world engine on world.sdf with the actor table, and an engine sending `users` as
+    RoadUsers every step (forwarded to the world by a TF)."""
+    ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "world.sdf",
+                       "EngineTimestep": 0.02, "ActorModels": TABLE})
+    ex.engine("traffic", textwrap.dedent("""\
+        from nrp_core.engines.python_json import EngineScript
+        USERS = %r
+        class Script(EngineScript):
+            def initialize(self):
+                self._registerDataPack("road_users")
+                self._setDataPack("road_users", {"users": USERS})
+            def runLoop(self, timestep_ns):
+                self._setDataPack("road_users", {"users": USERS})
+        """ % users), timestep=0.02)
+    ex.function("forward", FORWARD)
+
+
 class Rendering(unittest.TestCase):
     def test_every_model_loads_and_is_seen_with_its_class(self):
         models = load_table()["models"]
@@ -159,19 +179,7 @@ class Rendering(unittest.TestCase):
         self.assertLessEqual(len(users), 80)
         ex = Experiment(self)
         ex.file("world.sdf", WORLD)
-        ex.engines.append({"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": "world.sdf",
-                           "EngineTimestep": 0.02, "ActorModels": TABLE})
-        ex.engine("traffic", textwrap.dedent("""\
-            from nrp_core.engines.python_json import EngineScript
-            USERS = %r
-            class Script(EngineScript):
-                def initialize(self):
-                    self._registerDataPack("road_users")
-                    self._setDataPack("road_users", {"users": USERS})
-                def runLoop(self, timestep_ns):
-                    self._setDataPack("road_users", {"users": USERS})
-            """ % users), timestep=0.02)
-        ex.function("forward", FORWARD)
+        add_world_and_users(ex, users)
         ex.function("record", RECORD)
         ex.run(0.1)
         seen = {}
@@ -180,6 +188,76 @@ class Rendering(unittest.TestCase):
                 seen[b["model"]] = b["class"]
         for key, e in models.items():
             self.assertEqual(seen.get("a/" + key), e["class"], key)
+
+
+GOLDEN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "golden", "actor_models.png")
+
+GRAB = textwrap.dedent("""\
+    import os
+    import numpy as np
+    from nrp_core import *
+
+    @EngineDataPack(keyword='cam', id=DataPackIdentifier('street::link::cam', 'gazebo'))
+    @TransceiverFunction("gazebo")
+    def grab(cam):
+        if not cam.isEmpty() and cam.data.imageWidth > 0:
+            img = np.frombuffer(cam.data.imageData, np.uint8).reshape(
+                cam.data.imageHeight, cam.data.imageWidth, cam.data.imageDepth)
+            np.save(os.path.join(os.path.dirname(__file__), "frame.npy"), img)
+        return []
+    """)
+
+# A camera 1.6 m up, 14 m from a row of road users across its view, looking at them.
+STREET = """<?xml version="1.0"?>
+<sdf version="1.7">
+  <world name="street">
+    <light name="sun" type="directional"><pose>0 0 10 0 0 0</pose>
+      <diffuse>0.9 0.9 0.85 1</diffuse><direction>-0.3 0.4 -0.85</direction></light>
+    <model name="street"><static>true</static><pose>-14 0 1.6 0 0.05 0</pose>
+      <link name="link"><sensor name="cam" type="camera"><camera><horizontal_fov>1.6</horizontal_fov>
+        <image><width>640</width><height>240</height></image><clip><near>0.5</near><far>100</far></clip>
+      </camera></sensor></link></model>
+    <model name="ground"><static>true</static><link name="link">
+      <collision name="c"><geometry><plane><normal>0 0 1</normal><size>200 200</size></plane></geometry></collision>
+      <visual name="v"><geometry><plane><normal>0 0 1</normal><size>200 200</size></plane></geometry>
+        <material><ambient>0.3 0.3 0.32 1</ambient><diffuse>0.3 0.3 0.32 1</diffuse></material></visual>
+    </link></model>
+  </world>
+</sdf>
+"""
+
+# Side by side across the view (x, y, yaw): rear, front and side views.
+STREET_USERS = [("bicycle", 0.0, 12.0, 1.57), ("hatchback", 0.0, 8.5, 2.8), ("sedan_red", 0.0, 5.0, 0.3),
+                ("suv", 0.0, 1.5, 2.9), ("van", 0.0, -2.0, 0.25), ("pedestrian", -2.0, -4.3, 1.2),
+                ("walker", -2.0, -5.3, 2.0), ("bus", 8.0, -8.5, 0.15), ("truck", 14.0, -13.5, 3.0)]
+
+
+class Golden(unittest.TestCase):
+    def test_a_street_of_road_users_looks_as_its_golden_image(self):
+        ex = Experiment(self)
+        ex.file("world.sdf", STREET)
+        users = []
+        for key, x, y, yaw in STREET_USERS:
+            users.append({"id": "a/" + key, "model": key, "x": x, "y": y, "yaw": yaw})
+        add_world_and_users(ex, users)
+        ex.function("grab", GRAB)
+        ex.run(0.1)
+        frame = np.load(os.path.join(ex.dir, "frame.npy"))[:, :, :3]
+        import cv2
+        if os.environ.get("CONVOY_UPDATE_GOLDEN") == "1":
+            os.makedirs(os.path.dirname(GOLDEN), exist_ok=True)
+            cv2.imwrite(GOLDEN, frame[:, :, ::-1])
+        golden = cv2.imread(GOLDEN)
+        self.assertIsNotNone(golden, GOLDEN + ": missing (CONVOY_UPDATE_GOLDEN=1 writes it)")
+        golden = golden[:, :, ::-1]
+        self.assertEqual(frame.shape, golden.shape)
+        diff = np.abs(frame.astype(np.int16) - golden.astype(np.int16)).max(axis=2)
+        # Within tolerance: a few edge pixels may differ between Mesa builds.
+        self.assertLess(float(np.mean(diff > 24)), 0.005, "pixels off by more than 24 levels")
+        self.assertLess(float(diff.mean()), 1.5)
+        # And not a blank frame: the road users cover a good part of it.
+        ground_and_sky = np.mean(np.abs(frame.astype(np.int16) - frame[5, 5].astype(np.int16)).max(axis=2) < 6)
+        self.assertLess(ground_and_sky, 0.9)
 
 
 if __name__ == "__main__":

@@ -72,6 +72,29 @@ class Dataset(unittest.TestCase):
         first = [a for a in doc["annotations"] if a["image_id"] <= 5]
         self.assertEqual(json.dumps(first, sort_keys=True), json.dumps(doc2["annotations"], sort_keys=True))
 
+    def test_weather_kinds_in_turn_and_vehicle_models_drawn_per_run(self):
+        d = tempfile.mkdtemp(prefix="convoy-dataset-")
+        self.addCleanup(shutil.rmtree, d, True)
+        r = subprocess.run([PY, MAKE_DATASET, CITY, "--out", d, "--build", os.path.dirname(BIN_DIR), "--runs", "2",
+                            "--seconds", "2", "--every", "30", "--seed", "40", "--weather", "clear,rain",
+                            "--vary-models", "bus=1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           timeout=600)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        with open(os.path.join(d, "runs.json")) as f:
+            runs = json.load(f)
+        self.assertEqual([run["weather_kind"] for run in runs], ["clear", "rain"])
+        for run in runs:
+            self.assertEqual(len(run["models"]), 20)  # city_traffic's vehicle agents
+            self.assertTrue(all(m.startswith("bus") for m in run["models"].values()), run["models"])
+        self.assertNotEqual(runs[0]["models"], runs[1]["models"])
+        with open(os.path.join(d, "annotations.json")) as f:
+            doc = json.load(f)
+        rain = {img["seed"]: img["weather"]["precipitation"] for img in doc["images"]}
+        self.assertEqual(rain[40], 0.0)
+        self.assertGreater(rain[41], 0.0)
+        cats = {c["id"]: c["name"] for c in doc["categories"]}
+        self.assertIn("bus", {cats[a["category_id"]] for a in doc["annotations"]})
+
     def test_rle_round_trip(self):
         rng = np.random.default_rng(1)
         for shape in ((1, 1), (3, 5), (48, 64)):
@@ -86,9 +109,13 @@ class DatasetBadInput(unittest.TestCase):
     def run_tool(self, config, *args):
         d = tempfile.mkdtemp(prefix="convoy-dataset-bad-")
         self.addCleanup(shutil.rmtree, d, True)
-        return subprocess.run([PY, MAKE_DATASET, config, "--out", d, "--build", os.path.dirname(BIN_DIR),
-                               "--runs", "1", "--seconds", "1"] + list(args),
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
+        p = subprocess.Popen([PY, MAKE_DATASET, config, "--out", d, "--build", os.path.dirname(BIN_DIR),
+                              "--runs", "1", "--seconds", "1"] + list(args),
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        out, err = p.communicate(timeout=300)
+        r = subprocess.CompletedProcess(p.args, p.returncode, out, err)
+        r.pid = p.pid  # make_dataset names its derived configs .dataset_<pid>_<seed>.json
+        return r
 
     def test_an_experiment_without_a_weather_engine_is_named(self):
         cfg = os.path.join(REPO, "experiments", "wheeled_robot", "simulation_config.json")
@@ -102,12 +129,27 @@ class DatasetBadInput(unittest.TestCase):
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("--set nosuch.Key=1: no engine 'nosuch'", r.stderr)
 
+    def test_bad_weather_kinds_and_model_shares_are_named(self):
+        r = self.run_tool(PARKRING, "--weather", "clear,mud")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--weather clear,mud: unknown kind 'mud'", r.stderr)
+        r = self.run_tool(PARKRING, "--weather", "rain", "--randomize")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("either --weather or --randomize", r.stderr)
+        r = self.run_tool(PARKRING, "--vary-models", "car=1,plane=2")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--vary-models car=1,plane=2: unknown class 'plane'", r.stderr)
+        r = self.run_tool(PARKRING, "--vary-models", "car")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("expected CLASS=SHARE", r.stderr)
+
     def test_a_failing_run_names_the_run_and_leaves_no_derived_config(self):
         r = self.run_tool(PARKRING, "--set", "gazebo.GazeboWorldFile=missing_world.sdf")
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("run 0 failed", r.stderr)
         self.assertIn("missing_world.sdf", r.stderr)
-        left = [f for f in os.listdir(os.path.dirname(PARKRING)) if f.startswith(".dataset_")]
+        # (its own: other tests running at the same time may have theirs there)
+        left = [f for f in os.listdir(os.path.dirname(PARKRING)) if f.startswith(".dataset_%d_" % r.pid)]
         self.assertEqual(left, [])
 
 
@@ -117,7 +159,7 @@ class Training(unittest.TestCase):
         self.addCleanup(shutil.rmtree, d, True)
         make_dataset(os.path.join(d, "data"), "--runs", "1", "--seconds", "3", "--every", "15")
         r = subprocess.run([PY, TRAIN, "--data", os.path.join(d, "data"), "--out", os.path.join(d, "model"),
-                            "--iterations", "3", "--batch", "2"],
+                            "--iterations", "3", "--batch", "2", "--input", "128x96"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=600)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
         with open(os.path.join(d, "model", "model.json")) as f:
@@ -125,11 +167,11 @@ class Training(unittest.TestCase):
         with open(os.path.join(d, "model", "classes.txt")) as f:
             classes = f.read().split()
         self.assertEqual(meta["classes"], classes)
+        self.assertEqual((meta["input_width"], meta["input_height"]), (128, 96))
         net = cv2.dnn.readNetFromONNX(os.path.join(d, "model", "convoy_detector.onnx"))
-        size = meta["input_width"]
-        net.setInput(np.zeros((1, 3, size, size), np.float32))
+        net.setInput(np.zeros((1, 3, 96, 128), np.float32))
         out = net.forward()
-        cells = sum((size // s) ** 2 for s in (8, 16, 32))
+        cells = sum((128 // s) * (96 // s) for s in (8, 16, 32))
         self.assertEqual(out.shape, (1, 4 + len(classes), cells))
 
 
@@ -137,7 +179,7 @@ CITY = os.path.join(REPO, "experiments", "city_traffic", "simulation_config.json
 # The shipped model's mAP@0.5 on the fixed render set below, less a margin (docs/perception.md
 # has the measured figure; the issue's target, 0.8 on held-out renders, is checked by
 # benchmarks/perception_bench.py).
-MIN_MAP50 = 0.40  # measured 0.486 (car 0.58, bus 0.63, pedestrian 0.25; 31 frames)
+MIN_MAP50 = 0.80  # the issue's target; measured 0.939 (car 0.82, bus 1.00, pedestrian 1.00; 31 frames)
 
 
 class Shipped(unittest.TestCase):
@@ -151,9 +193,9 @@ class Shipped(unittest.TestCase):
         size = sum(os.path.getsize(os.path.join(MODEL_DIR, n)) for n in os.listdir(MODEL_DIR))
         self.assertLess(size, 15e6)
         net = cv2.dnn.readNetFromONNX(os.path.join(MODEL_DIR, "convoy_detector.onnx"))
-        s = meta["input_width"]
-        net.setInput(np.zeros((1, 3, s, s), np.float32))
-        self.assertEqual(net.forward().shape, (1, 4 + len(classes), sum((s // k) ** 2 for k in (8, 16, 32))))
+        w, h = meta["input_width"], meta["input_height"]
+        net.setInput(np.zeros((1, 3, h, w), np.float32))
+        self.assertEqual(net.forward().shape, (1, 4 + len(classes), sum((w // k) * (h // k) for k in (8, 16, 32))))
         # A small fixed render set on the held-out camera path (the city westbound, a seed
         # training never used), scored by convoy_perception.evaluation.
         d = tempfile.mkdtemp(prefix="convoy-shipped-")

@@ -304,5 +304,42 @@ TEST(LevelsTest, ErrorsBoundTheDistanceToTheTrueShape) {
   }
 }
 
+// Levels for meshes from files: fewer triangles each, the error growing, every coarse vertex
+// within its level's error of the true surface; the finest level untouched.
+TEST(MeshLevels, SimplifiedByVertexClustering) {
+  MeshData sphere = make_sphere(1.0f, 32, 64);
+  sphere.uvs.clear();
+  const MeshLevels levels = simplified_levels(sphere);
+  ASSERT_GE(levels.meshes.size(), 3u);
+  EXPECT_EQ(levels.meshes[0].indices, sphere.indices);
+  EXPECT_EQ(levels.errors[0], 0.0f);
+  for (size_t i = 1; i < levels.meshes.size(); ++i) {
+    const MeshData& m = levels.meshes[i];
+    EXPECT_NO_THROW(validate_mesh(m, "level"));
+    EXPECT_LE(m.triangle_count(), 0.6 * levels.meshes[i - 1].triangle_count()) << i;
+    EXPECT_GT(levels.errors[i], levels.errors[i - 1]) << i;
+    EXPECT_LT(levels.errors[i], 0.5f) << i;  // a cell's diagonal: cells of at most 1/12 of 3.46 m
+    ASSERT_EQ(m.normals.size(), m.positions.size());
+    for (size_t v = 0; v < m.vertex_count(); ++v) {
+      const double r =
+          std::hypot(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]);
+      EXPECT_LE(1.0 - r, levels.errors[i] + 1e-5) << "level " << i << " vertex " << v;
+      EXPECT_LE(r, 1.0 + 1e-5);
+    }
+  }
+  // Textured meshes keep their one level; tiny ones too.
+  MeshData textured = sphere;
+  textured.uvs.assign(2 * textured.vertex_count(), 0.5f);
+  EXPECT_EQ(simplified_levels(textured).meshes.size(), 1u);
+  EXPECT_EQ(simplified_levels(make_box(1, 1, 1)).meshes.size(), 1u);
+  // A road user from the actor library: a sedan's body.
+  const auto parts = load_mesh(std::string(CONVOY_ACTOR_MESH_DIR) + "/sedan_paint.obj");
+  ASSERT_FALSE(parts.empty());
+  const MeshLevels sedan = simplified_levels(parts[0].mesh);
+  ASSERT_GE(sedan.meshes.size(), 2u);
+  EXPECT_LE(sedan.meshes.back().triangle_count(), sedan.meshes[0].triangle_count() / 3);
+  EXPECT_LT(sedan.errors.back(), 0.5f);
+}
+
 }  // namespace
 }  // namespace convoy::render

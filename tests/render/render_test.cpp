@@ -163,6 +163,49 @@ TEST(RenderTest, SphereIsBrighterOnTheLitSide) {
   EXPECT_GT(left, 3 * right);
 }
 
+// Sun shadows (Scene::set_shadows): a box floating 1 m above the ground, the sun at 45 degrees
+// from behind the camera, shades the ground 1-2 m beyond it; off, the ground is lit alike.
+TEST(RenderTest, TheSunCastsShadowsWhereAsked) {
+  GET_RENDERER(renderer);
+  const CameraSpec spec{320, 240, 1.2, 0.1, 100};
+  Scene scene;
+  scene.set_ambient({0.2f, 0.2f, 0.2f, 1});
+  Light sun;
+  sun.direction = {1, 0, -1};
+  scene.add_light(sun);
+  scene.add_instance(scene.add_mesh(make_plane(80, 80)), plain(0.8f, 0.8f, 0.8f),
+                     make_pose(0, 0, -1.5));
+  scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(0.8f, 0.2f, 0.2f),
+                     make_pose(6, 0, 0));
+  auto grey = [&](const Frame& f, double x, double y, double z) {
+    const auto uv = project(spec, x, y, z);
+    const uint8_t* p = &f.rgb[3 * (static_cast<int>(uv[1]) * f.width + static_cast<int>(uv[0]))];
+    return (p[0] + p[1] + p[2]) / 3.0;
+  };
+  Frame off, on;
+  renderer->render(scene, identity_pose(), spec, &off);
+  Shadows shadows;
+  shadows.enabled = true;
+  scene.set_shadows(shadows);
+  renderer->render(scene, identity_pose(), spec, &on);
+  // In the shadow (x 6.5..8.5, y -0.5..0.5 on the ground) and beside it.
+  EXPECT_LT(grey(on, 7.5, 0, -1.5), 0.5 * grey(on, 7.5, 2, -1.5));
+  EXPECT_NEAR(grey(off, 7.5, 0, -1.5), grey(off, 7.5, 2, -1.5), 6);
+  // Lit ground and the lit box keep their colour; only the shadow changed.
+  EXPECT_NEAR(grey(on, 7.5, 2, -1.5), grey(off, 7.5, 2, -1.5), 2);
+  EXPECT_NEAR(grey(on, 4, 0, -1.5), grey(off, 4, 0, -1.5), 2);
+  // No sun above the horizon, no shadows.
+  scene.clear_lights();
+  Light evening;
+  evening.direction = {1, 0, -0.01f};
+  scene.add_light(evening);
+  Frame dusk_on, dusk_off;
+  renderer->render(scene, identity_pose(), spec, &dusk_on);
+  scene.set_shadows(Shadows{});
+  renderer->render(scene, identity_pose(), spec, &dusk_off);
+  EXPECT_EQ(dusk_on.rgb, dusk_off.rgb);
+}
+
 TEST(RenderTest, PointAndSpotLightsFadeWithDistanceAndCone) {
   GET_RENDERER(renderer);
   const CameraSpec spec{200, 150, 1.2, 0.1, 100};

@@ -2,10 +2,14 @@
 // (deterministic per seed and time), wet and snowy ground.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "render/precipitation.h"
 #include "render/renderer.h"
 #include "shared_renderer.h"
 
@@ -104,6 +108,46 @@ TEST(WeatherRenderTest, RainAndSnowDifferFromClearAndRepeatForTheSameSeed) {
     // Depth and ground truth are the scene's, not the weather's.
     EXPECT_EQ(one.depth, clear.depth);
     ASSERT_EQ(one.boxes.size(), clear.boxes.size());
+  }
+}
+
+// The particles: none without precipitation, more with more, each overlapping the image, the
+// same for the same seed and others for another.
+TEST(WeatherRenderTest, PrecipitationParticlesFollowAmountAndSeed) {
+  for (bool snow : {false, true}) {
+    PrecipitationParams p;
+    p.width = 736;
+    p.height = 480;
+    p.snow = snow;
+    p.slant = 0.15f;
+    p.seed = 9;
+    std::vector<PrecipitationVertex> v;
+    make_precipitation(p, &v);
+    EXPECT_TRUE(v.empty());
+    size_t last = 0;
+    for (float amount : {0.2f, 0.5f, 1.0f}) {
+      p.amount = amount;
+      make_precipitation(p, &v);
+      ASSERT_EQ(v.size() % 6, 0u);
+      EXPECT_GT(v.size(), last + 60) << amount;  // at least 10 more particles
+      last = v.size();
+      for (size_t i = 0; i < v.size(); i += 6) {
+        float x_min = 1e9f, x_max = -1e9f, y_min = 1e9f, y_max = -1e9f;
+        for (size_t k = i; k < i + 6; ++k) {
+          x_min = std::min(x_min, v[k].x), x_max = std::max(x_max, v[k].x);
+          y_min = std::min(y_min, v[k].y), y_max = std::max(y_max, v[k].y);
+        }
+        ASSERT_TRUE(x_max >= 0 && x_min <= p.width && y_max >= 0 && y_min <= p.height) << i;
+      }
+    }
+    std::vector<PrecipitationVertex> again, other;
+    make_precipitation(p, &again);
+    p.seed = 10;
+    make_precipitation(p, &other);
+    ASSERT_EQ(again.size(), v.size());
+    EXPECT_EQ(0, std::memcmp(again.data(), v.data(), v.size() * sizeof(v[0])));
+    EXPECT_TRUE(other.size() != v.size() ||
+                std::memcmp(other.data(), v.data(), v.size() * sizeof(v[0])) != 0);
   }
 }
 

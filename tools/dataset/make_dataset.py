@@ -5,7 +5,8 @@ with COCO ground truth (boxes, classes, instance ids, instance masks as RLE) and
 
   /usr/bin/python3 tools/dataset/make_dataset.py CONFIG --out DIR [--runs 4] [--seed 0]
       [--every 15] [--seconds 60] [--camera smart_camera::camera] [--world gazebo]
-      [--randomize] [--build build]
+      [--randomize | --weather KIND[,KIND...]] [--vary-models car=0.6,bus=0.2,truck=0.2]
+      [--build build]
 
 Writes DIR/annotations.json (all runs, COCO; each image's record has its seed, weather and
 time), DIR/images/*.jpg, DIR/depth/*.png (mm, uint16), DIR/runs.json (what each run drew).
@@ -26,10 +27,16 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(REPO, "python"))
 
 
-def draw_weather(rng):
-    """A weather for one run: clear most often, then rain, fog, snow, dusk and night."""
-    kind = rng.choices(["clear", "rain", "fog", "snow", "dusk", "night"],
-                       weights=[0.4, 0.15, 0.15, 0.1, 0.1, 0.1])[0]
+KINDS = ["clear", "rain", "fog", "snow", "dusk", "night"]
+
+
+def draw_weather(rng, kind=None):
+    """A weather for one run: clear most often, then rain, fog, snow, dusk and night; with
+    `kind`, that kind's parameters (still drawn from rng)."""
+    if kind is None:
+        kind = rng.choices(KINDS, weights=[0.4, 0.15, 0.15, 0.1, 0.1, 0.1])[0]
+    elif kind not in KINDS:
+        raise ValueError("unknown weather kind '%s' (%s)" % (kind, ", ".join(KINDS)))
     w = {"TimeOfDay": round(rng.uniform(8.0, 16.5), 2)}
     if kind == "rain":
         w.update(Precipitation=round(rng.uniform(0.3, 1.0), 2), Surface="wet")
@@ -45,6 +52,43 @@ def draw_weather(rng):
     return kind, w
 
 
+def actor_table():
+    """The world engine's actor table (engines/gazebo_grpc/actors/actor_models.json): model ->
+    {"class", "size": [length, width, height], "length_offset", ...}."""
+    with open(os.path.join(REPO, "engines", "gazebo_grpc", "actors", "actor_models.json")) as f:
+        return json.load(f)["models"]
+
+
+def actor_models():
+    """The actor table's model names by class ({"car": [...], "bus": [...], ...})."""
+    by_class = {}
+    for name, entry in sorted(actor_table().items()):
+        by_class.setdefault(entry["class"], []).append(name)
+    return by_class
+
+
+def vary_models(cfg, seed, shares):
+    """Gives each vehicle_agent of cfg a model drawn for this run: a class by `shares`
+    ({"car": 0.6, "bus": 0.2, "truck": 0.2}), then one of its variants; the agent takes the
+    model's class as its Category and its size (Length, Width, Height, and a Wheelbase of twice
+    the model's length_offset: the reference point is the rear axle). Its own random stream, so
+    that the weather drawn does not change it. Returns {engine: model}."""
+    rng = random.Random(seed * 7919 + 17)
+    table = actor_table()
+    by_class = actor_models()
+    classes = sorted(shares)
+    drawn = {}
+    for e in cfg["EngineConfigs"]:
+        if e.get("EngineType") == "vehicle_agent":
+            cls = rng.choices(classes, weights=[shares[c] for c in classes])[0]
+            model = drawn[e["EngineName"]] = rng.choice(by_class[cls])
+            entry = table[model]
+            length, width, height = entry["size"]
+            e.update(Model=model, Category=entry["class"], Length=length, Width=width, Height=height,
+                     Wheelbase=round(2 * entry["length_offset"], 3))
+    return drawn
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("config")
@@ -56,6 +100,12 @@ def main():
     ap.add_argument("--camera", default="smart_camera::camera")
     ap.add_argument("--world", default="gazebo", help="the world engine's name")
     ap.add_argument("--randomize", action="store_true", help="draw weather and time of day per run")
+    ap.add_argument("--weather", metavar="KIND[,KIND...]",
+                    help="the weather kind of each run, taken in turn (%s, or all); its parameters are "
+                         "drawn from the run's seed" % ", ".join(KINDS))
+    ap.add_argument("--vary-models", metavar="CLASS=SHARE[,...]",
+                    help="give each vehicle_agent a model drawn per run: a class by these shares "
+                         "(e.g. car=0.6,bus=0.2,truck=0.2), then one of its colour variants")
     ap.add_argument("--set", action="append", default=[], metavar="ENGINE.KEY=JSON",
                     help="set an engine's config key (the value read as JSON, else as a string)")
     ap.add_argument("--env", action="append", default=[], metavar="ENGINE:VAR=VALUE",
@@ -63,6 +113,26 @@ def main():
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
     args = ap.parse_args()
 
+    kinds = None
+    if args.weather:
+        kinds = KINDS if args.weather == "all" else args.weather.split(",")
+        bad = [k for k in kinds if k not in KINDS]
+        if bad or args.randomize:
+            sys.exit("make_dataset: --weather %s: %s" % (
+                args.weather, "use either --weather or --randomize" if not bad else
+                "unknown kind '%s' (%s, or all)" % (bad[0], ", ".join(KINDS))))
+    shares = None
+    if args.vary_models:
+        try:
+            shares = {k: float(v) for k, v in (item.split("=") for item in args.vary_models.split(","))}
+        except ValueError:
+            sys.exit("make_dataset: --vary-models %s: expected CLASS=SHARE[,CLASS=SHARE...]" % args.vary_models)
+        known = actor_models()
+        bad = [c for c in shares if c not in known or shares[c] < 0]
+        if bad or sum(shares.values()) <= 0:
+            sys.exit("make_dataset: --vary-models %s: %s" % (
+                args.vary_models, "unknown class '%s' (%s)" % (bad[0], ", ".join(sorted(known))) if bad
+                else "the shares add up to 0"))
     config_path = os.path.abspath(args.config)
     with open(config_path) as f:
         base = json.load(f)
@@ -84,7 +154,12 @@ def main():
     for k in range(args.runs):
         seed = args.seed + k
         rng = random.Random(seed)
-        kind, weather = draw_weather(rng) if args.randomize else ("as configured", {})
+        if kinds:
+            kind, weather = draw_weather(rng, kinds[k % len(kinds)])
+        elif args.randomize:
+            kind, weather = draw_weather(rng)
+        else:
+            kind, weather = "as configured", {}
         part = os.path.join(out, "parts", "run%03d" % seed)
         shutil.rmtree(part, ignore_errors=True)
         tf = os.path.join(out, "tf", "dataset_tf_%d.py" % seed)
@@ -106,6 +181,7 @@ def main():
             if e["EngineName"] == "weather":
                 e["Seed"] = seed
                 e.update(weather)
+        models = vary_models(cfg, seed, shares) if shares else {}
         for item in args.set:
             key, _, value = item.partition("=")
             engine, _, field = key.partition(".")
@@ -150,7 +226,8 @@ def main():
         for a in doc["annotations"]:
             merged.annotations.append(dict(a, id=len(merged.annotations) + 1, image_id=remap[a["image_id"]]))
         shutil.rmtree(part, ignore_errors=True)
-        runs.append({"seed": seed, "weather_kind": kind, "weather": weather, "frames": len(doc["images"]),
+        runs.append({"seed": seed, "weather_kind": kind, "weather": weather, "models": models,
+                     "frames": len(doc["images"]),
                      "annotations": len(doc["annotations"])})
         print("run %d (seed %d, %s): %d frames, %d annotations" % (k, seed, kind, len(doc["images"]),
                                                                    len(doc["annotations"])), flush=True)

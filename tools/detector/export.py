@@ -28,8 +28,9 @@ def clean(model_proto):
 
 
 def export(model, path, input_size):
+    """input_size: (width, height)."""
     model = model.eval()
-    x = torch.zeros(1, 3, input_size, input_size)
+    x = torch.zeros(1, 3, input_size[1], input_size[0])
     torch.onnx.export(model, x, path, opset_version=12, input_names=["images"],
                       output_names=["output0"], do_constant_folding=True)
     m = clean(onnx.load(path))

@@ -33,10 +33,11 @@ class Residual(nn.Module):
 
 class Detector(nn.Module):
     def __init__(self, num_classes, width=(16, 32, 64, 96, 128), input_size=320):
+        """input_size: a side (square) or (width, height), multiples of 32."""
         super().__init__()
         w = width
         self.num_classes = num_classes
-        self.input_size = input_size
+        self.input_size = tuple(input_size) if isinstance(input_size, (tuple, list)) else (input_size, input_size)
         self.stem = nn.Sequential(conv(3, w[0], 3, 2), conv(w[0], w[1], 3, 2), Residual(w[1]))
         self.s3 = nn.Sequential(conv(w[1], w[2], 3, 2), Residual(w[2]), Residual(w[2]))  # /8
         self.s4 = nn.Sequential(conv(w[2], w[3], 3, 2), Residual(w[3]), Residual(w[3]))  # /16
@@ -63,11 +64,11 @@ class Detector(nn.Module):
         p3 = self.s3(x)
         p4 = self.s4(p3)
         p5 = self.s5(p4)
-        n = self.input_size
+        nw, nh = self.input_size
         t5 = self.lat5(p5)  # (fixed sizes: the exported Resize gets constant sizes)
-        f4 = self.fuse4(torch.cat([F.interpolate(t5, size=(n // 16, n // 16), mode="nearest"), p4], 1))
+        f4 = self.fuse4(torch.cat([F.interpolate(t5, size=(nh // 16, nw // 16), mode="nearest"), p4], 1))
         t4 = self.lat4(f4)
-        f3 = self.fuse3(torch.cat([F.interpolate(t4, size=(n // 8, n // 8), mode="nearest"), p3], 1))
+        f3 = self.fuse3(torch.cat([F.interpolate(t4, size=(nh // 8, nw // 8), mode="nearest"), p3], 1))
         g4 = self.fuse4b(torch.cat([self.down3(f3), f4], 1))
         g5 = self.fuse5b(torch.cat([self.down4(g4), p5], 1))
         return [f3, g4, g5]
@@ -77,17 +78,17 @@ class Detector(nn.Module):
         return [h(f) for h, f in zip(self.heads, self.features(x))]
 
     def grids(self, size, device):
-        """Constant tensors for decoding at input side `size`: centres (1 x 2 x N) and scales
-        (1 x 4 x N), each cell's stride x RANGE."""
+        """Constant tensors for decoding at input `size` (width, height): centres (1 x 2 x N)
+        and scales (1 x 4 x N), each cell's stride x RANGE."""
         key = (size, str(device))
         if key not in self._grids:
             centres, scales = [], []
             for s in STRIDES:
-                n = size // s
-                ys, xs = torch.meshgrid(torch.arange(n), torch.arange(n), indexing="ij")
+                nx, ny = size[0] // s, size[1] // s
+                ys, xs = torch.meshgrid(torch.arange(ny), torch.arange(nx), indexing="ij")
                 c = torch.stack([xs.flatten(), ys.flatten()]).float().add(0.5).mul(s)
                 centres.append(c)
-                scales.append(torch.full((4, n * n), s * RANGE))
+                scales.append(torch.full((4, nx * ny), s * RANGE))
             self._grids[key] = (torch.cat(centres, 1)[None].to(device), torch.cat(scales, 1)[None].to(device))
         return self._grids[key]
 

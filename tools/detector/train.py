@@ -3,7 +3,7 @@
 on the CPU with Debian's python3-torch, and exports it for OpenCV 4.6 DNN.
 
   /usr/bin/python3 tools/detector/train.py --data DIR [--data DIR2 ...] --out models/detector
-      [--epochs 12] [--batch 16] [--input 320] [--seed 0] [--val DIR] [--iterations N]
+      [--epochs 12] [--batch 16] [--input 320 | WxH] [--seed 0] [--val DIR] [--iterations N]
 
 Writes into --out: convoy_detector.onnx (YOLOv8 layout, 1 x (4 + C) x N, cx cy w h in input
 pixels), classes.txt, model.json ({input_width, input_height, classes, ...}) and
@@ -83,21 +83,34 @@ def load_coco(folders, min_height=8):
     return items
 
 
+def parse_size(text):
+    """'320' (square) or '448x288' (width x height), multiples of 32."""
+    w, _, h = text.partition("x")
+    try:
+        size = (int(w), int(h or w))
+    except ValueError:
+        raise argparse.ArgumentTypeError("'%s': expected SIDE or WIDTHxHEIGHT" % text)
+    if min(size) <= 0 or size[0] % 32 or size[1] % 32:
+        raise argparse.ArgumentTypeError("'%s': sides must be positive multiples of 32" % text)
+    return size
+
+
 def letterbox(image, size, scale_jitter=1.0, rng=None):
-    """Resizes into a size x size canvas (pad 114): returns the canvas, the scale and the
-    offsets, with a random zoom and placement when rng is given."""
+    """Resizes into a size = (width, height) canvas (pad 114): returns the canvas, the scale
+    and the offsets, with a random zoom and placement when rng is given."""
     h, w = image.shape[:2]
-    scale = min(size / w, size / h) * scale_jitter
+    sw, sh = size
+    scale = min(sw / w, sh / h) * scale_jitter
     nw, nh = max(1, int(round(w * scale))), max(1, int(round(h * scale)))
     resized = cv2.resize(image, (nw, nh), interpolation=cv2.INTER_LINEAR)
-    canvas = np.full((size, size, 3), PAD, np.uint8)
+    canvas = np.full((sh, sw, 3), PAD, np.uint8)
     if rng is None:
-        ox, oy = (size - nw) // 2, (size - nh) // 2
+        ox, oy = (sw - nw) // 2, (sh - nh) // 2
     else:
-        ox = rng.randint(min(0, size - nw), max(0, size - nw))
-        oy = rng.randint(min(0, size - nh), max(0, size - nh))
+        ox = rng.randint(min(0, sw - nw), max(0, sw - nw))
+        oy = rng.randint(min(0, sh - nh), max(0, sh - nh))
     x0, y0 = max(ox, 0), max(oy, 0)
-    x1, y1 = min(ox + nw, size), min(oy + nh, size)
+    x1, y1 = min(ox + nw, sw), min(oy + nh, sh)
     canvas[y0:y1, x0:x1] = resized[y0 - oy:y1 - oy, x0 - ox:x1 - ox]
     return canvas, scale, ox, oy
 
@@ -111,13 +124,13 @@ def sample(item, size, rng, augment):
     else:
         canvas, s, ox, oy = letterbox(image, size)
     b = boxes * s + np.array([ox, oy, ox, oy], np.float32)
-    b = np.clip(b, 0, size)
+    b = np.clip(b, 0, np.array([size[0], size[1], size[0], size[1]], np.float32))
     keep = ((b[:, 2] - b[:, 0]) >= 2) & ((b[:, 3] - b[:, 1]) >= 2)
     b, c = b[keep], classes[keep]
     if augment:
         if rng.random() < 0.5:
             canvas = canvas[:, ::-1]
-            b = np.stack([size - b[:, 2], b[:, 1], size - b[:, 0], b[:, 3]], 1)
+            b = np.stack([size[0] - b[:, 2], b[:, 1], size[0] - b[:, 0], b[:, 3]], 1)
         canvas = canvas.astype(np.float32)
         canvas = canvas * rng.uniform(0.7, 1.3) + rng.uniform(-25, 25)
         canvas = np.clip(canvas, 0, 255)
@@ -126,13 +139,14 @@ def sample(item, size, rng, augment):
 
 
 def cell_grid(size):
-    """Per cell: centre x, y, stride and level index, over the three levels in order."""
+    """Per cell: centre x, y, stride and level index, over the three levels in order, for an
+    input of size (width, height)."""
     out = []
     for level, s in enumerate(STRIDES):
-        n = size // s
-        ys, xs = torch.meshgrid(torch.arange(n), torch.arange(n), indexing="ij")
+        nx, ny = size[0] // s, size[1] // s
+        ys, xs = torch.meshgrid(torch.arange(ny), torch.arange(nx), indexing="ij")
         out.append(torch.stack([(xs.flatten() + 0.5) * s, (ys.flatten() + 0.5) * s,
-                                torch.full((n * n,), float(s)), torch.full((n * n,), float(level))], 1))
+                                torch.full((nx * ny,), float(s)), torch.full((nx * ny,), float(level))], 1))
     return torch.cat(out, 0)
 
 
@@ -248,7 +262,8 @@ def main():
     ap.add_argument("--epochs", type=int, default=12)
     ap.add_argument("--iterations", type=int, default=0, help="stop after this many (smoke tests)")
     ap.add_argument("--batch", type=int, default=16)
-    ap.add_argument("--input", type=int, default=320)
+    ap.add_argument("--input", type=parse_size, default=(320, 320),
+                    help="network input: SIDE or WIDTHxHEIGHT (multiples of 32)")
     ap.add_argument("--lr", type=float, default=2e-3)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=2)
@@ -268,7 +283,7 @@ def main():
         opt, lambda k: min(1.0, (k + 1) / 100) * 0.5 * (1 + math.cos(math.pi * min(k, total) / total)))
     os.makedirs(args.out, exist_ok=True)
     history, step, t0 = [], 0, time.time()
-    print("train: %d images, %d steps of %d, input %d" % (len(items), total, args.batch, args.input), flush=True)
+    print("train: %d images, %d steps of %d, input %dx%d" % ((len(items), total, args.batch) + args.input), flush=True)
     done = False
     for epoch in range(args.epochs if not args.iterations else 10 ** 6):
         model.train()
@@ -312,7 +327,7 @@ def main():
     with open(os.path.join(args.out, "classes.txt"), "w") as f:
         f.write("\n".join(CLASSES) + "\n")
     with open(os.path.join(args.out, "model.json"), "w") as f:
-        json.dump({"input_width": args.input, "input_height": args.input, "classes": CLASSES,
+        json.dump({"input_width": args.input[0], "input_height": args.input[1], "classes": CLASSES,
                    "layout": "yolov8: 1 x (4 + C) x N, cx cy w h in input pixels, class scores",
                    "letterbox_pad": PAD, "onnx_opset": 12, "onnx_ops": ops}, f, indent=1)
     with open(os.path.join(args.out, "training.json"), "w") as f:

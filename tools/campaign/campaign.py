@@ -1,0 +1,17 @@
+#!/usr/bin/python3
+"""Runs a suite of Convoy experiments over seeds and weathers (docs/campaigns.md):
+
+    /usr/bin/python3 tools/campaign/campaign.py SUITE_DIR [--seeds N] [--weathers clear,rain]
+        [--workers N] [--backend local|slurm] [--out DIR] [--seconds S] [--build DIR]
+
+The command line is python/convoy_campaign/cli.py's."""
+import os
+import sys
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "python"))
+
+from convoy_campaign.cli import main  # noqa: E402 (after the path)
+
+if __name__ == "__main__":
+    sys.exit(main())
