@@ -23,7 +23,7 @@ import tempfile
 import time
 import unittest
 
-from e2e_util import BIN_DIR, CONVOY, REPO
+from e2e_util import BIN_DIR, REPO, E2ETestCase
 
 CAMPAIGN = os.path.join(REPO, "tools", "campaign", "campaign.py")
 SLURM_LOCAL = os.path.join(REPO, "tools", "campaign", "slurm_local.sh")
@@ -57,17 +57,11 @@ def write_suite(folder, entries):
     return folder
 
 
-class CampaignTest(unittest.TestCase):
-    maxDiff = None
-
-    @classmethod
-    def setUpClass(cls):
-        if not os.access(CONVOY, os.X_OK):
-            raise unittest.SkipTest("no coordinator at %s (set CONVOY_BIN_DIR)" % CONVOY)
+class CampaignTest(E2ETestCase):
+    """E2ETestCase's temp folder (self.dir), its skip without a coordinator and its clean-up."""
 
     def setUp(self):
-        self.dir = tempfile.mkdtemp(prefix="convoy-e2e-campaign-")
-        self.addCleanup(shutil.rmtree, self.dir, True)
+        super().setUp()
         self.t0 = time.monotonic()
 
     def tearDown(self):
