@@ -49,8 +49,9 @@ void EngineSet::launch() {
   for (auto& e : engines_) launch(*e);
 }
 
-void EngineSet::attach(const std::function<std::unique_ptr<transport::EngineChannel>(
-                           const config::EngineConfig&)>& channel) {
+void EngineSet::attach(
+    const std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>&
+        channel) {
   for (auto& e : engines_) e->attach(channel(e->config()));
 }
 

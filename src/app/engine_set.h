@@ -24,8 +24,9 @@ class EngineSet {
   // EmptyLaunchCommand engine's ServerAddress. Throws UserError or EngineError.
   void launch();
   // A replay: attaches `channel(engine)` to each handle instead of starting anything.
-  void attach(const std::function<std::unique_ptr<transport::EngineChannel>(
-                  const config::EngineConfig&)>& channel);
+  void attach(
+      const std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>&
+          channel);
   // Sends Initialize to every engine, then collects the replies, logging the warnings they
   // carry. Throws EngineError.
   void initialize(RunLog& log);

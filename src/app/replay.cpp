@@ -41,16 +41,16 @@ class ReplayChannel final : public transport::EngineChannel {
         time_ns_ += request.step().duration_ns();
         auto* step = reply_.mutable_step();
         step->set_time_ns(time_ns_);
-        for (auto& dp : replay_.take_from_engine(engine_, time_ns_))
-          step->add_outputs()->Swap(&dp);
+        for (auto& dp : replay_.take_from_engine(engine_, time_ns_)) step->add_outputs()->Swap(&dp);
         return;
       }
       case engine::Request::kShutdown:
         reply_.mutable_done();
         return;
       default:
-        reply_.set_error("a replay cannot do this (reset, set datapacks): the recording holds "
-                         "one run from its start");
+        reply_.set_error(
+            "a replay cannot do this (reset, set datapacks): the recording holds "
+            "one run from its start");
     }
   }
   transport::CallStatus finish(engine::Reply* reply, Deadline) override {
@@ -82,8 +82,8 @@ Replay::Replay(const fs::path& recording) : path_(recording) {
     record::McapReader check(recording);
     check.read_to_end();
     if (!check.complete())
-      warnings_.push_back(recording.string() + " is incomplete: " + check.incomplete_reason() +
-                          "; replaying what it holds");
+      throw UserError(recording.string() + ": incomplete recording: " + check.incomplete_reason() +
+                      " (convoy finishes its recordings on every error; was it killed?)");
     auto meta = check.metadata().find("convoy");
     if (meta == check.metadata().end())
       throw UserError(recording.string() +
@@ -149,16 +149,16 @@ void Replay::advance_to(uint64_t time_ns) {
     if (peeked_.log_time > time_ns) return;
     has_peeked_ = false;
     const Topic& t = topics_.at(peeked_.channel);
-    RecordedDataPack r{peeked_.log_time, peeked_.sequence, t.name, t.kind, t.type,
-                       std::move(peeked_.data)};
+    RecordedDataPack r{peeked_.log_time, peeked_.sequence, t.name,
+                       t.kind,           t.type,           std::move(peeked_.data)};
     (t.to_engine ? to_ : from_)[t.engine].push_back(std::move(r));
   }
 }
 
 void Replay::check_wanted(const std::string& engine, const engine::DataPackId& id) const {
   if (from_topics_.count({engine, id.name()})) return;
-  throw UserError(path_.string() + ": the functions read datapack '" + id.name() +
-                  "' of engine '" + engine + "', which the recording does not hold (topic '" +
+  throw UserError(path_.string() + ": the functions read datapack '" + id.name() + "' of engine '" +
+                  engine + "', which the recording does not hold (topic '" +
                   topic_of(engine, id.name(), false) + "')");
 }
 
@@ -199,8 +199,9 @@ void Replay::to_engine(const std::string& engine, const engine::DataPack& dp,
     queue.pop_front();
   }
   if (queue.empty() || queue.front().cycle != cycle) {
-    mismatch(topic, cycle, fn.label() + " sent it; the recording has nothing more for '" +
-                               engine + "' in this cycle");
+    mismatch(
+        topic, cycle,
+        fn.label() + " sent it; the recording has nothing more for '" + engine + "' in this cycle");
     return;
   }
   RecordedDataPack r = std::move(queue.front());
@@ -243,9 +244,12 @@ namespace {
 
 // What the coordinator writes into summary.json; the rest is the functions' and engines'.
 bool coordinator_field(const std::string& key) {
-  static const std::set<std::string> kKeys = {
-      "simulation", "config", "exit_code", "error", "wall_s", "cycles", "sim_time_s",
-      "loop_wall_s", "real_time_factor", "status_function_done", "frame_copies", "replay"};
+  static const std::set<std::string> kKeys = {"simulation",       "config",
+                                              "exit_code",        "error",
+                                              "wall_s",           "cycles",
+                                              "sim_time_s",       "loop_wall_s",
+                                              "real_time_factor", "status_function_done",
+                                              "frame_copies",     "replay"};
   return kKeys.count(key) > 0;
 }
 
@@ -413,7 +417,9 @@ int score_run(const ReplayOptions& options) {
     if (la.size() > 28) la = la.substr(0, 25) + "...";
     if (lb.size() > 28) lb = lb.substr(0, 25) + "...";
     std::printf("%-24s %-28s %-28s %s\n", f.c_str(), la.c_str(), lb.c_str(),
-                !live.contains(f) ? "no (not in the live summary)" : same ? "yes" : "NO");
+                !live.contains(f) ? "no (not in the live summary)"
+                : same            ? "yes"
+                                  : "NO");
   }
   if (rescored.contains("driving_score")) {
     const auto& b = rescored["driving_score"];

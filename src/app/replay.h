@@ -65,8 +65,8 @@ class Replay final : public loop::DataPackTap {
   void from_engine(const std::string&, const engine::DataPack&, const datapack::BlobReader&,
                    uint64_t, int64_t) override {}
   void to_engine(const std::string& engine, const engine::DataPack& dp,
-                 const datapack::BlobReader& blobs, const loop::LoadedFunction& fn,
-                 uint64_t cycle, int64_t time_ns) override;
+                 const datapack::BlobReader& blobs, const loop::LoadedFunction& fn, uint64_t cycle,
+                 int64_t time_ns) override;
   // After the loop: recorded datapacks the functions did not send (up to `until_ns`).
   void finish(uint64_t until_ns);
 

@@ -149,10 +149,11 @@ void Session::record_to(const fs::path& file, bool blobs, const record::StringMa
 
 void Session::finish_recording(const Outcome& outcome) {
   if (!recorder_) return;
-  const std::string error = recorder_->finish({{"exit_code", std::to_string(outcome.code)},
-                                               {"error", outcome.error},
-                                               {"cycles", std::to_string(figures_.cycles)},
-                                               {"sim_time_ns", std::to_string(figures_.sim_time_ns)}});
+  const std::string error =
+      recorder_->finish({{"exit_code", std::to_string(outcome.code)},
+                         {"error", outcome.error},
+                         {"cycles", std::to_string(figures_.cycles)},
+                         {"sim_time_ns", std::to_string(figures_.sim_time_ns)}});
   if (!error.empty()) {
     log_.error("recording: " + error);
   } else {

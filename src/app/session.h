@@ -6,19 +6,19 @@
 #include <atomic>
 #include <cstdio>
 #include <exception>
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "app/engine_set.h"
-#include "record/recorder.h"
 #include "app/run_log.h"
 #include "config/simulation_config.h"
 #include "loop/fti_loop.h"
 #include "python/function_runtime.h"
+#include "record/recorder.h"
 
 namespace convoy::app {
 

@@ -39,10 +39,10 @@ int serve_simulation(const RunOptions& options);
 
 // `convoy replay RUN_DIR` and `convoy score RUN_DIR` (app/replay.h).
 struct ReplayOptions {
-  std::filesystem::path run_dir;        // the recorded run
-  std::filesystem::path out_dir;        // default: RUN_DIR/replay (score: RUN_DIR/rescore)
-  std::filesystem::path config_file;    // instead of the recorded config (other functions)
-  std::vector<std::string> overrides;   // -o Key=Value on that config
+  std::filesystem::path run_dir;       // the recorded run
+  std::filesystem::path out_dir;       // default: RUN_DIR/replay (score: RUN_DIR/rescore)
+  std::filesystem::path config_file;   // instead of the recorded config (other functions)
+  std::vector<std::string> overrides;  // -o Key=Value on that config
   bool quiet = false;
 };
 // Exit code of a replay whose functions sent other datapacks than the recorded ones, and of a

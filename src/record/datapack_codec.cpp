@@ -48,8 +48,8 @@ ojson parse_msgpack(const engine::DataPack& dp) {
     if (!ojson::sax_parse(raw.begin(), raw.end(), &sax, ojson::input_format_t::msgpack))
       throw std::runtime_error(datapack::describe(dp.id()) + ": malformed or too deep MessagePack");
   } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(datapack::describe(dp.id()) + ": malformed MessagePack (" +
-                             e.what() + ")");
+    throw std::runtime_error(datapack::describe(dp.id()) + ": malformed MessagePack (" + e.what() +
+                             ")");
   }
   return value;
 }
@@ -166,9 +166,7 @@ struct FromText {
   }
 };
 
-std::string dump(const ojson& v) {
-  return v.dump(-1, ' ', false, ojson::error_handler_t::replace);
-}
+std::string dump(const ojson& v) { return v.dump(-1, ' ', false, ojson::error_handler_t::replace); }
 
 // A protobuf datapack's message with its blobs put back (a camera's pixels inline).
 std::string full_proto(const datapack::View& view) {
@@ -331,7 +329,8 @@ std::string base64_encode(std::string_view bytes) {
   out.reserve((bytes.size() + 2) / 3 * 4);
   size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const uint32_t n = (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) | uint8_t(bytes[i + 2]);
+    const uint32_t n =
+        (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) | uint8_t(bytes[i + 2]);
     out += kB64[n >> 18];
     out += kB64[(n >> 12) & 63];
     out += kB64[(n >> 6) & 63];

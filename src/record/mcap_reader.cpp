@@ -122,8 +122,7 @@ void McapReader::parse_record(uint8_t op, std::string_view body, uint64_t offset
       message->publish_time = c.uint(8);
       if (!c.ok) fail("malformed Message record", offset);
       if (!channels_.count(message->channel))
-        fail("Message on channel " + std::to_string(message->channel) +
-                 ", not defined before it",
+        fail("Message on channel " + std::to_string(message->channel) + ", not defined before it",
              offset);
       message->data.assign(body.substr(c.p));
       *got_message = true;
@@ -238,9 +237,8 @@ void McapReader::finish_file(uint64_t data_end_offset, std::string_view data_end
     const uint64_t from = sum_start ? sum_start : summary_start + footer_at;
     if (from < summary_start || from - summary_start > footer_at)
       fail("Footer's summary_start is out of range", pos_ - 8 - 29);
-    std::string_view covered =
-        std::string_view(rest).substr(from - summary_start, footer_at + 1 + 8 + 16 -
-                                                                (from - summary_start));
+    std::string_view covered = std::string_view(rest).substr(
+        from - summary_start, footer_at + 1 + 8 + 16 - (from - summary_start));
     if (mcap_io::crc32(covered) != sum_crc) fail("summary CRC does not match", sum_start);
   }
   // Summary records: schemas and channels are duplicates; nothing else is needed here.

@@ -64,8 +64,8 @@ class McapWriter {
   // A channel (id from 0); schema_id 0: none. Throws std::length_error past 65535 channels.
   uint16_t add_channel(const std::string& topic, const std::string& message_encoding,
                        uint16_t schema_id, const StringMap& metadata);
-  void write_message(uint16_t channel, uint32_t sequence, uint64_t log_time,
-                     uint64_t publish_time, std::string_view data);
+  void write_message(uint16_t channel, uint32_t sequence, uint64_t log_time, uint64_t publish_time,
+                     std::string_view data);
   // A Metadata record (between chunks: the current chunk is written first).
   void write_metadata(const std::string& name, const StringMap& metadata);
 

@@ -33,8 +33,8 @@ class Recorder final : public loop::DataPackTap {
   void from_engine(const std::string& engine, const engine::DataPack& dp,
                    const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns) override;
   void to_engine(const std::string& engine, const engine::DataPack& dp,
-                 const datapack::BlobReader& blobs, const loop::LoadedFunction& fn,
-                 uint64_t cycle, int64_t time_ns) override;
+                 const datapack::BlobReader& blobs, const loop::LoadedFunction& fn, uint64_t cycle,
+                 int64_t time_ns) override;
 
   // Writes the `convoy_end` metadata and finishes the file. Returns a write error, or "".
   std::string finish(const StringMap& end);
