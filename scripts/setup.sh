@@ -18,6 +18,7 @@ PACKAGES=(
   sumo sumo-tools
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
+  zlib1g-dev nodejs npm
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
@@ -38,3 +39,10 @@ echo "== building (Release) into build/"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build -j"$(nproc)"
 echo "== built: build/bin/convoy, build/bin/NRPCoreSim"
+
+# A test instrument: the official MCAP library reads Convoy's recordings
+# (tests/e2e/test_recording.py; skipped when it is not installed).
+if command -v npm >/dev/null; then
+  (cd tools/mcap_check && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "warning: npm ci in tools/mcap_check failed; the @mcap/core test will be skipped"
+fi

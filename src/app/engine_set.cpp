@@ -49,6 +49,12 @@ void EngineSet::launch() {
   for (auto& e : engines_) launch(*e);
 }
 
+void EngineSet::attach(
+    const std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>&
+        channel) {
+  for (auto& e : engines_) e->attach(channel(e->config()));
+}
+
 void EngineSet::launch(loop::EngineHandle& handle) {
   const auto& ec = handle.config();
   if (ec.launch_type == "EmptyLaunchCommand") {

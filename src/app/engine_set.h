@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,6 +23,10 @@ class EngineSet {
   // Forks each BasicFork engine (socket, shared-memory arenas) or connects to an
   // EmptyLaunchCommand engine's ServerAddress. Throws UserError or EngineError.
   void launch();
+  // A replay: attaches `channel(engine)` to each handle instead of starting anything.
+  void attach(
+      const std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>&
+          channel);
   // Sends Initialize to every engine, then collects the replies, logging the warnings they
   // carry. Throws EngineError.
   void initialize(RunLog& log);

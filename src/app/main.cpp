@@ -16,7 +16,18 @@ namespace {
 void usage(const char* prog) {
   std::printf(
       "usage: %s run -c simulation_config.json [-o Key=Value]... [--run-dir DIR] [--quiet]\n"
+      "                  [--record] [--record-blobs]\n"
+      "       %s replay RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
+      "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       NRPCoreSim -c simulation_config.json [-o Key=Value]...\n"
+      "\n"
+      "  --record            record every datapack that crosses the coordinator into\n"
+      "                      RUN_DIR/recording.mcap (MCAP; docs/recording.md)\n"
+      "  --record-blobs      --record, with the blobs (camera frames) too\n"
+      "  replay RUN_DIR      re-run the functions on the recording (no engines); exit 0 when\n"
+      "                      they send what they sent live, 5 when not (RUN_DIR/replay/)\n"
+      "  score RUN_DIR       replay into RUN_DIR/rescore/ and compare the fields the functions\n"
+      "                      wrote (driving_score...) with the live ones; exit 5 if one differs\n"
       "\n"
       "  -c, --config FILE   the simulation config (NRP-Core format)\n"
       "  -o, --param K=V     override a config key; K may be a path like "
@@ -34,7 +45,45 @@ void usage(const char* prog) {
       "  --logoutput all|engines|silent   all: this program's output into --logfilename;\n"
       "                      silent: none; engines: (engines log into the run folder anyway)\n"
       "  --logfilename FILE  default .console_output.log\n",
-      prog);
+      prog, prog, prog);
+}
+
+// convoy replay|score RUN_DIR [--out DIR] [-c CONFIG] [-o K=V]... [-q]
+int replay_command(const char* prog, bool score, int argc, char** argv) {
+  convoy::app::ReplayOptions options;
+  for (int i = 2; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "error: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--out")
+      options.out_dir = value();
+    else if (a == "-c" || a == "--config")
+      options.config_file = value();
+    else if (a == "-o" || a == "--param")
+      options.overrides.push_back(value());
+    else if (a == "-q" || a == "--quiet")
+      options.quiet = true;
+    else if (a == "-h" || a == "--help") {
+      usage(prog);
+      return 0;
+    } else if (!a.empty() && a[0] != '-' && options.run_dir.empty())
+      options.run_dir = a;
+    else {
+      std::fprintf(stderr, "error: unknown option '%s'\n", a.c_str());
+      usage(prog);
+      return 2;
+    }
+  }
+  if (options.run_dir.empty()) {
+    std::fprintf(stderr, "error: %s needs a run folder (RUN_DIR)\n", argv[1]);
+    return 2;
+  }
+  return score ? convoy::app::score_run(options) : convoy::app::replay_run(options);
 }
 
 // NRP-Core's --logoutput: `all` sends this program's stdout and stderr to `file`, `silent` to
@@ -71,6 +120,8 @@ int main(int argc, char** argv) {
       usage(prog.c_str());
       return argc < 2 ? 2 : 0;
     }
+    if (!std::strcmp(argv[1], "replay") || !std::strcmp(argv[1], "score"))
+      return replay_command(prog.c_str(), !std::strcmp(argv[1], "score"), argc, argv);
     if (std::strcmp(argv[1], "run") != 0) {
       std::fprintf(stderr, "error: unknown command '%s'\n", argv[1]);
       usage(prog.c_str());
@@ -107,6 +158,10 @@ int main(int argc, char** argv) {
       options.run_dir = value();
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
+    else if (a == "--record")
+      options.overrides.push_back("Record=true");
+    else if (a == "--record-blobs")
+      options.overrides.push_back("RecordBlobs=true");
     else if (a == "-d" || a == "--dir")
       dir = value();
     else if (a == "-m" || a == "--mode")

@@ -106,15 +106,22 @@ void Session::initialize(bool keep_observations) {
   if (status_) all.push_back(&*status_);
   check_functions(all, cfg_);
 
-  engines_.launch();
-  log_.info("started " + std::to_string(engines_.size()) + " engines");
-  engines_.initialize(log_);
-  log_.info("engines initialized in " +
-            std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) + " s");
+  if (replay_channel_) {
+    engines_.attach(replay_channel_);
+  } else {
+    engines_.launch();
+    log_.info("started " + std::to_string(engines_.size()) + " engines");
+    engines_.initialize(log_);
+    log_.info("engines initialized in " +
+              std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) +
+              " s");
+  }
 
   loop_ = std::make_unique<loop::FtiLoop>(engines_.handles(), runtime_, functions_,
                                           status_ ? &*status_ : nullptr);
   loop_->keep_observations(keep_observations);
+  if (recorder_) loop_->set_tap(recorder_.get());
+  if (replay_tap_) loop_->set_tap(replay_tap_);
   csv_.reset(std::fopen((run_dir_ / "steps.csv").c_str(), "w"));
   if (csv_) std::setvbuf(csv_.get(), nullptr, _IOFBF, 1 << 20);
   loop_->set_step_log(csv_.get());
@@ -132,6 +139,35 @@ void Session::initialize(bool keep_observations) {
   }
   figures_.ran = true;
   timed([&] { loop_->prime(); });
+}
+
+void Session::record_to(const fs::path& file, bool blobs, const record::StringMap& metadata) {
+  recorder_ = std::make_unique<record::Recorder>(file, blobs, metadata);
+  log_.info("recording the datapacks into " + file.string() +
+            (blobs ? " (with blobs)" : " (blobs as stubs; --record-blobs records them)"));
+}
+
+void Session::finish_recording(const Outcome& outcome) {
+  if (!recorder_) return;
+  const std::string error =
+      recorder_->finish({{"exit_code", std::to_string(outcome.code)},
+                         {"error", outcome.error},
+                         {"cycles", std::to_string(figures_.cycles)},
+                         {"sim_time_ns", std::to_string(figures_.sim_time_ns)}});
+  if (!error.empty()) {
+    log_.error("recording: " + error);
+  } else {
+    log_.info("recording: " + std::to_string(recorder_->messages()) + " messages, " +
+              std::to_string(recorder_->bytes()) + " bytes in " + recorder_->path().string());
+  }
+  if (recorder_->skipped() > 0)
+    log_.info("warning: recording: " + std::to_string(recorder_->skipped()) +
+              " datapacks could not be recorded; the first: " + recorder_->first_skip());
+}
+
+void Session::replay_with(ChannelFactory channel, loop::DataPackTap* tap) {
+  replay_channel_ = std::move(channel);
+  replay_tap_ = tap;
 }
 
 template <typename F>
@@ -191,6 +227,7 @@ void Session::reset(std::vector<engine::DataPack> inputs) {
 std::string Session::shut_down(bool clean) {
   shut_down_ = true;
   loop_.reset();
+  recorder_.reset();  // finished already, unless the run ended by an exception of its own
   std::string error = engines_.shut_down(clean, log_);
   if (csv_) std::fflush(csv_.get());
   return error;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,6 +18,7 @@
 #include "config/simulation_config.h"
 #include "loop/fti_loop.h"
 #include "python/function_runtime.h"
+#include "record/recorder.h"
 
 namespace convoy::app {
 
@@ -46,6 +48,19 @@ class Session {
   Session(const config::SimulationConfig& cfg, std::filesystem::path run_dir, RunLog& log,
           bool quiet);
   ~Session();
+
+  // Record the datapacks into `file` (record/recorder.h); `metadata` is the recording's
+  // `convoy` metadata. Before initialize(). Throws std::runtime_error when the file cannot be
+  // created.
+  void record_to(const std::filesystem::path& file, bool blobs, const record::StringMap& metadata);
+  // Finishes the recording with how the run ended (its `convoy_end` metadata). Logs a write
+  // error. Without a recording, does nothing.
+  void finish_recording(const Outcome& outcome);
+  // A replay: each engine is `channel(engine)` (no process, no Initialize), and `tap` sees the
+  // datapacks. Before initialize().
+  using ChannelFactory =
+      std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>;
+  void replay_with(ChannelFactory channel, loop::DataPackTap* tap);
 
   // Loads the functions (a broken file costs no start-up), launches and initializes the
   // engines, and fetches the functions' first inputs. `keep_observations`: collect what the
@@ -86,6 +101,9 @@ class Session {
   int64_t step_ns_ = 0;  // the smallest EngineTimestep: NRP-Core's simulation timestep
   LoopFigures figures_;
   bool shut_down_ = false;
+  std::unique_ptr<record::Recorder> recorder_;
+  ChannelFactory replay_channel_;
+  loop::DataPackTap* replay_tap_ = nullptr;
 };
 
 }  // namespace convoy::app

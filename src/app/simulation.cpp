@@ -25,6 +25,7 @@
 #include "loop/fti_loop.h"
 #include "python/function_runtime.h"
 #include "python/interpreter.h"
+#include "record/recorder.h"
 
 namespace convoy::app {
 
@@ -60,7 +61,9 @@ void raise_file_limit() {
   setrlimit(RLIMIT_NOFILE, &limit);
 }
 
-void install_signal_handlers(bool ignore_sigint = false) {
+}  // namespace
+
+void install_signal_handlers(bool ignore_sigint) {
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
@@ -72,6 +75,8 @@ void install_signal_handlers(bool ignore_sigint = false) {
     sigaction(SIGINT, &sa, nullptr);
   signal(SIGPIPE, SIG_IGN);
 }
+
+namespace {
 
 fs::path make_run_dir(const RunOptions& options, const std::string& sim_name) {
   fs::path dir = options.run_dir;
@@ -102,6 +107,8 @@ nlohmann::json frame_copies(const config::SimulationConfig& cfg, const fs::path&
   return out;
 }
 
+}  // namespace
+
 // summary.json: what an engine or function of the run wrote there (a JSON object, e.g. an
 // experiment's own figures), with the coordinator's fields on top.
 void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
@@ -127,6 +134,8 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   std::ofstream(file) << j.dump(2) << "\n";
 }
 
+namespace {
+
 // The effective config as the run folder keeps it: tokens are written as "***".
 nlohmann::json redacted(nlohmann::json config) {
   if (config.contains("EngineConfigs") && config["EngineConfigs"].is_array()) {
@@ -135,6 +144,19 @@ nlohmann::json redacted(nlohmann::json config) {
   }
   return config;
 }
+
+}  // namespace
+
+record::StringMap recording_metadata(const config::SimulationConfig& cfg) {
+  return {{"format", record::kRecordingFormat},
+          {"convoy_version", CONVOY_VERSION},
+          {"simulation", cfg.name},
+          {"config_file", cfg.file.string()},
+          {"config", redacted(cfg.json).dump(2)},
+          {"record_blobs", cfg.record_blobs ? "true" : "false"}};
+}
+
+namespace {
 
 // The config and the run folder. Returns kExitOk, or the exit code once it has
 // logged why the run cannot start.
@@ -178,12 +200,14 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   return kExitOk;
 }
 
-// The functions see what the engines see (engine_set.cpp): the run folder and the share
-// folder. Before the interpreter starts, which copies the environment into os.environ.
+}  // namespace
+
 void export_run_environment(const fs::path& run_dir) {
   setenv("CONVOY_RUN_DIR", run_dir.c_str(), 1);
   setenv("CONVOY_SHARE_DIR", share_dir().c_str(), 0);
 }
+
+namespace {
 
 // The run proper, with the interpreter up: load the functions, launch and initialize the
 // engines, run the loop; then shut the engines down, whatever happened before.
@@ -194,6 +218,14 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
   Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
   try {
+    if (cfg.record) {
+      try {
+        session.record_to(run_dir / record::kRecordingFile, cfg.record_blobs,
+                          recording_metadata(cfg));
+      } catch (const std::runtime_error& e) {
+        throw UserError(std::string("Record: ") + e.what());
+      }
+    }
     session.initialize(/*keep_observations=*/false);
     session.run_to_end();
     if (interrupted()) outcome = {kExitInterrupted, interrupted_text()};
@@ -201,6 +233,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
     outcome = outcome_of(std::current_exception());
   }
   *figures = session.figures();
+  session.finish_recording(outcome);
   if (outcome.code == kExitInterrupted) {
     log.info(outcome.error + ": shutting the engines down (Ctrl-C again to kill them)");
     interrupt_signal().store(0);
@@ -261,6 +294,7 @@ int serve_simulation(const RunOptions& options) {
   config::SimulationConfig cfg;
   fs::path run_dir;
   if (int code = load(options, log, &cfg, &run_dir); code != kExitOk) return code;
+  if (cfg.record) log.info("warning: Record is not available in server mode; nothing is recorded");
 
   const auto t0 = SteadyClock::now();
   Outcome outcome;

@@ -5,6 +5,10 @@
 #include <string>
 #include <vector>
 
+#include "app/session.h"
+#include "config/simulation_config.h"
+#include "record/mcap_writer.h"
+
 namespace convoy::app {
 
 struct RunOptions {
@@ -32,6 +36,31 @@ enum ExitCode {
 int run_simulation(const RunOptions& options);
 // The server mode: serves until a client's shutdown, an interrupt or (slave) the client's exit.
 int serve_simulation(const RunOptions& options);
+
+// `convoy replay RUN_DIR` and `convoy score RUN_DIR` (app/replay.h).
+struct ReplayOptions {
+  std::filesystem::path run_dir;       // the recorded run
+  std::filesystem::path out_dir;       // default: RUN_DIR/replay (score: RUN_DIR/rescore)
+  std::filesystem::path config_file;   // instead of the recorded config (other functions)
+  std::vector<std::string> overrides;  // -o Key=Value on that config
+  bool quiet = false;
+};
+// Exit code of a replay whose functions sent other datapacks than the recorded ones, and of a
+// score whose fields differ from the live ones.
+constexpr int kExitReplayDiffers = 5;
+int replay_run(const ReplayOptions& options);
+int score_run(const ReplayOptions& options);
+
+// Shared by the commands (simulation.cpp).
+void install_signal_handlers(bool ignore_sigint = false);
+// $CONVOY_RUN_DIR and $CONVOY_SHARE_DIR for the functions, before the interpreter starts.
+void export_run_environment(const std::filesystem::path& run_dir);
+// summary.json: what the run's engines and functions wrote there, with the coordinator's
+// fields on top.
+void write_summary(const std::filesystem::path& file, const config::SimulationConfig& cfg,
+                   const LoopFigures& loop, double wall_s, const Outcome& outcome);
+// The `convoy` metadata of a recording: the effective config (tokens redacted), version.
+record::StringMap recording_metadata(const config::SimulationConfig& cfg);
 
 // Directory of the running executable, and the share directory next to it.
 std::filesystem::path bin_dir();

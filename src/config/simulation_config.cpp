@@ -483,6 +483,8 @@ SimulationConfig load_simulation_config(const fs::path& file,
   config.process_launcher_type = doc["ProcessLauncherType"].get<std::string>();
   config.datapack_processor = doc["DataPackProcessor"].get<std::string>();
   config.argument_passing = doc["FunctionArgumentsPassingMethod"].get<std::string>();
+  config.record_blobs = doc["RecordBlobs"].get<bool>();
+  config.record = doc["Record"].get<bool>() || config.record_blobs;
   config.json = std::move(doc);
   config.warnings = std::move(report.warnings);
   return config;

@@ -58,6 +58,8 @@ struct SimulationConfig {
   std::string datapack_processor;     // "tf" or "cg"
   std::string argument_passing;       // "value" or "reference"
   int64_t timeout_ns = 0;             // 0 = run until interrupted
+  bool record = false;                // Record: write recording.mcap (docs/recording.md)
+  bool record_blobs = false;          // RecordBlobs: with the blobs (implies record)
   int64_t timestep_ns = 10'000'000;
   std::vector<EngineConfig> engines;
   std::vector<FunctionConfig> functions;  // DataPackProcessingFunctions, in config order

@@ -34,6 +34,8 @@ class EngineHandle {
   // Reads blobs of this engine's replies; writes blobs of datapacks sent to it.
   const datapack::BlobReader* blob_reader() const { return &reader_; }
   datapack::BlobWriter* blob_writer();
+  // Reads the blobs blob_writer() wrote (the datapacks sent to it, until they are sent).
+  const datapack::BlobReader* sent_blob_reader() const { return &sent_reader_; }
   bool connected() const { return channel_ != nullptr; }
   bool busy() const { return busy_; }
 
@@ -66,6 +68,7 @@ class EngineHandle {
   launch::ChildProcess process_;
   transport::ShmArena out_arena_, in_arena_;
   transport::ShmBlobReader reader_{&out_arena_};
+  transport::ShmBlobReader sent_reader_{&in_arena_};
   std::unique_ptr<transport::ShmBlobWriter> shm_writer_;
   datapack::InlineBlobWriter inline_writer_;
   bool busy_ = false;

@@ -128,6 +128,7 @@ void FtiLoop::prime() {
     e->finish(&reply);
     for (auto& dp : *reply.mutable_get_datapacks()->mutable_datapacks()) {
       if (keep_observations_) keep_observation(dp, e->name());
+      if (tap_) tap_->from_engine(e->name(), dp, *e->blob_reader(), cycles_, sim_time_ns_);
       auto& slot = pool_[key(e->name(), dp.id().name())];
       slot.datapack.Swap(&dp);
       slot.cycle = 0;
@@ -136,10 +137,11 @@ void FtiLoop::prime() {
   for (size_t i = 0; i < engines_.size(); ++i) queue_.emplace(engines_[i]->time_ns, i);
 }
 
-void FtiLoop::take_outputs(EngineHandle& e, engine::StepReply* reply) {
+void FtiLoop::take_outputs(EngineHandle& e, engine::StepReply* reply, int64_t time_ns) {
   e.time_ns = reply->time_ns();
   e.last_compute_ns = reply->compute_ns();
   for (auto& dp : *reply->mutable_outputs()) {
+    if (tap_) tap_->from_engine(e.name(), dp, *e.blob_reader(), cycles_, time_ns);
     auto& slot = pool_[key(e.name(), dp.id().name())];
     slot.datapack.Swap(&dp);
     slot.cycle = cycles_;
@@ -153,6 +155,8 @@ void FtiLoop::route(std::vector<engine::DataPack>& outputs, const LoadedFunction
       throw FunctionError(fn.label() + " returned datapack '" + dp.id().name() +
                           "' for unknown engine '" + dp.id().engine_name() + "'");
     }
+    if (tap_)
+      tap_->to_engine(it->first, dp, *it->second->sent_blob_reader(), fn, cycles_, sim_time_ns_);
     it->second->pending_inputs.push_back(std::move(dp));
   }
   outputs.clear();
@@ -235,7 +239,7 @@ bool FtiLoop::cycle(int64_t next, int64_t bound_ns, bool stop_on_done) {
     if (!e->busy()) continue;
     reply_.Clear();
     e->finish(&reply_);
-    take_outputs(*e, reply_.mutable_step());
+    take_outputs(*e, reply_.mutable_step(), next);
     e->time_ns = next;  // the schedule, not the engine's clock, drives the loop
   }
   sim_time_ns_ = next;

@@ -20,6 +20,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "loop/datapack_tap.h"
 #include "loop/engine_handle.h"
 #include "loop/function_runner.h"
 
@@ -34,6 +35,9 @@ class FtiLoop {
 
   // Writes one CSV row per cycle (wall times per engine) to `csv` (may be null).
   void set_step_log(std::FILE* csv);
+  // Shows every datapack taken from an engine and every one the functions send to `tap`
+  // (null: none). The tap must outlive the loop.
+  void set_tap(DataPackTap* tap) { tap_ = tap; }
   // Calls `report(sim_time_ns)` about every `period_s` of wall time while running.
   void set_progress(double period_s, std::function<void(int64_t)> report) {
     progress_period_ns_ = static_cast<int64_t>(period_s * 1e9);
@@ -77,7 +81,7 @@ class FtiLoop {
   // (none past `bound_ns` when > 0, none when `stop_on_done` and the status function says
   // done). Returns false when the loop must stop (interrupt, done).
   bool cycle(int64_t next, int64_t bound_ns, bool stop_on_done);
-  void take_outputs(EngineHandle& e, engine::StepReply* reply);
+  void take_outputs(EngineHandle& e, engine::StepReply* reply, int64_t time_ns);
   void run_functions();
   void keep_observation(const engine::DataPack& dp, const std::string& engine);
   void route(std::vector<engine::DataPack>& outputs, const LoadedFunction& fn);
@@ -108,6 +112,7 @@ class FtiLoop {
   int64_t last_cycle_ns_ = 0;
   int64_t last_progress_ns_ = 0;
   std::FILE* csv_ = nullptr;
+  DataPackTap* tap_ = nullptr;
   int64_t sim_time_ns_ = 0;
   uint64_t cycles_ = 0;
   int64_t progress_period_ns_ = 0;

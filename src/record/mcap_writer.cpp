@@ -1,0 +1,284 @@
+#include "record/mcap_writer.h"
+
+#include <zlib.h>
+
+#include <cerrno>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+namespace convoy::record {
+
+namespace mcap_io {
+
+void put_u8(std::string* out, uint8_t v) { out->push_back(static_cast<char>(v)); }
+void put_u16(std::string* out, uint16_t v) {
+  for (int i = 0; i < 2; ++i) out->push_back(static_cast<char>(v >> (8 * i)));
+}
+void put_u32(std::string* out, uint32_t v) {
+  for (int i = 0; i < 4; ++i) out->push_back(static_cast<char>(v >> (8 * i)));
+}
+void put_u64(std::string* out, uint64_t v) {
+  for (int i = 0; i < 8; ++i) out->push_back(static_cast<char>(v >> (8 * i)));
+}
+void put_string(std::string* out, std::string_view s) {
+  put_u32(out, static_cast<uint32_t>(s.size()));
+  out->append(s);
+}
+void put_map(std::string* out, const StringMap& map) {
+  std::string body;
+  for (const auto& [k, v] : map) {
+    put_string(&body, k);
+    put_string(&body, v);
+  }
+  put_string(out, body);
+}
+std::string record(uint8_t op, std::string_view content) {
+  std::string out;
+  out.reserve(9 + content.size());
+  put_u8(&out, op);
+  put_u64(&out, content.size());
+  out.append(content);
+  return out;
+}
+uint32_t crc32(std::string_view bytes, uint32_t crc) {
+  // zlib takes a uInt length: feed large buffers in pieces.
+  uLong c = crc;
+  const auto* p = reinterpret_cast<const Bytef*>(bytes.data());
+  size_t left = bytes.size();
+  while (left > 0) {
+    const uInt n = static_cast<uInt>(std::min<size_t>(left, 1u << 30));
+    c = ::crc32(c, p, n);
+    p += n;
+    left -= n;
+  }
+  return static_cast<uint32_t>(c);
+}
+
+}  // namespace mcap_io
+
+using namespace mcap_io;
+
+McapWriter::~McapWriter() { close(); }
+
+void McapWriter::open(const std::filesystem::path& path, const std::string& library,
+                      size_t chunk_bytes) {
+  if (file_) throw std::logic_error("McapWriter: already open");
+  path_ = path;
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) {
+    throw std::runtime_error("cannot create " + path.string() + ": " + std::strerror(errno));
+  }
+  chunk_bytes_ = chunk_bytes;
+  std::string header;
+  put_string(&header, "");  // profile
+  put_string(&header, library);
+  write_raw(kMcapMagic);
+  write_raw(record(kOpHeader, header));
+  check_io();
+}
+
+void McapWriter::write_raw(std::string_view bytes) {
+  if (!file_) return;
+  if (!io_error_ && std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size())
+    io_error_ = true;
+  data_crc_ = crc32(bytes, data_crc_);
+  pos_ += bytes.size();
+}
+
+void McapWriter::check_io() {
+  if (io_error_) throw std::runtime_error("cannot write " + path_.string() + ": disk full?");
+}
+
+uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding,
+                                std::string_view data) {
+  if (next_schema_ == 0) throw std::length_error(path_.string() + ": too many schemas");
+  const uint16_t id = next_schema_++;
+  std::string body;
+  put_u16(&body, id);
+  put_string(&body, name);
+  put_string(&body, encoding);
+  put_string(&body, data);  // uint32 length-prefixed bytes
+  std::string rec = record(kOpSchema, body);
+  chunk_ += rec;
+  schema_records_.push_back(std::move(rec));
+  return id;
+}
+
+uint16_t McapWriter::add_channel(const std::string& topic, const std::string& message_encoding,
+                                 uint16_t schema_id, const StringMap& metadata) {
+  if (next_channel_ > std::numeric_limits<uint16_t>::max())
+    throw std::length_error(path_.string() + ": more than 65536 channels");
+  const auto id = static_cast<uint16_t>(next_channel_++);
+  std::string body;
+  put_u16(&body, id);
+  put_u16(&body, schema_id);
+  put_string(&body, topic);
+  put_string(&body, message_encoding);
+  put_map(&body, metadata);
+  std::string rec = record(kOpChannel, body);
+  chunk_ += rec;
+  channel_records_.push_back(std::move(rec));
+  channel_counts_[id];
+  return id;
+}
+
+void McapWriter::write_message(uint16_t channel, uint32_t sequence, uint64_t log_time,
+                               uint64_t publish_time, std::string_view data) {
+  if (!file_) return;
+  chunk_index_[channel].emplace_back(log_time, chunk_.size());
+  put_u8(&chunk_, kOpMessage);
+  put_u64(&chunk_, 2 + 4 + 8 + 8 + data.size());
+  put_u16(&chunk_, channel);
+  put_u32(&chunk_, sequence);
+  put_u64(&chunk_, log_time);
+  put_u64(&chunk_, publish_time);
+  chunk_.append(data);
+  if (!chunk_has_messages_ || log_time < chunk_start_) chunk_start_ = log_time;
+  if (!chunk_has_messages_ || log_time > chunk_end_) chunk_end_ = log_time;
+  if (message_count_ == 0 || log_time < start_time_) start_time_ = log_time;
+  if (message_count_ == 0 || log_time > end_time_) end_time_ = log_time;
+  chunk_has_messages_ = true;
+  ++message_count_;
+  ++channel_counts_[channel];
+  if (chunk_.size() >= chunk_bytes_) flush_chunk();
+}
+
+void McapWriter::flush_chunk() {
+  if (!file_ || chunk_.empty()) return;
+  const uint64_t chunk_offset = pos_;
+  std::string head;
+  put_u64(&head, chunk_has_messages_ ? chunk_start_ : 0);
+  put_u64(&head, chunk_has_messages_ ? chunk_end_ : 0);
+  put_u64(&head, chunk_.size());  // uncompressed_size
+  put_u32(&head, crc32(chunk_));  // uncompressed_crc
+  put_string(&head, "");          // compression
+  put_u64(&head, chunk_.size());  // records length
+  std::string prefix;
+  put_u8(&prefix, kOpChunk);
+  put_u64(&prefix, head.size() + chunk_.size());
+  write_raw(prefix);
+  write_raw(head);
+  write_raw(chunk_);
+  const uint64_t chunk_length = pos_ - chunk_offset;
+
+  // Message indexes, one per channel with messages in the chunk.
+  const uint64_t index_start = pos_;
+  std::map<uint16_t, uint64_t> index_offsets;
+  for (const auto& [channel, entries] : chunk_index_) {
+    std::string body;
+    put_u16(&body, channel);
+    put_u32(&body, static_cast<uint32_t>(entries.size() * 16));
+    for (const auto& [time, offset] : entries) {
+      put_u64(&body, time);
+      put_u64(&body, offset);
+    }
+    index_offsets[channel] = pos_;
+    write_raw(record(kOpMessageIndex, body));
+  }
+
+  std::string ci;
+  put_u64(&ci, chunk_has_messages_ ? chunk_start_ : 0);
+  put_u64(&ci, chunk_has_messages_ ? chunk_end_ : 0);
+  put_u64(&ci, chunk_offset);
+  put_u64(&ci, chunk_length);
+  std::string offsets;
+  for (const auto& [channel, offset] : index_offsets) {
+    put_u16(&offsets, channel);
+    put_u64(&offsets, offset);
+  }
+  put_string(&ci, offsets);
+  put_u64(&ci, pos_ - index_start);
+  put_string(&ci, "");
+  put_u64(&ci, chunk_.size());  // compressed_size
+  put_u64(&ci, chunk_.size());  // uncompressed_size
+  chunk_index_records_.push_back(record(kOpChunkIndex, ci));
+
+  ++chunk_count_;
+  chunk_.clear();
+  chunk_index_.clear();
+  chunk_has_messages_ = false;
+  std::fflush(file_);
+}
+
+void McapWriter::write_metadata(const std::string& name, const StringMap& metadata) {
+  if (!file_) return;
+  flush_chunk();
+  std::string body;
+  put_string(&body, name);
+  put_map(&body, metadata);
+  const uint64_t offset = pos_;
+  std::string rec = record(kOpMetadata, body);
+  write_raw(rec);
+  std::string index;
+  put_u64(&index, offset);
+  put_u64(&index, rec.size());
+  put_string(&index, name);
+  metadata_index_records_.push_back(record(kOpMetadataIndex, index));
+  ++metadata_count_;
+  std::fflush(file_);
+}
+
+std::string McapWriter::close() {
+  if (!file_) return "";
+  flush_chunk();
+  std::string data_end;
+  put_u32(&data_end, data_crc_);
+  write_raw(record(kOpDataEnd, data_end));
+
+  // Summary, grouped by opcode; everything after Data End goes into the summary CRC.
+  const uint64_t summary_start = pos_;
+  std::string summary;
+  std::vector<std::tuple<uint8_t, uint64_t, uint64_t>> groups;
+  auto group = [&](uint8_t op, const std::vector<std::string>& records) {
+    if (records.empty()) return;
+    const uint64_t start = summary_start + summary.size();
+    for (const auto& r : records) summary += r;
+    groups.emplace_back(op, start, summary_start + summary.size() - start);
+  };
+  group(kOpSchema, schema_records_);
+  group(kOpChannel, channel_records_);
+  std::string stats;
+  put_u64(&stats, message_count_);
+  put_u16(&stats, static_cast<uint16_t>(schema_records_.size()));
+  put_u32(&stats, static_cast<uint32_t>(channel_records_.size()));
+  put_u32(&stats, 0);  // attachments
+  put_u32(&stats, metadata_count_);
+  put_u32(&stats, chunk_count_);
+  put_u64(&stats, message_count_ ? start_time_ : 0);
+  put_u64(&stats, message_count_ ? end_time_ : 0);
+  std::string counts;
+  for (const auto& [channel, n] : channel_counts_) {
+    put_u16(&counts, channel);
+    put_u64(&counts, n);
+  }
+  put_string(&stats, counts);
+  group(kOpStatistics, {record(kOpStatistics, stats)});
+  group(kOpChunkIndex, chunk_index_records_);
+  group(kOpMetadataIndex, metadata_index_records_);
+  const uint64_t offsets_start = summary_start + summary.size();
+  for (const auto& [op, start, length] : groups) {
+    std::string so;
+    put_u8(&so, op);
+    put_u64(&so, start);
+    put_u64(&so, length);
+    summary += record(kOpSummaryOffset, so);
+  }
+  std::string footer_head;
+  put_u8(&footer_head, kOpFooter);
+  put_u64(&footer_head, 8 + 8 + 4);
+  put_u64(&footer_head, summary_start);
+  put_u64(&footer_head, offsets_start);
+  summary += footer_head;
+  const uint32_t summary_crc = crc32(summary);
+  put_u32(&summary, summary_crc);
+  summary.append(kMcapMagic);
+  if (!io_error_ && std::fwrite(summary.data(), 1, summary.size(), file_) != summary.size())
+    io_error_ = true;
+  pos_ += summary.size();
+  if (std::fclose(file_) != 0) io_error_ = true;
+  file_ = nullptr;
+  return io_error_ ? "cannot write " + path_.string() + " (disk full?)" : "";
+}
+
+}  // namespace convoy::record

@@ -1,0 +1,120 @@
+// An MCAP file writer (https://mcap.dev/spec), written from the specification: the log
+// format of ROS 2 and Foxglove, which Foxglove and Lichtblick open.
+//
+// Layout: magic, Header, then the data section: uncompressed Chunks (Schema, Channel and
+// Message records) each followed by its Message Index records, Metadata records between
+// chunks; Data End; a Summary section (Schemas, Channels, Statistics, Chunk Indexes, Metadata
+// Indexes, grouped by opcode), Summary Offsets, Footer, magic. CRC32s (zlib) everywhere the
+// format has one.
+//
+// The file is written as it goes: a chunk goes to disk (and is flushed) once it holds about
+// `chunk_bytes`, so memory stays bounded and a killed process leaves every finished chunk
+// readable by a streaming reader. close() writes the summary and footer.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace convoy::record {
+
+inline constexpr std::string_view kMcapMagic{"\x89MCAP0\r\n", 8};
+
+enum McapOp : uint8_t {
+  kOpHeader = 0x01,
+  kOpFooter = 0x02,
+  kOpSchema = 0x03,
+  kOpChannel = 0x04,
+  kOpMessage = 0x05,
+  kOpChunk = 0x06,
+  kOpMessageIndex = 0x07,
+  kOpChunkIndex = 0x08,
+  kOpAttachment = 0x09,
+  kOpAttachmentIndex = 0x0A,
+  kOpStatistics = 0x0B,
+  kOpMetadata = 0x0C,
+  kOpMetadataIndex = 0x0D,
+  kOpSummaryOffset = 0x0E,
+  kOpDataEnd = 0x0F,
+};
+
+using StringMap = std::map<std::string, std::string>;
+
+class McapWriter {
+ public:
+  McapWriter() = default;
+  ~McapWriter();
+  McapWriter(const McapWriter&) = delete;
+  McapWriter& operator=(const McapWriter&) = delete;
+
+  // Creates (truncates) `path` and writes the magic and the Header (profile "", `library`).
+  // Throws std::runtime_error naming the file.
+  void open(const std::filesystem::path& path, const std::string& library,
+            size_t chunk_bytes = size_t{1} << 20);
+  bool is_open() const { return file_ != nullptr; }
+  const std::filesystem::path& path() const { return path_; }
+
+  // A schema (id from 1). Written into the current chunk and the summary.
+  uint16_t add_schema(const std::string& name, const std::string& encoding, std::string_view data);
+  // A channel (id from 0); schema_id 0: none. Throws std::length_error past 65535 channels.
+  uint16_t add_channel(const std::string& topic, const std::string& message_encoding,
+                       uint16_t schema_id, const StringMap& metadata);
+  void write_message(uint16_t channel, uint32_t sequence, uint64_t log_time, uint64_t publish_time,
+                     std::string_view data);
+  // A Metadata record (between chunks: the current chunk is written first).
+  void write_metadata(const std::string& name, const StringMap& metadata);
+
+  // Finishes the file: the last chunk, Data End, summary, footer, magic. Never throws (a
+  // write error is returned, "" when all went well). Idempotent.
+  std::string close();
+
+  uint64_t message_count() const { return message_count_; }
+  uint64_t bytes_written() const { return pos_; }
+
+ private:
+  void write_raw(std::string_view bytes);  // to the data section (counts its CRC)
+  void flush_chunk();
+  void check_io();
+
+  std::filesystem::path path_;
+  std::FILE* file_ = nullptr;
+  bool io_error_ = false;
+  uint64_t pos_ = 0;
+  uint32_t data_crc_ = 0;
+  size_t chunk_bytes_ = 0;
+
+  // The chunk being filled.
+  std::string chunk_;
+  uint64_t chunk_start_ = 0, chunk_end_ = 0;
+  bool chunk_has_messages_ = false;
+  std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunk_index_;
+
+  // For the summary.
+  std::vector<std::string> schema_records_, channel_records_, chunk_index_records_,
+      metadata_index_records_;
+  std::map<uint16_t, uint64_t> channel_counts_;
+  uint64_t message_count_ = 0, start_time_ = 0, end_time_ = 0;
+  uint32_t chunk_count_ = 0, metadata_count_ = 0;
+  uint16_t next_schema_ = 1;
+  uint32_t next_channel_ = 0;
+};
+
+// Serialization helpers (little-endian), shared with the tests.
+namespace mcap_io {
+void put_u8(std::string* out, uint8_t v);
+void put_u16(std::string* out, uint16_t v);
+void put_u32(std::string* out, uint32_t v);
+void put_u64(std::string* out, uint64_t v);
+void put_string(std::string* out, std::string_view s);  // u32 length + bytes
+void put_map(std::string* out, const StringMap& map);
+// <op><u64 length><content>
+std::string record(uint8_t op, std::string_view content);
+uint32_t crc32(std::string_view bytes, uint32_t crc = 0);
+}  // namespace mcap_io
+
+}  // namespace convoy::record

@@ -1,0 +1,63 @@
+// Records the datapacks that cross the coordinator into an MCAP file (the run folder's
+// recording.mcap), as `convoy run --record` asks.
+//
+// Topics: `<engine>/<datapack>` for what the loop takes from an engine for the functions,
+// `<engine>/<datapack>/in` for what the functions send to it. log_time and publish_time are
+// the simulated time of the loop cycle in ns, the message's sequence is the loop cycle. The
+// encodings are those of record/datapack_codec.h: JSON datapacks as JSON, protobuf ones as
+// protobuf with their FileDescriptorSet, blobs (camera frames) as stubs unless
+// `record_blobs`. A Metadata record `convoy` holds what a replay needs (the effective config,
+// Convoy's version); `convoy_end` how the run ended.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <tuple>
+
+#include "loop/datapack_tap.h"
+#include "record/datapack_codec.h"
+#include "record/mcap_writer.h"
+
+namespace convoy::record {
+
+inline constexpr const char* kRecordingFile = "recording.mcap";
+inline constexpr const char* kRecordingFormat = "convoy-recording-1";
+
+class Recorder final : public loop::DataPackTap {
+ public:
+  // Creates `path` and writes the header and the `convoy` metadata. Throws std::runtime_error.
+  Recorder(const std::filesystem::path& path, bool record_blobs, const StringMap& metadata);
+  ~Recorder() override;
+
+  void from_engine(const std::string& engine, const engine::DataPack& dp,
+                   const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns) override;
+  void to_engine(const std::string& engine, const engine::DataPack& dp,
+                 const datapack::BlobReader& blobs, const loop::LoadedFunction& fn, uint64_t cycle,
+                 int64_t time_ns) override;
+
+  // Writes the `convoy_end` metadata and finishes the file. Returns a write error, or "".
+  std::string finish(const StringMap& end);
+  uint64_t messages() const { return writer_.message_count(); }
+  uint64_t bytes() const { return writer_.bytes_written(); }
+  const std::filesystem::path& path() const { return writer_.path(); }
+  // Datapacks that could not be encoded (left out), and why the first one could not.
+  uint64_t skipped() const { return skipped_; }
+  const std::string& first_skip() const { return first_skip_; }
+
+ private:
+  void write(const std::string& engine, const engine::DataPack& dp,
+             const datapack::BlobReader& blobs, bool to_engine, const std::string& function,
+             uint64_t cycle, int64_t time_ns);
+  uint16_t channel(const std::string& engine, const std::string& name, bool to_engine,
+                   const Encoded& enc);
+
+  McapWriter writer_;
+  bool record_blobs_;
+  uint64_t skipped_ = 0;
+  std::string first_skip_;
+  std::map<std::string, uint16_t> schemas_;  // "kind\0type" -> schema id
+  std::map<std::tuple<std::string, std::string, bool, int, std::string>, uint16_t> channels_;
+};
+
+}  // namespace convoy::record

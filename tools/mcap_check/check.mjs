@@ -1,0 +1,77 @@
+// Reads an MCAP file with the official MCAP library (@mcap/core), both ways: the streaming
+// reader (every record, CRCs checked) and the indexed reader (summary, chunk indexes, message
+// indexes, metadata). Prints what it found as JSON; exits 1 when either reader refuses the
+// file. A test instrument for Convoy's own writer (tests/e2e/test_recording.py).
+//
+//   node tools/mcap_check/check.mjs FILE.mcap
+import { McapIndexedReader, McapStreamReader } from "@mcap/core";
+import { readFileSync } from "node:fs";
+import zlib from "node:zlib";
+
+const file = process.argv[2];
+const bytes = new Uint8Array(readFileSync(file));
+const out = { file, stream: {}, indexed: {} };
+
+// Streaming: every record, chunk and data-section CRCs validated.
+const stream = new McapStreamReader({ validateCrcs: true });
+stream.append(bytes);
+const ops = {};
+let streamMessages = 0;
+for (let rec; (rec = stream.nextRecord()); ) {
+  ops[rec.type] = (ops[rec.type] ?? 0) + 1;
+  if (rec.type === "Message") streamMessages++;
+}
+out.stream = { done: stream.done(), records: ops, messages: streamMessages };
+if (!stream.done()) {
+  console.log(JSON.stringify(out));
+  console.error(`${file}: the streaming reader did not reach the end of the file`);
+  process.exit(1);
+}
+
+// Indexed: summary, chunk and message indexes, metadata.
+const readable = {
+  size: async () => BigInt(bytes.length),
+  read: async (offset, length) => bytes.subarray(Number(offset), Number(offset + length)),
+};
+const reader = await McapIndexedReader.Initialize({ readable });
+const topics = {};
+let indexedMessages = 0;
+let lastTime = -1n;
+let ordered = true;
+let jsonOk = 0;
+for await (const m of reader.readMessages({ validateCrcs: true })) {
+  indexedMessages++;
+  const ch = reader.channelsById.get(m.channelId);
+  topics[ch.topic] = (topics[ch.topic] ?? 0) + 1;
+  if (m.logTime < lastTime) ordered = false;
+  lastTime = m.logTime;
+  if (ch.messageEncoding === "json") {
+    JSON.parse(new TextDecoder().decode(m.data));
+    jsonOk++;
+  }
+}
+const metadata = {};
+for await (const md of reader.readMetadata()) metadata[md.name] = Object.fromEntries(md.metadata);
+const schemas = {};
+for (const s of reader.schemasById.values()) schemas[s.name] = s.encoding;
+let dataCrcOk = null;
+if (reader.dataSectionCrc !== undefined && zlib.crc32) {
+  const own = zlib.crc32(bytes.subarray(0, Number(reader.dataEndOffset))) >>> 0;
+  dataCrcOk = own === reader.dataSectionCrc;
+}
+out.indexed = {
+  messages: indexedMessages,
+  statistics_messages: Number(reader.statistics?.messageCount ?? -1),
+  chunks: reader.chunkIndexes.length,
+  channels: reader.channelsById.size,
+  topics,
+  schemas,
+  metadata_names: Object.keys(metadata),
+  convoy_version: metadata.convoy?.convoy_version,
+  json_messages_parsed: jsonOk,
+  log_time_ordered: ordered,
+  data_section_crc_ok: dataCrcOk,
+  profile: reader.header.profile,
+  library: reader.header.library,
+};
+console.log(JSON.stringify(out));
