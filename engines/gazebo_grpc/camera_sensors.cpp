@@ -258,20 +258,27 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
   }
 }
 
-int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls) {
+int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls,
+                             const std::vector<ModelDesc>& poses) {
   if (cameras_.empty()) return -1;
   model_names_.push_back(model.name);
   model_classes_.push_back(cls);
   const auto label = static_cast<uint32_t>(model_names_.size());
   Actor actor;
-  for (const auto& link : model.links) {
-    Tracked tracked{-1, {}, {}};
-    add_visuals(link, link.pose, label, &tracked);
-    actor.instances.insert(actor.instances.end(), tracked.instances.begin(),
-                           tracked.instances.end());
-    actor.offsets.insert(actor.offsets.end(), tracked.offsets.begin(), tracked.offsets.end());
-    actor.link_poses.insert(actor.link_poses.end(), tracked.instances.size(), link.pose);
-  }
+  auto add = [&](const ModelDesc& m, int pose) {
+    for (const auto& link : m.links) {
+      Tracked tracked{-1, {}, {}};
+      add_visuals(link, link.pose, label, &tracked);
+      actor.instances.insert(actor.instances.end(), tracked.instances.begin(),
+                             tracked.instances.end());
+      actor.offsets.insert(actor.offsets.end(), tracked.offsets.begin(), tracked.offsets.end());
+      actor.link_poses.insert(actor.link_poses.end(), tracked.instances.size(), link.pose);
+      actor.pose_of.insert(actor.pose_of.end(), tracked.instances.size(), pose);
+    }
+  };
+  if (poses.empty()) add(model, -1);
+  for (size_t k = 0; k < poses.size(); ++k) add(poses[k], static_cast<int>(k));
+  for (int inst : actor.instances) scene_.set_visible(inst, false);
   actors_.push_back(std::move(actor));
   const int index = static_cast<int>(actors_.size() - 1);
   if (is_vehicle_class(cls)) vehicles_.push_back({label, -1, index, vehicle_extent(model)});
@@ -288,8 +295,16 @@ void CameraSensors::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
 
 void CameraSensors::set_actor_visible(int actor, bool visible) {
   if (actor < 0) return;
-  actors_[actor].visible = visible;
-  for (int inst : actors_[actor].instances) scene_.set_visible(inst, visible);
+  Actor& a = actors_[actor];
+  a.visible = visible;
+  for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
+}
+
+void CameraSensors::set_actor_shown(int actor, int pose) {
+  if (actor < 0 || actors_[actor].shown == pose) return;
+  Actor& a = actors_[actor];
+  a.shown = pose;
+  for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
 }
 
 void CameraSensors::update(double t) {
