@@ -123,6 +123,7 @@ CameraSensors::~CameraSensors() = default;
 void CameraSensors::build_scene(const WorldDesc& desc) {
   scene_.set_ambient(desc.ambient);
   scene_.set_background(desc.background);
+  scene_.set_sky(render::Sky::from_background(desc.background));
   for (const auto& l : desc.lights) {
     render::Light light;
     light.type = l.type == LightDesc::kPoint  ? render::Light::kPoint
@@ -457,7 +458,10 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
   a.seed = static_cast<uint32_t>(w.seed ^ (w.seed >> 32));
   a.time = now_;
   scene_.set_atmosphere(a);
-  scene_.set_background(foggy ? mixed(fog, sky, std::exp(-3.912 * 1000.0 / w.visibility_m)) : sky);
+  // In fog the sky is the fog's colour but for what 1 km of air lets through.
+  const double clear = foggy ? std::exp(-3.912 * 1000.0 / w.visibility_m) : 1.0;
+  scene_.set_background(foggy ? mixed(fog, sky, clear) : sky);
+  scene_.set_sky(render::Sky::from_background(scene_.background(), static_cast<float>(clear)));
 }
 
 void CameraSensors::first_render(Camera& cam) {

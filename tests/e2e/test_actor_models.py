@@ -267,6 +267,8 @@ class Golden(unittest.TestCase):
         users = []
         for key, x, y, yaw in STREET_USERS:
             users.append({"id": "a/" + key, "model": key, "x": x, "y": y, "yaw": yaw})
+            if key == "walker":  # mid-way through its cycle: the left heel striking
+                users[-1].update(speed=1.4, walk_phase=0.25)
         add_world_and_users(ex, users)
         ex.function("grab", GRAB)
         ex.run(0.1)
