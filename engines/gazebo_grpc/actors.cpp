@@ -109,6 +109,25 @@ const ActorModel& ActorLibrary::find(const std::string& model, const std::string
                              "'");
   auto descs = load_model(am.file, key, Eigen::Isometry3d::Identity());
   am.desc = std::move(descs.front());
+  try {
+    if (e.contains("walk_cycle")) {
+      for (const auto& f : e.at("walk_cycle")) {
+        const std::string file = f.get<std::string>();
+        auto pose = load_model(table_.parent_path() / file, key, Eigen::Isometry3d::Identity());
+        am.walk_cycle.push_back(std::move(pose.front()));
+      }
+    }
+    if (e.contains("stand")) {
+      const std::string stand = e.at("stand").get<std::string>();
+      if (!models.contains(stand))
+        throw std::runtime_error("\"stand\": '" + stand + "' is not in \"models\"");
+      auto pose = load_model(table_.parent_path() / models[stand].at("file").get<std::string>(),
+                             key, Eigen::Isometry3d::Identity());
+      am.stand.push_back(std::move(pose.front()));
+    }
+  } catch (const std::exception& ex) {
+    throw std::runtime_error(table_.string() + ": model '" + key + "': " + ex.what());
+  }
   return loaded_.emplace(key, std::move(am)).first->second;
 }
 

@@ -23,6 +23,11 @@ struct ActorModel {
   Eigen::Vector3d size = Eigen::Vector3d::Ones();  // length width height at scale 1
   double length_offset = 0;
   ModelDesc desc;  // the parsed SDF model, its frame the actor's (box centre on the ground)
+  // A walker's animation (the table's "walk_cycle" and "stand"): the poses of its walking
+  // cycle, pose k at walk_phase k / walk_cycle.size(), and its standing model; empty when
+  // the model is not animated. Shown in place of `desc` by the cameras (docs/road_users.md).
+  std::vector<ModelDesc> walk_cycle;
+  std::vector<ModelDesc> stand;  // none or one
 };
 
 class ActorLibrary {

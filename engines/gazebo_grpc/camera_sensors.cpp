@@ -123,6 +123,7 @@ CameraSensors::~CameraSensors() = default;
 void CameraSensors::build_scene(const WorldDesc& desc) {
   scene_.set_ambient(desc.ambient);
   scene_.set_background(desc.background);
+  scene_.set_sky(render::Sky::from_background(desc.background));
   for (const auto& l : desc.lights) {
     render::Light light;
     light.type = l.type == LightDesc::kPoint  ? render::Light::kPoint
@@ -258,20 +259,27 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
   }
 }
 
-int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls) {
+int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls,
+                             const std::vector<ModelDesc>& poses) {
   if (cameras_.empty()) return -1;
   model_names_.push_back(model.name);
   model_classes_.push_back(cls);
   const auto label = static_cast<uint32_t>(model_names_.size());
   Actor actor;
-  for (const auto& link : model.links) {
-    Tracked tracked{-1, {}, {}};
-    add_visuals(link, link.pose, label, &tracked);
-    actor.instances.insert(actor.instances.end(), tracked.instances.begin(),
-                           tracked.instances.end());
-    actor.offsets.insert(actor.offsets.end(), tracked.offsets.begin(), tracked.offsets.end());
-    actor.link_poses.insert(actor.link_poses.end(), tracked.instances.size(), link.pose);
-  }
+  auto add = [&](const ModelDesc& m, int pose) {
+    for (const auto& link : m.links) {
+      Tracked tracked{-1, {}, {}};
+      add_visuals(link, link.pose, label, &tracked);
+      actor.instances.insert(actor.instances.end(), tracked.instances.begin(),
+                             tracked.instances.end());
+      actor.offsets.insert(actor.offsets.end(), tracked.offsets.begin(), tracked.offsets.end());
+      actor.link_poses.insert(actor.link_poses.end(), tracked.instances.size(), link.pose);
+      actor.pose_of.insert(actor.pose_of.end(), tracked.instances.size(), pose);
+    }
+  };
+  if (poses.empty()) add(model, -1);
+  for (size_t k = 0; k < poses.size(); ++k) add(poses[k], static_cast<int>(k));
+  for (int inst : actor.instances) scene_.set_visible(inst, false);
   actors_.push_back(std::move(actor));
   const int index = static_cast<int>(actors_.size() - 1);
   if (is_vehicle_class(cls)) vehicles_.push_back({label, -1, index, vehicle_extent(model)});
@@ -288,8 +296,16 @@ void CameraSensors::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
 
 void CameraSensors::set_actor_visible(int actor, bool visible) {
   if (actor < 0) return;
-  actors_[actor].visible = visible;
-  for (int inst : actors_[actor].instances) scene_.set_visible(inst, visible);
+  Actor& a = actors_[actor];
+  a.visible = visible;
+  for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
+}
+
+void CameraSensors::set_actor_shown(int actor, int pose) {
+  if (actor < 0 || actors_[actor].shown == pose) return;
+  Actor& a = actors_[actor];
+  a.shown = pose;
+  for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
 }
 
 void CameraSensors::update(double t) {
@@ -442,7 +458,10 @@ void CameraSensors::apply_weather(const Camera& cam, const Eigen::Isometry3d& ca
   a.seed = static_cast<uint32_t>(w.seed ^ (w.seed >> 32));
   a.time = now_;
   scene_.set_atmosphere(a);
-  scene_.set_background(foggy ? mixed(fog, sky, std::exp(-3.912 * 1000.0 / w.visibility_m)) : sky);
+  // In fog the sky is the fog's colour but for what 1 km of air lets through.
+  const double clear = foggy ? std::exp(-3.912 * 1000.0 / w.visibility_m) : 1.0;
+  scene_.set_background(foggy ? mixed(fog, sky, clear) : sky);
+  scene_.set_sky(render::Sky::from_background(scene_.background(), static_cast<float>(clear)));
 }
 
 void CameraSensors::first_render(Camera& cam) {

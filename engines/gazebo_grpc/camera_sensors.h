@@ -43,9 +43,13 @@ class CameraSensors {
 
   // Actors: models added while running (road users), each one ground-truth instance of class
   // `cls`; link poses in the actor's frame. Returns its index (-1: the world has no camera).
-  int add_actor(const ModelDesc& model, const std::string& cls);
+  // With `poses` (an animated walker's), the actor is shown as one of them at a time
+  // (set_actor_shown, pose 0 at first) instead of `model`.
+  int add_actor(const ModelDesc& model, const std::string& cls,
+                const std::vector<ModelDesc>& poses = {});
   void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
   void set_actor_visible(int actor, bool visible);
+  void set_actor_shown(int actor, int pose);
 
   // The weather from now on (see weather_effects.h): the sun, the sky, fog, wet or snowy
   // ground, rain or snow over the image, and at night the vehicles' headlights and the street
@@ -112,7 +116,12 @@ class CameraSensors {
     std::vector<int> instances;
     std::vector<render::Pose> offsets;          // each instance in its link's frame
     std::vector<Eigen::Isometry3d> link_poses;  // its link in the actor's frame
+    std::vector<int> pose_of;                   // each instance's pose (-1: not animated)
+    int shown = 0;                              // the pose shown
   };
+  bool shows(const Actor& a, size_t instance) const {
+    return a.visible && (a.pose_of[instance] < 0 || a.pose_of[instance] == a.shown);
+  }
   // A mesh file's parts, loaded, simplified into levels of detail and added to the scene once
   // for every visual and actor that uses the file at that scale.
   struct FilePart {

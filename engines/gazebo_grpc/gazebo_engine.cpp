@@ -494,7 +494,18 @@ class GazeboEngine final : public Engine {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the model's frame
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     Eigen::Vector3d half = Eigen::Vector3d::Zero();  // half the box, about the model's frame
+    int walk_poses = 0;  // an animated walker's walking cycle poses (then the camera's pose
+    bool stand = false;  // walk_poses is its standing model, if it has one)
   };
+
+  // The pose an animated walker shows: its walking cycle's pose nearest to walk_phase while
+  // it moves, its standing model when it stands still.
+  static int walker_pose(const ActorState& a, const data::RoadUser& u) {
+    constexpr double kStandingSpeed = 0.05;  // m/s
+    if (a.stand && std::abs(u.speed()) < kStandingSpeed) return a.walk_poses;
+    const double phase = u.walk_phase() - std::floor(u.walk_phase());
+    return static_cast<int>(std::lround(phase * a.walk_poses)) % a.walk_poses;
+  }
 
   static bool is_road_user_class(const std::string& c) {
     return c == "car" || c == "truck" || c == "bus" || c == "pedestrian" || c == "cyclist";
@@ -541,7 +552,16 @@ class GazeboEngine final : public Engine {
     model.name = u.id();
     a.half = 0.5 * am->size.cwiseProduct(scale);
     a.physics = physics_->add_actor(u.id(), model);
-    a.camera = cameras_->add_actor(model, a.cls);
+    std::vector<world::ModelDesc> poses;
+    if (!am->walk_cycle.empty()) {
+      // The walker's poses keep their proportions: scaled to its height only.
+      const Eigen::Vector3d uniform = Eigen::Vector3d::Constant(scale.z());
+      for (const auto& p : am->walk_cycle) poses.push_back(world::scaled(p, uniform));
+      for (const auto& p : am->stand) poses.push_back(world::scaled(p, uniform));
+      a.walk_poses = static_cast<int>(am->walk_cycle.size());
+      a.stand = !am->stand.empty();
+    }
+    a.camera = cameras_->add_actor(model, a.cls, poses);
     offsets_.push_back(am->length_offset * scale.x());
     actors_.push_back(std::move(a));
     actor_by_id_[u.id()] = actors_.size() - 1;
@@ -578,6 +598,7 @@ class GazeboEngine final : public Engine {
       a.last_seen_ns = time_ns_;
       physics_->set_actor_pose(a.physics, a.pose);
       cameras_->set_actor_pose(a.camera, a.pose);
+      if (a.walk_poses > 0) cameras_->set_actor_shown(a.camera, walker_pose(a, u));
       set_present(a, true);
     }
     pending_.clear();

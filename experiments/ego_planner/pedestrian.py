@@ -16,6 +16,7 @@ KERB_Y = -4.0        # m: waiting here
 STOP_Y = -1.7        # m: walks to the lane's centre line and stays
 TRIGGER_M = 30.0     # m: steps out when the ego's front is this far away
 WALK_SPEED = 1.5     # m/s
+STRIDE = 1.4         # m walked per walking cycle (its walk_phase 0 -> 1)
 
 
 def _gap_ahead(ego, x, y, length, width):
@@ -83,4 +84,4 @@ class Script(EngineScript):
             "id": "pedestrian", "category": "pedestrian", "model": "pedestrian",
             "x": PED_X, "y": self.y, "z": 0.0, "yaw": math.pi / 2 if vy > 0 else 0.0,
             "speed": vy, "vx": 0.0, "vy": vy, "length": 0.5, "width": 0.5, "height": 1.75,
-            "walk_phase": 0.0, "time_ns": self._time_ns})
+            "walk_phase": ((self.y - KERB_Y) / STRIDE) % 1.0, "time_ns": self._time_ns})

@@ -358,6 +358,33 @@ void main() {}
 
 namespace {
 
+// The sky: one triangle covering the screen at the far plane (depth 1, drawn with LEQUAL:
+// only where nothing was drawn); the view ray through each corner is forward + x right +
+// y up (the camera's axes in the world, scaled by the field of view), interpolated exactly.
+const char* kSkyVertexShader = R"(#version 300 es
+uniform vec3 u_forward;
+uniform vec3 u_right;
+uniform vec3 u_up;
+out vec3 v_ray;
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  v_ray = u_forward + p.x * u_right + p.y * u_up;
+  gl_Position = vec4(p, 1.0, 1.0);
+}
+)";
+
+const char* kSkyShader = R"(#version 300 es
+precision mediump float;
+uniform vec3 u_horizon;
+uniform vec3 u_zenith;
+in vec3 v_ray;
+out vec4 out_color;
+void main() {
+  float elevation = max(normalize(v_ray).z, 0.0);
+  out_color = vec4(mix(u_horizon, u_zenith, sqrt(elevation)), 1.0);
+}
+)";
+
 // Rain streaks and snow flakes as small quads made on the CPU (precipitation.h): positions in
 // image pixels (row 0 at the top), a local coordinate across the streak or the flake, and the
 // particle's opacity. Only the pixels the particles cover are shaded.
@@ -385,6 +412,18 @@ void main() {
 )";
 
 }  // namespace
+
+SkyProgram build_sky_program() {
+  SkyProgram p;
+  p.id = link(kSkyVertexShader, kSkyShader);
+  p.forward = glGetUniformLocation(p.id, "u_forward");
+  p.right = glGetUniformLocation(p.id, "u_right");
+  p.up = glGetUniformLocation(p.id, "u_up");
+  p.horizon = glGetUniformLocation(p.id, "u_horizon");
+  p.zenith = glGetUniformLocation(p.id, "u_zenith");
+  glGenVertexArrays(1, &p.vao);  // no attributes: the corners come from gl_VertexID
+  return p;
+}
 
 PrecipitationProgram build_precipitation_program() {
   PrecipitationProgram p;

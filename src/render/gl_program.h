@@ -54,6 +54,14 @@ struct ShadowProgram {
 };
 ShadowProgram build_shadow_program();
 
+// The sky behind the scene: a full-screen triangle at the far plane, drawn where nothing
+// else is, from the horizon's colour to the zenith's by the view ray's elevation.
+struct SkyProgram {
+  GLuint id = 0, vao = 0;
+  GLint forward = -1, right = -1, up = -1, horizon = -1, zenith = -1;
+};
+SkyProgram build_sky_program();
+
 // Draws rain streaks or snow flakes (precipitation.h's quads) over the image, blended.
 struct PrecipitationProgram {
   GLuint id = 0, vao = 0, vbo = 0;

@@ -122,6 +122,7 @@ struct Renderer::Impl {
   RenderTargetCache targets;
   std::map<ProgramKey, SurfaceProgram> programs;  // built when first needed
   PrecipitationProgram precipitation;             // built when first needed
+  SkyProgram sky;                                 // built when first needed
   std::vector<PrecipitationVertex> precipitation_vertices;
   // Sun shadows (Scene::shadows): the depth program, the map and its framebuffer, and this
   // frame's eye-to-map matrix and biases.
@@ -153,6 +154,10 @@ struct Renderer::Impl {
     if (shadow_program.id) glDeleteProgram(shadow_program.id);
     if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
     if (shadow_texture) glDeleteTextures(1, &shadow_texture);
+    if (sky.id) {
+      glDeleteProgram(sky.id);
+      glDeleteVertexArrays(1, &sky.vao);
+    }
     if (precipitation.id) {
       glDeleteProgram(precipitation.id);
       glDeleteVertexArrays(1, &precipitation.vao);
@@ -160,6 +165,8 @@ struct Renderer::Impl {
     }
   }
   void draw_precipitation(const Atmosphere& a, int width, int height);
+  // The sky gradient where nothing was drawn (colour only).
+  void draw_sky(const Sky& sky, const Pose& camera_world_pose, const CameraSpec& spec);
   // Renders light `li`'s shadow map around the camera of `view` (world to eye); false when
   // the light is too low to cast shadows.
   bool render_shadow_map(const Scene& scene, int li, const glm::dmat4& view, const GpuScene& gpu);
@@ -463,6 +470,38 @@ bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dm
   return true;
 }
 
+void Renderer::Impl::draw_sky(const Sky& s, const Pose& camera_world_pose, const CameraSpec& spec) {
+  if (!sky.id) sky = build_sky_program();
+  // The camera's axes in the world (SDF: x forward, y left, z up), scaled so that the ray
+  // through a pixel at normalised device coordinates (x, y) is forward + x right + y up.
+  // The projection is flipped (rows top first): device y = +1 is the image's bottom.
+  const double tx = std::tan(spec.hfov / 2);
+  const double ty = tx * spec.height / spec.width;
+  auto axis = [&](int c, double scale) {  // column c of the rotation (column-major pose)
+    glm::vec3 v;
+    for (int r = 0; r < 3; ++r) v[r] = static_cast<float>(scale * camera_world_pose[4 * c + r]);
+    return v;
+  };
+  const glm::vec3 forward = axis(0, 1.0), right = axis(1, -tx), up = axis(2, -ty);
+  const GLenum colour_only[3] = {GL_COLOR_ATTACHMENT0, GL_NONE, GL_NONE};
+  glDrawBuffers(3, colour_only);
+  glDepthFunc(GL_LEQUAL);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(sky.id);
+  glUniform3fv(sky.forward, 1, &forward[0]);
+  glUniform3fv(sky.right, 1, &right[0]);
+  glUniform3fv(sky.up, 1, &up[0]);
+  glUniform3fv(sky.horizon, 1, s.horizon.data());
+  glUniform3fv(sky.zenith, 1, s.zenith.data());
+  glBindVertexArray(sky.vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_CULL_FACE);
+}
+
 // Rain or snow over the colour image only (depth and ids keep the scene's).
 void Renderer::Impl::draw_precipitation(const Atmosphere& a, int width, int height) {
   // A new pattern for each frame time, the same for the same seed and time.
@@ -584,6 +623,7 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   glActiveTexture(GL_TEXTURE0);
   s.collect_draws(scene, view, spec);
   s.draw(key, scene, view, spec, gpu);
+  if (scene.sky().gradient) s.draw_sky(scene.sky(), camera_world_pose, spec);
   if (scene.atmosphere().precipitation > 0) s.draw_precipitation(scene.atmosphere(), w, h);
 
   // Read back. Rows come top first thanks to the flipped projection.

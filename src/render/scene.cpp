@@ -65,6 +65,9 @@ Scene& Scene::operator=(Scene&& other) noexcept {
   lights_ = std::move(other.lights_);
   ambient_ = other.ambient_;
   background_ = other.background_;
+  atmosphere_ = other.atmosphere_;
+  shadows_ = other.shadows_;
+  sky_ = other.sky_;
   // The renderer caches GPU copies by uid: the emptied source must not share it.
   other.uid_ = next_uid();
   other.meshes_.clear();

@@ -14,6 +14,7 @@
 //   ...  scene.set_pose(car, make_pose(6, 0, 0.5));
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -89,6 +90,29 @@ struct Atmosphere {
   bool operator==(const Atmosphere&) const = default;
 };
 
+// The sky behind the scene. With `gradient`, a view ray at elevation e (0 at and below the
+// horizon, 1 straight up) sees horizon + (zenith - horizon) sqrt(e); without, the background
+// colour everywhere (the default). from_background() makes a daylight sky around a colour:
+// the horizon paler (half-way to a grey as bright as its brightest channel), the zenith 30 %
+// deeper, both by `strength` (0: uniform).
+struct Sky {
+  bool gradient = false;
+  Rgba horizon{0.7f, 0.7f, 0.7f, 1.0f};
+  Rgba zenith{0.7f, 0.7f, 0.7f, 1.0f};
+  bool operator==(const Sky&) const = default;
+  static Sky from_background(const Rgba& c, float strength = 1.0f) {
+    const float grey = std::max({c[0], c[1], c[2]});
+    Sky s;
+    s.gradient = true;
+    for (int k = 0; k < 3; ++k) {
+      s.horizon[k] = c[k] + (grey - c[k]) * 0.5f * strength;
+      s.zenith[k] = c[k] * (1.0f - 0.3f * strength);
+    }
+    s.horizon[3] = s.zenith[3] = 1.0f;
+    return s;
+  }
+};
+
 // Sun shadows: the first directional light, while it is at least 3 degrees above the horizon,
 // casts shadows through a shadow map of map_size x map_size texels covering the ground from
 // the camera to `distance` metres ahead of it (beyond, no shadows). Off by default.
@@ -160,6 +184,7 @@ class Scene {
   void set_background(const Rgba& rgba) { background_ = rgba; }
   void set_atmosphere(const Atmosphere& a) { atmosphere_ = a; }
   void set_shadows(const Shadows& s) { shadows_ = s; }
+  void set_sky(const Sky& s) { sky_ = s; }
 
   // Read access for the renderer.
   uint64_t uid() const { return uid_; }  // unique per Scene object in this process
@@ -174,6 +199,7 @@ class Scene {
   const Rgba& background() const { return background_; }
   const Atmosphere& atmosphere() const { return atmosphere_; }
   const Shadows& shadows() const { return shadows_; }
+  const Sky& sky() const { return sky_; }
 
  private:
   Instance& instance_at(int index, const char* what);
@@ -190,6 +216,7 @@ class Scene {
   Rgba background_{0.7f, 0.7f, 0.7f, 1.0f};  // SDF <scene><background> default
   Atmosphere atmosphere_;                    // none: clear air
   Shadows shadows_;
+  Sky sky_;  // the background colour
 };
 
 }  // namespace convoy::render

@@ -62,7 +62,8 @@ class Files(unittest.TestCase):
             self.assertEqual(mismatch + errors, [], "out of date: run /usr/bin/python3 tools/assets/make_road_users.py")
             stack += c.subdirs.values()
         total = sum(os.path.getsize(os.path.join(d, f)) for d, _, fs in os.walk(ACTORS) for f in fs)
-        self.assertLess(total, 3_000_000)
+        # 1.8 MB of models, 2.5 MB of walking cycles (8 poses of 4 figures)
+        self.assertLess(total, 5_000_000)
 
     def test_table_entries_match_their_models(self):
         table = load_table()
@@ -190,6 +191,33 @@ class Rendering(unittest.TestCase):
             self.assertEqual(seen.get("a/" + key), e["class"], key)
 
 
+class Animation(unittest.TestCase):
+    def test_walkers_show_the_pose_of_their_walk_phase(self):
+        """Walkers seen from the side at the eight phases of the walking cycle, and one standing
+        still: their boxes (the rendered silhouette's) are narrow with the feet together (phase
+        0 and 0.5) and wide at heel strike (0.25, 0.75), and the one standing is narrower still."""
+        ex = Experiment(self)
+        ex.file("world.sdf", STREET.replace("street", "side").replace("<width>640</width>", "<width>1280</width>")
+                .replace("<height>240</height>", "<height>360</height>"))
+        users = [{"id": "w%d" % k, "model": "walker_woman_2", "category": "pedestrian", "x": 0.0,
+                  "y": 7.0 - 1.6 * k, "yaw": 1.5708, "speed": 1.4, "walk_phase": k / 8.0} for k in range(8)]
+        users.append({"id": "stand", "model": "walker_woman_2", "category": "pedestrian", "x": 0.0,
+                      "y": 7.0 - 1.6 * 8, "yaw": 1.5708, "speed": 0.0, "walk_phase": 0.25})
+        add_world_and_users(ex, users)
+        ex.function("record", RECORD.replace("top::link::cam", "side::link::cam"))
+        ex.run(0.1)
+        width = {}
+        for boxes in ex.records("record"):
+            for b in boxes:
+                width[b["model"]] = b["x_max"] - b["x_min"]
+        self.assertEqual(sorted(width), sorted(u["id"] for u in users))
+        together = max(width["w0"], width["w4"])
+        strike = min(width["w2"], width["w6"])
+        self.assertGreater(strike, 1.4 * together, width)
+        self.assertLess(width["stand"], 0.8 * strike, width)
+        self.assertGreaterEqual(len({round(w) for w in width.values()}), 4, width)
+
+
 GOLDEN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "golden", "actor_models.png")
 
 GRAB = textwrap.dedent("""\
@@ -239,6 +267,8 @@ class Golden(unittest.TestCase):
         users = []
         for key, x, y, yaw in STREET_USERS:
             users.append({"id": "a/" + key, "model": key, "x": x, "y": y, "yaw": yaw})
+            if key == "walker":  # mid-way through its cycle: the left heel striking
+                users[-1].update(speed=1.4, walk_phase=0.25)
         add_world_and_users(ex, users)
         ex.function("grab", GRAB)
         ex.run(0.1)

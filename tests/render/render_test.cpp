@@ -267,6 +267,49 @@ TEST(RenderTest, BackgroundWhereNothingIs) {
   EXPECT_TRUE(f.boxes.empty());
 }
 
+TEST(RenderTest, TheSkyGoesFromTheHorizonToTheZenithBehindTheScene) {
+  GET_RENDERER(renderer);
+  const CameraSpec spec{160, 120, 1.2, 0.1, 100};
+  Scene scene;
+  scene.set_background({0.55f, 0.7f, 0.9f, 1});
+  const Sky sky = Sky::from_background(scene.background());
+  scene.set_sky(sky);
+  // The ground, 1.5 m below the camera, and a box in front: neither may change.
+  scene.add_instance(scene.add_mesh(make_plane(400, 400)), plain(0.3f, 0.3f, 0.3f),
+                     make_pose(0, 0, -1.5));
+  scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(0.8f, 0.2f, 0.2f), make_pose(6, 0, 0),
+                     1, 1);
+  // Looking up 0.4 rad: the top rows see higher elevations than the rows near the horizon.
+  const Pose up = make_pose(0, 0, 0, 0, -0.4, 0);
+  Frame with, without;
+  renderer->render(scene, up, spec, &with, true, true);
+  Scene plain_sky;
+  plain_sky = std::move(scene);
+  plain_sky.set_sky(Sky{});
+  renderer->render(plain_sky, up, spec, &without, true, true);
+  auto blue = [&](const Frame& f, int row) { return f.rgb[3 * (row * f.width + 2) + 2]; };
+  auto red = [&](const Frame& f, int row) { return f.rgb[3 * (row * f.width + 2)]; };
+  // Without a gradient the background everywhere; with it, the zenith deeper than the horizon.
+  EXPECT_EQ(blue(without, 0), 230);
+  EXPECT_EQ(blue(without, 105), 230);
+  EXPECT_LT(red(with, 0), red(with, 105));  // row 105: 2 degrees above the horizon
+  EXPECT_GT(red(with, 105), 150);           // paler near the horizon than the background (140)
+  EXPECT_NEAR(red(with, 0), 255 * (0.55 + (sky.zenith[0] - 0.55) * 0.75), 30);
+  // The sky draws only where nothing is: depth, ids, boxes and the models' pixels are the same.
+  EXPECT_EQ(with.depth, without.depth);
+  ASSERT_EQ(with.boxes.size(), 1u);
+  ASSERT_EQ(without.boxes.size(), 1u);
+  EXPECT_EQ(with.boxes[0].pixel_count, without.boxes[0].pixel_count);
+  size_t differ = 0;
+  for (size_t p = 0; p < with.depth.size(); ++p) {
+    const bool sky_pixel = std::isinf(with.depth[p]);
+    const bool same = std::equal(&with.rgb[3 * p], &with.rgb[3 * p] + 3, &without.rgb[3 * p]);
+    if (!sky_pixel) EXPECT_TRUE(same) << "pixel " << p;
+    differ += sky_pixel && !same;
+  }
+  EXPECT_GT(differ, with.depth.size() / 4);
+}
+
 TEST(RenderTest, BoxesCountVisiblePixelsOnly) {
   GET_RENDERER(renderer);
   const CameraSpec spec{320, 240, 1.0, 0.1, 100};

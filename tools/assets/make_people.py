@@ -1,5 +1,6 @@
 """People for the road-user actors (see make_road_users.py): pedestrians (four figures,
-standing and in a walking mid-stride pose) and a cyclist on a bicycle.
+standing, in a walking mid-stride pose, and in the WALK_FRAMES poses of a walking cycle that
+the world engine shows by the walker's walk_phase) and a cyclist on a bicycle.
 
 A figure is a skeleton (joint positions in a standing rest pose, scaled to its height) and
 one mesh part per bone: pelvis, torso, neck, head (+ hair), upper_arm_l/r, lower_arm_l/r,
@@ -329,6 +330,76 @@ def pose_walk(rest, f):
     return j
 
 
+WALK_FRAMES = 8  # poses of the walking cycle (walk_phase k / WALK_FRAMES)
+
+
+def bump(phase, centre, width):
+    """A smooth bump of height 1 at `centre` on the cycle (phase and centre in [0, 1))."""
+    d = (phase - centre + 0.5) % 1.0 - 0.5
+    return math.exp(-(d / width) ** 2)
+
+
+def gait_angles(phase):
+    """Joint angles (degrees) of the walking cycle at `phase` (RoadUser.walk_phase: 0 and 0.5
+    feet together, the left heel striking at 0.25, the right at 0.75): per side, the thigh's
+    swing forward, the knee's bend, the foot's angle (toes up positive), the arm's swing
+    forward and the elbow's bend. Hips +-A sin, the swinging leg's knee bent most as it
+    passes the other, the foot up at heel strike and down at push-off, the arms opposite."""
+    out = {}
+    for k, shift in (("l", 0.0), ("r", 0.5)):
+        q = (phase + shift) % 1.0  # this leg's phase: heel strike at 0.25, push-off ~0.7
+        thigh = 3.0 + 18.0 * math.sin(2 * math.pi * q)
+        knee = 5.0 + 10.0 * bump(q, 0.35, 0.08) + 45.0 * bump(q, 0.97, 0.1)
+        foot = 8.0 * bump(q, 0.25, 0.06) - 22.0 * bump(q, 0.72, 0.07) + 4.0 * bump(q, 0.0, 0.1)
+        arm = -18.0 * math.sin(2 * math.pi * q)
+        elbow = 14.0 + 0.6 * max(0.0, arm)
+        out[k] = (thigh, knee, foot, arm, elbow)
+    return out
+
+
+def pose_cycle(rest, f, phase):
+    """The walking cycle's pose at `phase` (see gait_angles); the trunk leans forward 4
+    degrees. The figure is not lifted here: its lowest point goes onto the ground after."""
+    j = dict(rest)
+    lean = math.radians(4)
+    w = rest["waist"]
+    for k in ("neck_base", "head_base", "head_top", "shoulder_l", "shoulder_r"):
+        j[k] = add(w, swing(sub(rest[k], w), -lean))
+    j["head_top"] = add(j["head_base"], sub(rest["head_top"], rest["head_base"]))
+    for k, (thigh, knee, foot_angle, arm, elbow) in gait_angles(phase).items():
+        thigh, knee, foot_angle = math.radians(thigh), math.radians(knee), math.radians(foot_angle)
+        hip = rest["hip_" + k]
+        kn = add(hip, swing(sub(rest["knee_" + k], hip), thigh))
+        an = add(kn, swing(sub(rest["ankle_" + k], rest["knee_" + k]), thigh - knee))
+        to = add(an, swing(sub(rest["toe_" + k], rest["ankle_" + k]), foot_angle))
+        sh = j["shoulder_" + k]
+        sw, el = math.radians(arm), math.radians(elbow)
+        e = add(sh, swing(sub(rest["elbow_" + k], rest["shoulder_" + k]), sw))
+        wr = add(e, swing(sub(rest["wrist_" + k], rest["elbow_" + k]), sw + el))
+        ft = add(wr, swing(sub(rest["fingertip_" + k], rest["wrist_" + k]), sw + el))
+        j.update({"knee_" + k: kn, "ankle_" + k: an, "toe_" + k: to,
+                  "elbow_" + k: e, "wrist_" + k: wr, "fingertip_" + k: ft})
+    return j
+
+
+def walk_cycle(f):
+    """The walking cycle's meshes: [(phase, Mesh)] for phase k / WALK_FRAMES, each in the frame
+    of the figure's mid-stride walker (the pelvis where the walker has it), its lowest point
+    on the ground, so that the figure bobs as it walks but does not slide."""
+    m, rest = build_figure(f)
+    apply_pose(m, rest, pose_walk(rest, f))
+    lo, hi = m.bounds()
+    centre = ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2)
+    frames = []
+    for k in range(WALK_FRAMES):
+        m, rest = build_figure(f)
+        apply_pose(m, rest, pose_cycle(rest, f, k / WALK_FRAMES))
+        lo, _ = m.bounds()
+        m.transform(0, move=(-centre[0], -centre[1], -lo[2]))
+        frames.append((k / WALK_FRAMES, m))
+    return frames
+
+
 def pose_stand(rest, f):
     j = dict(rest)
     for k, sw in (("l", 3), ("r", -2)):
@@ -476,6 +547,7 @@ def build_all():
     """Yields (model name, Mesh, meta) for every person model; the first model of a mesh
     writes it (meta["write"])."""
     for fig, f in FIGURES.items():
+        cycle = [("%s_walk%d" % (fig, k), phase, mesh) for k, (phase, mesh) in enumerate(walk_cycle(f))]
         for pose_name, pose, prefix in (("stand", pose_stand, "pedestrian"), ("walk", pose_walk, "walker")):
             m, rest = build_figure(f)
             posed = pose(rest, f)
@@ -494,6 +566,8 @@ def build_all():
                     "cls": "pedestrian", "mesh": mesh, "write": k == 0, "mesh_slots": SLOTS,
                     "colours": cols, "parts": sorted({t[0] for t in m.tris}), "fixed": False,
                     "length_offset": 0, "skeleton": skel if k == 0 else None,
+                    "cycle": cycle if pose_name == "walk" else None,
+                    "stand": "pedestrian_%s_%d" % (fig, k + 1),
                     "comment": "A pedestrian actor: %s, %s, %.2f m tall" % (fig.replace("_", " "),
                                                                            "walking (mid-stride)" if pose_name == "walk" else "standing", f["h"])})
     # the cyclist
@@ -515,5 +589,5 @@ def build_all():
         yield ("cyclist_%d" % (k + 1), m, {
             "cls": "cyclist", "mesh": "cyclist", "write": k == 0, "mesh_slots": SLOTS + ["frame"],
             "colours": cols, "parts": sorted({t[0] for t in m.tris}), "fixed": True,
-            "length_offset": round(-rear_x, 3), "skeleton": None,
+            "length_offset": round(-rear_x, 3), "skeleton": None, "cycle": None,
             "comment": "A cyclist actor: a rider in a helmet on a city bicycle"})

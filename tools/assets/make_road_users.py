@@ -156,6 +156,37 @@ class Writer:
                 self.report.append((meta["mesh"], total))
             self.sdf(name, meta["cls"], size, visuals, meta["comment"])
             self.entry(name, meta["cls"], size, meta["length_offset"])
+            if meta.get("cycle"):
+                self.walk_cycle(name, meta)
+
+    def walk_cycle(self, name, meta):
+        """A walker's walking cycle: an SDF per pose (<name>_f<k>.sdf, the walker's colours on
+        the pose's meshes) listed in its entry as "walk_cycle", and its standing model as
+        "stand" (docs/road_users.md, Actor models)."""
+        files = []
+        for k, (mesh, phase, m) in enumerate(meta["cycle"]):
+            lo, hi = m.bounds()
+            size = tuple(hi[i] - lo[i] for i in range(3))
+            header = "%s: walking cycle pose %d of %d (walk_phase %.3f). %s" % (
+                mesh, k, len(meta["cycle"]), phase, HEADER)
+            visuals, total = [], 0
+            for slot in meta["mesh_slots"]:
+                pick = lambda p, mat, s=slot: mat == s
+                if not m.count(pick):
+                    continue
+                rel = "meshes/%s_%s.obj" % (mesh, slot)
+                if meta["write"]:
+                    total += m.write_obj(self.path(rel), header=header, select=pick)
+                specular = 0.15 if slot in ("hair", "shoes") else 0.05
+                visuals.append((slot, rel, material_xml(meta["colours"][slot], specular)))
+            if meta["write"]:
+                assert total <= BUDGET[meta["cls"]], (mesh, total)
+            frame = "%s_f%d" % (name, k)
+            self.sdf(frame, meta["cls"], size, visuals,
+                     "%s, walking cycle pose %d of %d (walk_phase %.3f)" % (meta["comment"], k, len(meta["cycle"]), phase))
+            files.append(frame + ".sdf")
+        self.table[name]["walk_cycle"] = files
+        self.table[name]["stand"] = meta["stand"]
 
     def write_table(self):
         models = {k: self.table[v] for k, v in DEFAULTS.items()}
