@@ -18,6 +18,7 @@ PACKAGES=(
   sumo sumo-tools
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
+  ffmpeg
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
