@@ -19,6 +19,7 @@ PACKAGES=(
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
   zlib1g-dev nodejs npm
+  ffmpeg
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then

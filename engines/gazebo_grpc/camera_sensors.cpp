@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <thread>
 
 #include "datapack/camera.h"
 #include "datapack/json.h"
@@ -100,22 +102,43 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
         cameras_.push_back(std::move(c));
       }
   if (cameras_.empty()) return;
-  renderer_ = std::make_unique<render::Renderer>();
-  build_scene(desc);
   // Gaussian noise comes from a fixed table read at a random offset per frame: as random as
-  // a camera needs, deterministic for a seed, and far cheaper than a draw per pixel.
-  std::normal_distribution<double> normal(0.0, 1.0);
-  for (auto& cam : cameras_) {
-    if (cam.desc->format == "L8" || cam.desc->format == "L_INT8") cam.depth_channels = 1;
-    if (!cam.desc->noise || cam.desc->noise_stddev <= 0) continue;
-    // 2^20 starting points, each followed by a whole frame's worth of samples
-    cam.noise.resize((size_t{1} << 20) +
-                     static_cast<size_t>(cam.desc->width) * cam.desc->height * 3);
-    for (auto& v : cam.noise) {
-      v = static_cast<int16_t>(
-          std::lround(255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
+  // a camera needs, deterministic for a seed, and far cheaper than a draw per pixel. The tables
+  // take about as long as the renderer and the scene, which touch neither rng_ nor the
+  // cameras' noise, so they are drawn meanwhile in a thread of their own (the same draws in
+  // the same order: the same tables).
+  double noise_s = 0;
+  std::thread noise([this, &noise_s] {
+    const auto start = std::chrono::steady_clock::now();
+    std::normal_distribution<double> normal(0.0, 1.0);
+    for (auto& cam : cameras_) {
+      if (cam.desc->format == "L8" || cam.desc->format == "L_INT8") cam.depth_channels = 1;
+      if (!cam.desc->noise || cam.desc->noise_stddev <= 0) continue;
+      // 2^20 starting points, each followed by a whole frame's worth of samples
+      cam.noise.resize((size_t{1} << 20) +
+                       static_cast<size_t>(cam.desc->width) * cam.desc->height * 3);
+      for (auto& v : cam.noise) {
+        v = static_cast<int16_t>(
+            std::lround(255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
+      }
     }
+    noise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point t1, t2;
+  try {
+    renderer_ = std::make_unique<render::Renderer>();
+    t1 = std::chrono::steady_clock::now();
+    build_scene(desc);
+    t2 = std::chrono::steady_clock::now();
+  } catch (...) {
+    noise.join();
+    throw;
   }
+  noise.join();
+  auto s = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  std::fprintf(stderr, "convoy: cameras: renderer %.3f s, scene %.3f s, noise %.3f s (alongside)\n",
+               s(t0, t1), s(t1, t2), noise_s);
 }
 
 CameraSensors::~CameraSensors() = default;

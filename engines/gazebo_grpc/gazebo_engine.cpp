@@ -102,12 +102,16 @@ class GazeboEngine final : public Engine {
     const auto t0 = std::chrono::steady_clock::now();
     world::CacheResult cache;
     desc_ = world::load_world_cached(file, extra, &cache);
-    std::fprintf(stderr, "convoy: engine '%s': world %s loaded in %.3f s (cache: %s, %s)\n",
-                 name.c_str(), file.filename().c_str(),
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                 world::to_string(cache), world::cache_dir().c_str());
+    const auto t1 = std::chrono::steady_clock::now();
     physics_ = std::make_unique<world::PhysicsWorld>(desc_);
+    const auto t2 = std::chrono::steady_clock::now();
     cameras_ = std::make_unique<world::CameraSensors>(desc_, *physics_, seed_);
+    auto s = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+    std::fprintf(stderr,
+                 "convoy: engine '%s': world %s loaded in %.3f s (cache: %s, %s); physics %.3f s, "
+                 "cameras %.3f s\n",
+                 name.c_str(), file.filename().c_str(), s(t0, t1), world::to_string(cache),
+                 world::cache_dir().c_str(), s(t1, t2), s(t2, std::chrono::steady_clock::now()));
     cameras_->set_shadows(shadows_);
 
     std::vector<engine::DataPackId> ids;

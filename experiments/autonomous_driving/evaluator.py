@@ -20,6 +20,7 @@ from nrp_core.engines.python_json import EngineScript
 
 import relateAngle_computation
 from convoy_perception.evaluation import evaluate
+from convoy_video import VideoWriter
 
 # The road users the detector is scored on (the ground truth's class names; a COCO model's
 # person, car, bus, truck are mapped to them).
@@ -97,9 +98,7 @@ class Script(EngineScript):
             img = cv2.cvtColor(np.ascontiguousarray(frame), cv2.COLOR_RGB2BGR)
             self._draw(img, dets)
             if self.video is None:
-                h, w = img.shape[:2]
-                self.video = cv2.VideoWriter(os.path.join(self.dir, "camera.mp4"),
-                                             cv2.VideoWriter_fourcc(*"mp4v"), FPS, (w, h))
+                self.video = VideoWriter(os.path.join(self.dir, "camera.mp4"), FPS)
             self.video.write(img)
             self.frames += 1
             if self.window:
@@ -144,7 +143,7 @@ class Script(EngineScript):
 
     def shutdown(self):
         if self.video is not None:
-            self.video.release()
+            self.video.close()
         self._birds_eye(os.path.join(self.dir, "birds_eye.png"))
         wall = time.perf_counter() - self.wall0 if self.wall0 is not None else 0.0
         sim = (self._time_ns - self.sim0) * 1e-9 if self.wall0 is not None else 0.0
@@ -172,6 +171,7 @@ class Script(EngineScript):
             "physics_real_time_factor": sim / wall if wall > 0 else None,
             "camera_frames": self.frames,
             "camera_frames_per_s": self.frames / wall if wall > 0 else None,
+            "camera_video_codec": self.video.codec if self.video is not None else None,
             "detections_per_class": self.per_class,
             "detector_precision": score.get("precision"),
             "detector_recall": score.get("recall"),

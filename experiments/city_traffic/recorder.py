@@ -17,6 +17,7 @@ import time
 
 import cv2
 import numpy as np
+from convoy_video import VideoWriter
 from nrp_core.engines.python_json import EngineScript
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -123,9 +124,7 @@ class Script(EngineScript):
             cv2.putText(img, det["class"], (p1[0], max(12, p1[1] - 4)), cv2.FONT_HERSHEY_SIMPLEX,
                         0.45, (0, 255, 255), 1, cv2.LINE_AA)
         if self.video is None:
-            h, w = img.shape[:2]
-            self.video = cv2.VideoWriter(os.path.join(self.dir, "camera.mp4"),
-                                         cv2.VideoWriter_fourcc(*"mp4v"), FPS, (w, h))
+            self.video = VideoWriter(os.path.join(self.dir, "camera.mp4"), FPS)
         self.video.write(img)
         self.frames += 1
 
@@ -196,7 +195,7 @@ class Script(EngineScript):
             return
         self.tracks_file.close()
         if self.video is not None:
-            self.video.release()
+            self.video.close()
         self._birds_eye()
         wall = time.perf_counter() - self.wall0 if self.wall0 is not None else 0.0
         sim = (self.last_t - self.sim0) * 1e-9 if self.wall0 is not None else 0.0

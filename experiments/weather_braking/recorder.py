@@ -6,6 +6,7 @@ import os
 
 import cv2
 import numpy as np
+from convoy_video import VideoWriter
 from nrp_core.engines.python_json import EngineScript
 
 FPS = 15
@@ -40,13 +41,11 @@ class Script(EngineScript):
         cv2.putText(frame, caption, (6, 17), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1,
                     cv2.LINE_AA)
         if self.video is None:
-            h, wd = frame.shape[:2]
-            self.video = cv2.VideoWriter(os.path.join(self.dir, "camera.mp4"),
-                                         cv2.VideoWriter_fourcc(*"mp4v"), FPS, (wd, h))
+            self.video = VideoWriter(os.path.join(self.dir, "camera.mp4"), FPS)
         self.video.write(frame)
         self.frames += 1
 
     def shutdown(self):
         if self.video is not None:
-            self.video.release()
+            self.video.close()
             print("recorder: %d frames in camera.mp4" % self.frames, flush=True)

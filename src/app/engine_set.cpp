@@ -134,7 +134,7 @@ void EngineSet::launch(loop::EngineHandle& handle) {
   handle.attach(transport::make_socket_channel(fds[0]), child);
 }
 
-void EngineSet::initialize(RunLog& log) {
+void EngineSet::initialize(RunLog& log, std::vector<EngineStartup>* startup) {
   for (auto& e : engines_) {
     engine::Request request;
     auto* init = request.mutable_initialize();
@@ -149,8 +149,15 @@ void EngineSet::initialize(RunLog& log) {
   for (auto& e : engines_) {
     engine::Reply reply;
     e->finish(&reply);
-    for (const auto& w : reply.initialize().warnings())
-      log.info("warning: engine '" + e->name() + "': " + w);
+    const auto& init = reply.initialize();
+    for (const auto& w : init.warnings()) log.info("warning: engine '" + e->name() + "': " + w);
+    if (startup) {
+      EngineStartup s{e->name()};
+      if (init.compute_ns() > 0) s.initialize_s = init.compute_ns() * 1e-9;
+      // A remote engine's process started whenever its owner started it.
+      if (init.process_ns() > 0 && e->process().pid() > 0) s.process_s = init.process_ns() * 1e-9;
+      startup->push_back(std::move(s));
+    }
   }
 }
 

@@ -14,6 +14,13 @@
 
 namespace convoy::app {
 
+// One engine's start-up, as it reports it in its Initialize reply (summary.json's "startup").
+struct EngineStartup {
+  std::string name;
+  double process_s = -1;     // its process's start -> the Initialize request (forked engines)
+  double initialize_s = -1;  // inside Initialize
+};
+
 class EngineSet {
  public:
   // One handle per engine of `cfg`, in config order, logging to `log_dir`/<name>.log. Nothing
@@ -28,8 +35,8 @@ class EngineSet {
       const std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>&
           channel);
   // Sends Initialize to every engine, then collects the replies, logging the warnings they
-  // carry. Throws EngineError.
-  void initialize(RunLog& log);
+  // carry, and each engine's start-up figures into `startup` (if given). Throws EngineError.
+  void initialize(RunLog& log, std::vector<EngineStartup>* startup = nullptr);
   // Shuts every engine down (see EngineHandle::shutdown), the longer timeout after a clean
   // run. Logs each failure with the engine's last log lines; returns the first one, or "".
   std::string shut_down(bool clean, RunLog& log);

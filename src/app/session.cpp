@@ -91,6 +91,11 @@ Session::~Session() {
 void Session::initialize(bool keep_observations) {
   if (loop_) throw std::logic_error("the simulation is already initialized");
   const auto t0 = SteadyClock::now();
+  auto since = [](SteadyClock::time_point from) {
+    return std::chrono::duration<double>(SteadyClock::now() - from).count();
+  };
+  if (const int64_t start = process_start_ns(); start > 0)
+    startup_.process_s = (now_ns() - start) * 1e-9;
   for (const auto& f : cfg_.functions) {
     if (!f.active) continue;
     python::add_python_path(f.file.parent_path());
@@ -105,13 +110,18 @@ void Session::initialize(bool keep_observations) {
   for (const auto& fn : functions_) all.push_back(&fn);
   if (status_) all.push_back(&*status_);
   check_functions(all, cfg_);
+  startup_.functions_s = since(t0);
 
   if (replay_channel_) {
     engines_.attach(replay_channel_);
   } else {
+    auto t1 = SteadyClock::now();
     engines_.launch();
+    startup_.launch_s = since(t1);
     log_.info("started " + std::to_string(engines_.size()) + " engines");
-    engines_.initialize(log_);
+    t1 = SteadyClock::now();
+    engines_.initialize(log_, &startup_.engines);
+    startup_.initialize_s = since(t1);
     log_.info("engines initialized in " +
               std::to_string(std::chrono::duration<double>(SteadyClock::now() - t0).count()) +
               " s");
@@ -138,7 +148,11 @@ void Session::initialize(bool keep_observations) {
     });
   }
   figures_.ran = true;
+  const auto t_prime = SteadyClock::now();
   timed([&] { loop_->prime(); });
+  startup_.prime_s = since(t_prime);
+  if (const int64_t start = process_start_ns(); start > 0)
+    startup_.total_s = (now_ns() - start) * 1e-9;
 }
 
 void Session::record_to(const fs::path& file, bool blobs, const record::StringMap& metadata) {

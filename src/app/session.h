@@ -31,6 +31,19 @@ struct LoopFigures {
   bool done = false;  // the status function ended the run
 };
 
+// From the command's start to the first loop step (summary.json's "startup_s" and "startup").
+// Negative: not reached.
+struct StartupFigures {
+  double total_s = -1;       // the process's start -> the first loop step
+  double process_s = -1;     // the process's start -> the session: exec, config, run folder,
+                             // the embedded interpreter
+  double functions_s = -1;   // loading the TF/PF files (their imports)
+  double launch_s = -1;      // forking the engines (or connecting to remote ones)
+  double initialize_s = -1;  // Initialize of every engine (concurrently), until the last reply
+  double prime_s = -1;       // the functions' first datapacks
+  std::vector<EngineStartup> engines;
+};
+
 // How a run ended: its exit code (simulation.h's ExitCode) and, unless it went well, why.
 struct Outcome {
   int code = 0;
@@ -80,6 +93,7 @@ class Session {
 
   loop::FtiLoop& loop() { return *loop_; }
   const LoopFigures& figures() const { return figures_; }
+  const StartupFigures& startup() const { return startup_; }
 
   // Shuts the engines down (see EngineSet::shut_down); returns the first error, or "".
   std::string shut_down(bool clean);
@@ -100,6 +114,7 @@ class Session {
   std::unique_ptr<loop::FtiLoop> loop_;
   int64_t step_ns_ = 0;  // the smallest EngineTimestep: NRP-Core's simulation timestep
   LoopFigures figures_;
+  StartupFigures startup_;
   bool shut_down_ = false;
   std::unique_ptr<record::Recorder> recorder_;
   ChannelFactory replay_channel_;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <ctime>
 #include <fstream>
@@ -107,12 +108,26 @@ nlohmann::json frame_copies(const config::SimulationConfig& cfg, const fs::path&
   return out;
 }
 
+// The start-up figures as summary.json's "startup".
+nlohmann::json startup_json(const StartupFigures& s) {
+  auto r = [](double v) {
+    return v < 0 ? nlohmann::json() : nlohmann::json(std::round(v * 1e4) / 1e4);
+  };
+  nlohmann::json engines = nlohmann::json::object();
+  for (const auto& e : s.engines)
+    engines[e.name] = {{"process_s", r(e.process_s)}, {"initialize_s", r(e.initialize_s)}};
+  return {{"process_s", r(s.process_s)}, {"functions_s", r(s.functions_s)},
+          {"launch_s", r(s.launch_s)},   {"initialize_s", r(s.initialize_s)},
+          {"prime_s", r(s.prime_s)},     {"engines", engines}};
+}
+
 }  // namespace
 
 // summary.json: what an engine or function of the run wrote there (a JSON object, e.g. an
 // experiment's own figures), with the coordinator's fields on top.
 void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
-                   const LoopFigures& loop, double wall_s, const Outcome& outcome) {
+                   const LoopFigures& loop, double wall_s, const Outcome& outcome,
+                   const StartupFigures* startup) {
   nlohmann::json j = nlohmann::json::object();
   if (std::ifstream in(file); in) {
     j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
@@ -130,6 +145,11 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   j["loop_wall_s"] = loop.wall_s;
   j["real_time_factor"] = loop.wall_s > 0 ? sim_s / loop.wall_s : 0.0;
   if (cfg.status_function && cfg.status_function->active) j["status_function_done"] = loop.done;
+  // From the command's start to the first loop step, and its parts (standalone runs).
+  if (startup && startup->total_s >= 0) {
+    j["startup_s"] = startup->total_s;
+    j["startup"] = startup_json(*startup);
+  }
   j["frame_copies"] = frame_copies(cfg, file.parent_path());
   std::ofstream(file) << j.dump(2) << "\n";
 }
@@ -212,7 +232,7 @@ namespace {
 // The run proper, with the interpreter up: load the functions, launch and initialize the
 // engines, run the loop; then shut the engines down, whatever happened before.
 Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet,
-                    RunLog& log, LoopFigures* figures) {
+                    RunLog& log, LoopFigures* figures, StartupFigures* startup) {
   export_run_environment(run_dir);
   python::Interpreter interpreter;
   Session session(cfg, run_dir, log, quiet);
@@ -234,6 +254,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
   }
   *figures = session.figures();
   session.finish_recording(outcome);
+  *startup = session.startup();
   if (outcome.code == kExitInterrupted) {
     log.info(outcome.error + ": shutting the engines down (Ctrl-C again to kill them)");
     interrupt_signal().store(0);
@@ -250,8 +271,15 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
 
 // summary.json and the last lines of the log.
 void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog& log,
-            const LoopFigures& figures, double wall_s, const Outcome& outcome) {
-  write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome);
+            const LoopFigures& figures, double wall_s, const Outcome& outcome,
+            const StartupFigures* startup = nullptr) {
+  write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome, startup);
+  if (startup && startup->total_s >= 0) {
+    std::ostringstream s;
+    s.precision(3);
+    s << std::fixed << "start-up " << startup->total_s << " s (to the first loop step)";
+    log.info(s.str());
+  }
   if (figures.ran) {
     std::ostringstream s;
     s << "simulated " << static_cast<double>(figures.sim_time_ns) * 1e-9 << " s in " << wall_s
@@ -279,9 +307,10 @@ int run_simulation(const RunOptions& options) {
 
   const auto t0 = SteadyClock::now();
   LoopFigures figures;
-  Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures);
+  StartupFigures startup;
+  Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup);
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
-  report(cfg, run_dir, log, figures, wall_s, outcome);
+  report(cfg, run_dir, log, figures, wall_s, outcome, &startup);
   return outcome.code;
 }
 

@@ -56,9 +56,10 @@ void install_signal_handlers(bool ignore_sigint = false);
 // $CONVOY_RUN_DIR and $CONVOY_SHARE_DIR for the functions, before the interpreter starts.
 void export_run_environment(const std::filesystem::path& run_dir);
 // summary.json: what the run's engines and functions wrote there, with the coordinator's
-// fields on top.
+// fields on top (and the start-up figures, when given: a live run's).
 void write_summary(const std::filesystem::path& file, const config::SimulationConfig& cfg,
-                   const LoopFigures& loop, double wall_s, const Outcome& outcome);
+                   const LoopFigures& loop, double wall_s, const Outcome& outcome,
+                   const StartupFigures* startup = nullptr);
 // The `convoy` metadata of a recording: the effective config (tokens redacted), version.
 record::StringMap recording_metadata(const config::SimulationConfig& cfg);
 

@@ -85,12 +85,17 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
   try {
     switch (request.kind_case()) {
       case engine::Request::kInitialize: {
+        const int64_t t0 = now_ns();
         const auto& init = request.initialize();
         nlohmann::json config = nlohmann::json::parse(init.config_json());
         auto ids = engine_.initialize(init.engine_name(), config, init.timestep_ns());
         initialized_ = true;
-        for (auto& id : ids) *reply->mutable_initialize()->add_registered() = id;
-        for (auto& w : engine_.take_warnings()) reply->mutable_initialize()->add_warnings(w);
+        auto* out = reply->mutable_initialize();
+        for (auto& id : ids) *out->add_registered() = id;
+        for (auto& w : engine_.take_warnings()) out->add_warnings(w);
+        out->set_compute_ns(now_ns() - t0);
+        if (const int64_t start = process_start_ns(); start > 0 && start < t0)
+          out->set_process_ns(t0 - start);
         break;
       }
       case engine::Request::kStep:
