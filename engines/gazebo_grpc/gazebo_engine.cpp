@@ -96,7 +96,6 @@ class GazeboEngine final : public Engine {
     actor_timeout_ = config.value("ActorTimeout", 1.0);
     actor_table_ = config.value("ActorModels", std::string());
     weather_dp_ = config.value("WeatherDataPack", std::string("weather"));
-    shadows_.enabled = config.value("Shadows", false);
     shadows_.distance = config.value("ShadowDistance", 60.0);
     rng_.seed(seed_);
     const auto t0 = std::chrono::steady_clock::now();
@@ -112,6 +111,10 @@ class GazeboEngine final : public Engine {
                  "cameras %.3f s\n",
                  name.c_str(), file.filename().c_str(), s(t0, t1), world::to_string(cache),
                  world::cache_dir().c_str(), s(t1, t2), s(t2, std::chrono::steady_clock::now()));
+    // Shadows as the world's <scene><shadows> says (SDF: on by default), unless the config says.
+    shadows_.enabled = config.contains("Shadows") && config["Shadows"].is_boolean()
+                           ? config["Shadows"].get<bool>()
+                           : desc_.shadows;
     cameras_->set_shadows(shadows_);
 
     std::vector<engine::DataPackId> ids;

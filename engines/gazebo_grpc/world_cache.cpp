@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '3'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '4'};  // bump on format change
 
 // --- Binary writer and reader -------------------------------------------------------------
 
@@ -380,6 +380,7 @@ std::string serialize_world(const WorldDesc& d) {
   w.pod(d.max_step_size);
   w.rgba(d.ambient);
   w.rgba(d.background);
+  w.pod<uint8_t>(d.shadows);
   w.pod<uint8_t>(d.world_plugin);
   w.size(d.models.size());
   for (const auto& m : d.models) put(w, m);
@@ -408,6 +409,7 @@ WorldDesc deserialize_world(const std::string& bytes) {
   d.max_step_size = r.pod<double>();
   d.ambient = r.rgba();
   d.background = r.rgba();
+  d.shadows = r.pod<uint8_t>() != 0;
   d.world_plugin = r.pod<uint8_t>() != 0;
   d.models.resize(r.size());
   for (auto& m : d.models) get(r, m);

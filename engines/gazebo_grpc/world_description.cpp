@@ -535,6 +535,7 @@ WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& ex
   if (const sdf::Scene* scene = w->Scene()) {
     world.ambient = to_rgba(scene->Ambient());
     world.background = to_rgba(scene->Background());
+    world.shadows = scene->Shadows();
   }
   if (auto e = w->Element(); e && e->HasElement("plugin")) {
     for (auto p = e->GetElement("plugin"); p; p = p->GetNextElement("plugin")) {

@@ -137,6 +137,7 @@ struct WorldDesc {
   Eigen::Vector3d gravity{0, 0, -9.8};
   double max_step_size = 0.001;
   Rgba ambient{0.4f, 0.4f, 0.4f, 1}, background{0.7f, 0.7f, 0.7f, 1};
+  bool shadows = true;  // <scene><shadows>
   bool world_plugin = false;
   std::vector<ModelDesc> models;
   std::vector<LightDesc> lights;

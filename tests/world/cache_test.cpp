@@ -72,6 +72,21 @@ TEST_F(CacheTest, AHitGivesTheSameDescriptionAsParsing) {
   EXPECT_DOUBLE_EQ(second.models[0].links[0].collisions[0].shape.size.x(), 2.0);
   EXPECT_NEAR(second.models[0].links[0].pose.translation().y(), 2.0, 1e-12);
   EXPECT_DOUBLE_EQ(second.models[1].links[0].mass, 2.0);
+  EXPECT_TRUE(second.shadows);  // no <scene><shadows>: SDF's default
+}
+
+TEST_F(CacheTest, TheScenesShadowsSettingIsKept) {
+  write(world_,
+        "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
+        "<scene><shadows>false</shadows><background>0.1 0.2 0.3 1</background></scene>"
+        "</world></sdf>");
+  CacheResult r;
+  EXPECT_FALSE(load_world_cached(world_, {}, &r).shadows);
+  EXPECT_EQ(r, CacheResult::kMiss);
+  WorldDesc hit = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kHit);
+  EXPECT_FALSE(hit.shadows);
+  EXPECT_FLOAT_EQ(hit.background[2], 0.3f);
 }
 
 TEST_F(CacheTest, AChangedIncludedFileIsRebuilt) {
