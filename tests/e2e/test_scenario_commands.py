@@ -20,7 +20,7 @@ import unittest
 
 from e2e_util import BIN_DIR, E2ETestCase
 from test_vehicle_agent import CONSTANT, XODR, LENGTH, W, front, rear
-from test_pedestrian_agent import NO_CROSSWALK
+from test_pedestrian_agent import CITY, NO_CROSSWALK
 
 AGENT = os.path.join(BIN_DIR, "convoy-engine-vehicle_agent")
 PED = os.path.join(BIN_DIR, "convoy-engine-pedestrian_agent")
@@ -380,6 +380,43 @@ class VehicleStartPose(CommandCase):
         self.assertEqual(rows[-1]["lane"], 1)
         self.assertAlmostEqual(rows[-1]["y"], 1.75, delta=0.05)
         self.assertLess(rows[-1]["x"], 480.0)
+
+    def test_onward_through_the_city_by_seed(self):
+        # On the city map from road 1 (west of junction 100), no Route: at each junction a
+        # way drawn from Seed, the route planned on as it goes, until a map edge.
+        seqs = {}
+        for seed in (0, 1, 2, 3, 0):
+            out = self.experiment("def command(t, me):\n    return None\n",
+                                  agent={"Map": CITY, "Route": {}, "Seed": seed,
+                                         "StartPose": {"x": -230.0, "y": -1.75, "yaw": 0.0},
+                                         "InitialSpeed": 12.0, "v0": 13.9, "LaneChanges": True},
+                                  timeout=70.0)
+            self.run_ok()
+            rows = self.rows(out)
+            os.remove(out)
+            present = [u for u in rows if not u["absent"]]
+            for k in range(1, len(present)):
+                self.assertContinuous(present, k, max_speed=15.0, max_dv=0.5)
+            roads = []
+            for u in present:
+                if not roads or roads[-1] != u["road"]:
+                    roads.append(u["road"])
+            self.assertGreater(len(roads), 2, roads)  # through a junction at least
+            if seed in seqs:
+                self.assertEqual(seqs[seed], roads, "the same seed, the same way")
+            seqs[seed] = roads
+            # It drove more than its first plan's 600 m, or ended at a map edge.
+            last = present[-1]
+            travelled = sum(math.hypot(b["x"] - a["x"], b["y"] - a["y"])
+                            for a, b in zip(present, present[1:]))
+            at_edge = abs(last["x"]) > 440 or abs(last["y"]) > 140
+            if os.environ.get("CONVOY_E2E_SHOW"):
+                print(seed, roads, round(travelled), rows[-1]["absent"], last["x"], last["y"])
+            self.assertTrue(travelled > 600.0 or (rows[-1]["absent"] and at_edge),
+                            (seed, roads, travelled, last))
+        if os.environ.get("CONVOY_E2E_SHOW"):
+            print(seqs)
+        self.assertGreater(len({tuple(v) for v in seqs.values()}), 1, seqs)
 
     def test_start_pose_with_route_to(self):
         out = self.experiment("def command(t, me):\n    return None\n",
