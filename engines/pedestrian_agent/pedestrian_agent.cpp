@@ -232,7 +232,8 @@ class PedestrianAgent final : public Engine {
   double kr_ = kKeepRight;  // how far right of the path it walks (0 at a new path's start)
   double kr_from_ = 0;      // the arc from which it eases over to kKeepRight (on the sidewalk)
   double initial_kr_from_ = 0;
-  bool idle_ = false;  // no sidewalk near: it stands until commanded
+  bool idle_ = false;          // no sidewalk near: it stands until commanded
+  bool stand_at_end_ = false;  // its path does not reach a sidewalk: it stands at its end
   std::optional<Command> command_;
   Points last_route_, polyline_;
   Path traj_path_;
@@ -603,6 +604,7 @@ void PedestrianAgent::start() {
   rng_ = initial_rng_;
   kr_ = start_pose_ ? 0.0 : kKeepRight;
   kr_from_ = initial_kr_from_;
+  stand_at_end_ = false;
   command_.reset();
   last_route_.clear();
   polyline_.clear();
@@ -917,7 +919,8 @@ void PedestrianAgent::replan(const Points& via) {
     append_leg(path, path.poses.back().x, path.poses.back().y, px, py);
   const double yaw = path.poses.size() > 1 ? path.poses.back().heading : yaw_;
   kr_from_ = INFINITY;
-  if (!path_from(path, path.poses.back().x, path.poses.back().y, yaw, &kr_from_) && via.empty()) {
+  stand_at_end_ = !path_from(path, path.poses.back().x, path.poses.back().y, yaw, &kr_from_);
+  if (stand_at_end_ && via.empty()) {
     char where[96];
     std::snprintf(where, sizeof where, "(%.2f, %.2f)", x_, y_);
     warn_once("idle", std::string("no sidewalk within 50 m of ") + where +
@@ -982,6 +985,7 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
     idle_ = initial_idle_;
     kr_ = kr0;
     kr_from_ = initial_kr_from_;
+    stand_at_end_ = false;
     arc_ = 0;
     v_ = acc_ = yaw_rate_ = 0;
     x_ = sx;
@@ -1148,7 +1152,9 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   x_ = p.x + kr_ * std::sin(p.heading);
   y_ = p.y - kr_ * std::cos(p.heading);
   yaw_ = yaw_new;
-  if (!idle_ && arc_ >= path_.length() - 1e-6) {
+  if (!idle_ && stand_at_end_ && arc_ >= path_.length() - 1e-6) {
+    idle_ = true;  // no sidewalk to go on to: it stands where its route ended
+  } else if (!idle_ && arc_ >= path_.length() - 1e-6) {
     absent_ = true;
     absent_since_ns_ = time_ns_;
     if (respawn_) {  // absent, it waits at its start: its view is around there

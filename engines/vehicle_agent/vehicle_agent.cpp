@@ -790,6 +790,7 @@ void VehicleAgent::consider_lane_change() {
       }
     }
   };
+  const bool open_before = open_end_;  // (planning a change that is not taken sets it)
   for (int side : {+1, -1}) {
     const odr::LaneIndex target = side > 0 ? lane.left() : lane.right();
     const bool allowed = side > 0 ? lane.change_left() : lane.change_right();
@@ -867,6 +868,7 @@ void VehicleAgent::consider_lane_change() {
     changing_ = side;
     return;
   }
+  open_end_ = open_before;
 }
 
 namespace {

@@ -687,7 +687,7 @@ def command(t, me):
     return None
 """
         out = self.experiment(command, agent={"EngineType": "pedestrian_agent", "EngineName": "ped",
-                                              "Route": {}, "v0": None, "LaneChanges": None,
+                                              "Route": {},
                                               "StartPose": {"x": 60.0, "y": -9.0,
                                                             "yaw": math.pi / 2}},
                               timeout=8.0)
@@ -705,6 +705,31 @@ def command(t, me):
         self.assertAlmostEqual(rows[-1]["x"], 60.0, places=6)
         # commanded from the step ending at 2.0 s: 121 steps of 1.5 m/s x 0.05 s
         self.assertAlmostEqual(rows[-1]["y"], -9.0 + 1.5 * (8.0 - 2.0 + DT), delta=1e-6)
+
+
+    def test_without_sidewalks_a_route_ends_standing(self):
+        command = """\
+def command(t, me):
+    if abs(t - 1.0) < 1e-6:
+        return {"route": {"positions": [[60.0, -5.0], [62.0, -5.0]]}}
+    return None
+"""
+        out = self.experiment(command, agent={"EngineType": "pedestrian_agent", "EngineName": "ped",
+                                              "Route": {}, "SpeedSd": 0.0, "Speed": 1.4,
+                                              "StartPose": {"x": 60.0, "y": -9.0,
+                                                            "yaw": math.pi / 2}},
+                              timeout=8.0)
+        with open(os.path.join(self.dir, "simulation_config.json")) as f:
+            cfg = json.load(f)
+        for key in ("v0", "LaneChanges"):
+            del cfg["EngineConfigs"][0][key]
+        self.write_config(cfg)
+        self.run_ok()
+        rows = self.rows(out, "ped")
+        self.assertFalse(any(u["absent"] for u in rows))
+        self.assertEqual((rows[-1]["x"], rows[-1]["y"], rows[-1]["speed"]), (62.0, -5.0, 0.0))
+        for k in range(1, len(rows)):
+            self.assertContinuous(rows, k, max_speed=1.5, max_dv=1.5)
 
 
 class PedestrianDeterminism(PedestrianCase):
