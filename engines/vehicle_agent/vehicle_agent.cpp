@@ -247,6 +247,10 @@ class VehicleAgent final : public Engine {
   // The route on from (lane, s): through its goals when it can still reach them, else
   // onward (its goals given up).
   odr::LaneRoute plan_from(odr::LaneIndex lane, double s);
+  // After a change into `target` (lane ids `shift` from its own): the route keeping that
+  // lane to its next goal's road when it can (else to the goal), then on; onward without
+  // goals; nullopt when there is none.
+  std::optional<odr::LaneRoute> route_keeping(odr::LaneIndex target, double s, int shift);
   void set_path(const odr::LaneRoute& route);
   void compute_goal_arcs();
   // Onto the nearest lane from its present pose and a route on from there; false when no
@@ -829,34 +833,8 @@ void VehicleAgent::consider_lane_change() {
     if (incentive <= threshold_) continue;
     // The route on from the target lane: keep that lane to the destination road if it can,
     // else any route there.
-    odr::RouteOptions keep;
-    keep.lane_changes = false;
-    std::optional<odr::LaneRoute> route;
-    if (!goals_.empty()) {
-      const Goal& g = goals_.front();
-      const odr::LaneNode& dest = graph_->lane(g.lane);
-      const int dest_id = dest.lane_id + (tl.lane_id - lane.lane_id);
-      const odr::LaneIndex dest2 = graph_->find(dest.road->id, dest_id, g.s);
-      if (dest2 != odr::kNoLane) route = graph_->route(target, loc->s, dest2, g.s, keep);
-      if (!route) route = graph_->route(target, loc->s, g.lane, g.s);
-      if (route && !route->segments.empty() && (goals_.size() > 1 || onward_)) {
-        // On through the other goals (and onward) from where it reaches the first.
-        size_t failed = 0;
-        const auto& end = route->segments.back();
-        auto rest = route_from(end.lane, end.s_to, 1, &failed);
-        if (!rest) continue;
-        for (auto& seg : rest->segments) {
-          if (seg.lane == route->segments.back().lane &&
-              std::abs(seg.s_from - route->segments.back().s_to) < 1e-9 && !seg.lane_change) {
-            route->segments.back().s_to = seg.s_to;
-          } else {
-            route->segments.push_back(seg);
-          }
-        }
-      }
-    } else if (onward_) {
-      route = onward(target, loc->s, kOnwardLength, &open_end_);
-    }
+    const std::optional<odr::LaneRoute> route =
+        route_keeping(target, loc->s, tl.lane_id - lane.lane_id);
     if (!route || route->segments.empty()) continue;
     Path p = make_path(*route);
     if (p.poses.size() < 2) continue;
@@ -1196,6 +1174,38 @@ odr::LaneRoute VehicleAgent::plan_from(odr::LaneIndex lane, double s) {
   return *route_from(lane, s, 0, &failed);
 }
 
+std::optional<odr::LaneRoute> VehicleAgent::route_keeping(odr::LaneIndex target, double s,
+                                                          int shift) {
+  if (goals_.empty()) {
+    if (!onward_) return std::nullopt;
+    return onward(target, s, kOnwardLength, &open_end_);
+  }
+  odr::RouteOptions keep;
+  keep.lane_changes = false;
+  std::optional<odr::LaneRoute> route;
+  const Goal& g = goals_.front();
+  const odr::LaneNode& dest = graph_->lane(g.lane);
+  const odr::LaneIndex dest2 = graph_->find(dest.road->id, dest.lane_id + shift, g.s);
+  if (dest2 != odr::kNoLane) route = graph_->route(target, s, dest2, g.s, keep);
+  if (!route) route = graph_->route(target, s, g.lane, g.s);
+  if (route && !route->segments.empty() && (goals_.size() > 1 || onward_)) {
+    // On through the other goals (and onward) from where it reaches the first.
+    size_t failed = 0;
+    const auto& end = route->segments.back();
+    auto rest = route_from(end.lane, end.s_to, 1, &failed);
+    if (!rest) return std::nullopt;
+    for (auto& seg : rest->segments) {
+      if (seg.lane == route->segments.back().lane &&
+          std::abs(seg.s_from - route->segments.back().s_to) < 1e-9 && !seg.lane_change) {
+        route->segments.back().s_to = seg.s_to;
+      } else {
+        route->segments.push_back(seg);
+      }
+    }
+  }
+  return route;
+}
+
 void VehicleAgent::compute_goal_arcs() {
   goal_arcs_.clear();
   size_t lo = 0;
@@ -1316,8 +1326,10 @@ void VehicleAgent::begin_lane(const Command::Lane& c) {
   lane_run_.from_lane = c.from_lane;
   lane_run_.progress = c.progress;
   lane_run_.d_from = -(wf.x - wt.x) * std::sin(h) + (wf.y - wt.y) * std::cos(h);
-  // The route on from the target lane (through its goals if it can).
-  set_path(plan_from(tgt, loc->s));
+  // The route on from the target lane: keeping it to its next goal's road if it can, else
+  // through its goals, else onward.
+  auto route = route_keeping(tgt, loc->s, lane - from);
+  set_path(route && !route->segments.empty() ? *route : plan_from(tgt, loc->s));
   lane_run_.lateral = path_.project(x_, y_).lateral;
   lane_run_.e0 = lane_run_.lateral - lane_run_.d_from;
   lane_run_.side = lane_run_.d_from + lane_run_.e0 < -0.5  ? 1

@@ -242,6 +242,24 @@ def command(t, me):
         self.assertFalse(rows[-1]["absent"])
 
 
+    def test_a_routed_agent_keeps_the_new_lane_to_its_destination_road(self):
+        # Route 1:-1 -> 1:-1; after a change to lane -2 it keeps lane -2 to the road's end
+        # (its destination road), rather than changing back.
+        command = """\
+def command(t, me):
+    if 1.0 <= t <= 3.0:
+        return {"lane": {"road": "1", "lane": -2, "from_lane": -1, "progress": (t - 1.0) / 2.0}}
+    return None
+"""
+        out = self.experiment(command, agent={"InitialSpeed": 20.0, "v0": 25.0}, timeout=50.0)
+        self.run_ok()
+        rows = self.rows(out)
+        after = [u for u in rows if u["t"] > 3.0 and not u["absent"]]
+        self.assertGreater(after[-1]["x"], 990.0)
+        self.assertEqual({u["lane"] for u in after}, {-2})
+        self.assertTrue(rows[-1]["absent"])
+
+
 class VehicleRoute(CommandCase):
     def test_route_through_positions_kept_after_the_command(self):
         command = """\
