@@ -516,6 +516,17 @@ class VehicleBadCommand(CommandCase):
         self.assertStderrHas(r, "car", "StartPose", "not within 50 m")
         self.assertNoEngineLeft()
 
+    def test_start_pose_and_start_s_or_position(self):
+        for extra, key in (({"StartS": 20.0}, "StartS"),
+                           ({"Position": {"x": 100.0, "y": -1.75}}, "Position")):
+            agent = {"Route": {}, "StartPose": {"x": 100.0, "y": -1.75, "yaw": 0.0}}
+            agent.update(extra)
+            self.experiment("def command(t, me):\n    return None\n", agent=agent)
+            r = self.run_convoy(timeout=60)
+            self.assertNotEqual(r.code, 0)
+            self.assertStderrHas(r, "car", key, "StartPose", "not both")
+            self.assertNoEngineLeft()
+
     def test_start_pose_and_route_from(self):
         self.experiment("def command(t, me):\n    return None\n",
                         agent={"StartPose": {"x": 100.0, "y": -1.75, "yaw": 0.0}})
