@@ -218,6 +218,32 @@ TEST(LaneGraph, WorldPoseAndLocateRoundTrip) {
   EXPECT_NEAR(off->distance, 3.5, 1e-9);
 }
 
+TEST(LaneGraph, LocateIfFiltersTheLanes) {
+  const LaneGraph& g = test_graph();
+  // A point on a's lane -1: without a filter that lane; with one accepting only lanes driven
+  // within 60 degrees of heading pi (the other way), the nearest such lane, a's lane 1.
+  const WorldPose w = g.world_pose("a", -1, 20, 0);
+  const auto any = g.locate(w.x, w.y);
+  ASSERT_TRUE(any);
+  EXPECT_EQ(any->lane_id, -1);
+  const double back = w.heading + 3.141592653589793;
+  const auto other = g.locate_if(w.x, w.y, back, 20.0, [&](const LaneNode& n, double h) {
+    return n.drivable() && std::abs(std::remainder(h - back, 2 * 3.141592653589793)) < 1.05;
+  });
+  ASSERT_TRUE(other);
+  EXPECT_EQ(other->road_id, "a");
+  EXPECT_EQ(other->lane_id, 1);
+  EXPECT_GT(other->distance, 0.0);
+  // Sidewalks only.
+  const auto walk = g.locate_if(w.x, w.y, std::nullopt, 20.0,
+                                [](const LaneNode& n, double) { return n.type == "sidewalk"; });
+  ASSERT_TRUE(walk);
+  EXPECT_EQ(g.lane(walk->lane).type, "sidewalk");
+  // Nothing accepted: none.
+  EXPECT_FALSE(
+      g.locate_if(w.x, w.y, std::nullopt, 20.0, [](const LaneNode&, double) { return false; }));
+}
+
 TEST(LaneGraph, SpeedLimitsCrosswalksSidewalksSignals) {
   const LaneGraph& g = test_graph();
   EXPECT_NEAR(g.speed_limit(g.require("a", -1, 10), 10).mps, 50 / 3.6, 1e-12);
