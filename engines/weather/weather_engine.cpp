@@ -11,6 +11,12 @@
 //       "none"), visibility_m, fog, surface, mu, wetness, snow_cover, sun_altitude_deg,
 //       sun_azimuth_deg, daylight, night, wind_speed_mps, wind_direction_deg, wind [x, y],
 //       seed.
+// Datapacks read:
+//   <ControlDataPack> ("weather_control")  optional JSON: any of the state keys (Precipitation,
+//       PrecipitationType, Visibility, Surface, SunAltitude, SunAzimuth, TimeOfDay, WindSpeed,
+//       WindDirection) and TransitionTime (s, default 0). From the step it arrives the keys
+//       move linearly to the new values over TransitionTime; from then on they no longer
+//       follow the Schedule (WeatherModel::control). The scenario engine's EnvironmentAction.
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -32,6 +38,7 @@ class WeatherEngine final : public Engine {
                                              int64_t) override {
     name_ = name;
     dp_name_ = config.value("DataPack", std::string("weather"));
+    control_name_ = config.value("ControlDataPack", std::string("weather_control"));
     try {
       model_ = std::make_unique<convoy::weather::WeatherModel>(config);
     } catch (const std::invalid_argument& e) {
@@ -58,8 +65,24 @@ class WeatherEngine final : public Engine {
 
   void set_datapack(const datapack::View& dp) override {
     if (dp.empty()) return;
-    throw std::runtime_error("weather engine '" + name_ + "' reads no datapack (got '" +
-                             dp.id().name() + "'); its Schedule changes the weather");
+    const std::string& name = dp.id().name();
+    if (name != control_name_) {
+      throw std::runtime_error("weather engine '" + name_ + "' reads only '" + control_name_ +
+                               "' (got '" + name + "'); its Schedule changes the weather");
+    }
+    if (!dp.is_json()) {
+      throw std::runtime_error("weather engine '" + name_ + "': " + name +
+                               ": expected a JSON datapack of weather keys");
+    }
+    try {
+      const nlohmann::json keys = datapack::read_json(dp);
+      if (model_->control(keys, static_cast<double>(time_ns_) * 1e-9, name)) {
+        std::fprintf(stderr, "weather engine '%s': t=%.3f s: %s\n", name_.c_str(),
+                     static_cast<double>(time_ns_) * 1e-9, keys.dump().c_str());
+      }
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error("weather engine '" + name_ + "': " + e.what());
+    }
   }
 
   void get_datapack(const engine::DataPackId&, datapack::Builder& out) override {
@@ -72,7 +95,7 @@ class WeatherEngine final : public Engine {
   }
 
  private:
-  std::string name_, dp_name_;
+  std::string name_, dp_name_, control_name_;
   std::unique_ptr<convoy::weather::WeatherModel> model_;
   int64_t time_ns_ = 0;
 };

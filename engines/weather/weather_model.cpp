@@ -68,6 +68,76 @@ std::pair<double, double> WeatherModel::sun_at(double hours) {
   return {altitude, azimuth};
 }
 
+void WeatherModel::read_keys(const json& obj, const std::string& where, bool strict,
+                             const std::vector<std::string>& allowed, Change* c) {
+  auto key = [&](const std::string& k) { return where.empty() ? k : where + "." + k; };
+  auto set = [&](int k, double v) {
+    c->has[k] = true;
+    c->to[k] = v;
+  };
+  if (strict) {
+    static const char* state_keys[] = {"Precipitation", "PrecipitationType", "Visibility",
+                                       "Surface",       "SunAltitude",       "SunAzimuth",
+                                       "TimeOfDay",     "WindSpeed",         "WindDirection"};
+    std::string list;
+    for (const auto& a : allowed) list += a + ", ";
+    for (const char* k : state_keys) list += std::string(k) + (k == state_keys[8] ? "" : ", ");
+    for (const auto& [k, v] : obj.items()) {
+      if (std::find(std::begin(state_keys), std::end(state_keys), k) == std::end(state_keys) &&
+          std::find(allowed.begin(), allowed.end(), k) == allowed.end())
+        bad(key(k), "unknown key (" + list + ")");
+    }
+  }
+  if (obj.contains("Precipitation")) {
+    const double p = number(obj, "Precipitation", key("Precipitation"));
+    if (p < 0 || p > 1) bad(key("Precipitation"), "must be in [0, 1], got " + std::to_string(p));
+    set(kPrecipitation, p);
+  }
+  if (obj.contains("PrecipitationType")) {
+    const json& v = obj["PrecipitationType"];
+    if (!v.is_string() || (v != "rain" && v != "snow"))
+      bad(key("PrecipitationType"), "expected \"rain\" or \"snow\", got " + v.dump());
+    c->precipitation_type = v.get<std::string>();
+  }
+  if (obj.contains("Visibility")) {
+    const double v = number(obj, "Visibility", key("Visibility"));
+    if (!(v > 0)) bad(key("Visibility"), "must be > 0 m, got " + obj["Visibility"].dump());
+    set(kVisibility, std::log(std::min(v, 1e7)));
+  }
+  if (obj.contains("Surface")) {
+    const json& v = obj["Surface"];
+    const SurfaceInfo* s = v.is_string() ? surface_named(v.get<std::string>()) : nullptr;
+    if (!s) bad(key("Surface"), "unknown surface " + v.dump() + " (dry, wet, snow, ice)");
+    c->surface = s->name;
+    set(kMu, s->mu);
+    set(kWetness, s->wetness);
+    set(kSnow, s->snow_cover);
+  }
+  if (obj.contains("TimeOfDay")) {
+    if (obj.contains("SunAltitude") || obj.contains("SunAzimuth"))
+      bad(key("TimeOfDay"), "give either TimeOfDay or SunAltitude/SunAzimuth, not both");
+    const double h = number(obj, "TimeOfDay", key("TimeOfDay"));
+    if (h < 0 || h > 24)
+      bad(key("TimeOfDay"), "must be in [0, 24] hours, got " + obj["TimeOfDay"].dump());
+    auto [alt, az] = sun_at(h);
+    set(kAltitude, alt);
+    set(kAzimuth, az);
+  }
+  if (obj.contains("SunAltitude")) {
+    const double a = number(obj, "SunAltitude", key("SunAltitude"));
+    if (a < -90 || a > 90) bad(key("SunAltitude"), "must be in [-90, 90] degrees");
+    set(kAltitude, a);
+  }
+  if (obj.contains("SunAzimuth")) set(kAzimuth, number(obj, "SunAzimuth", key("SunAzimuth")));
+  if (obj.contains("WindSpeed")) {
+    const double w = number(obj, "WindSpeed", key("WindSpeed"));
+    if (w < 0) bad(key("WindSpeed"), "must be >= 0 m/s, got " + obj["WindSpeed"].dump());
+    set(kWindSpeed, w);
+  }
+  if (obj.contains("WindDirection"))
+    set(kWindDirection, number(obj, "WindDirection", key("WindDirection")));
+}
+
 WeatherModel::WeatherModel(const json& config) {
   if (!config.is_object()) bad("config", "expected an object");
   initial_[kPrecipitation] = 0;
@@ -79,78 +149,8 @@ WeatherModel::WeatherModel(const json& config) {
   initial_surface_ = "dry";
   initial_type_ = "rain";
 
-  // Reads the state keys of `obj` (the config, or a schedule entry named `where`).
-  auto read = [&](const json& obj, const std::string& where, bool strict, Change* c) {
-    auto key = [&](const std::string& k) { return where.empty() ? k : where + "." + k; };
-    auto set = [&](int k, double v) {
-      c->has[k] = true;
-      c->to[k] = v;
-    };
-    if (strict) {
-      static const char* known[] = {
-          "Time",       "Transition", "Precipitation", "PrecipitationType",
-          "Visibility", "Surface",    "SunAltitude",   "SunAzimuth",
-          "TimeOfDay",  "WindSpeed",  "WindDirection"};
-      for (const auto& [k, v] : obj.items()) {
-        if (std::find(std::begin(known), std::end(known), k) == std::end(known))
-          bad(key(k),
-              "unknown key (Time, Transition, Precipitation, PrecipitationType, "
-              "Visibility, Surface, SunAltitude, SunAzimuth, TimeOfDay, WindSpeed, "
-              "WindDirection)");
-      }
-    }
-    if (obj.contains("Precipitation")) {
-      const double p = number(obj, "Precipitation", key("Precipitation"));
-      if (p < 0 || p > 1) bad(key("Precipitation"), "must be in [0, 1], got " + std::to_string(p));
-      set(kPrecipitation, p);
-    }
-    if (obj.contains("PrecipitationType")) {
-      const json& v = obj["PrecipitationType"];
-      if (!v.is_string() || (v != "rain" && v != "snow"))
-        bad(key("PrecipitationType"), "expected \"rain\" or \"snow\", got " + v.dump());
-      c->precipitation_type = v.get<std::string>();
-    }
-    if (obj.contains("Visibility")) {
-      const double v = number(obj, "Visibility", key("Visibility"));
-      if (!(v > 0)) bad(key("Visibility"), "must be > 0 m, got " + obj["Visibility"].dump());
-      set(kVisibility, std::log(std::min(v, 1e7)));
-    }
-    if (obj.contains("Surface")) {
-      const json& v = obj["Surface"];
-      const SurfaceInfo* s = v.is_string() ? surface_named(v.get<std::string>()) : nullptr;
-      if (!s) bad(key("Surface"), "unknown surface " + v.dump() + " (dry, wet, snow, ice)");
-      c->surface = s->name;
-      set(kMu, s->mu);
-      set(kWetness, s->wetness);
-      set(kSnow, s->snow_cover);
-    }
-    if (obj.contains("TimeOfDay")) {
-      if (obj.contains("SunAltitude") || obj.contains("SunAzimuth"))
-        bad(key("TimeOfDay"), "give either TimeOfDay or SunAltitude/SunAzimuth, not both");
-      const double h = number(obj, "TimeOfDay", key("TimeOfDay"));
-      if (h < 0 || h > 24)
-        bad(key("TimeOfDay"), "must be in [0, 24] hours, got " + obj["TimeOfDay"].dump());
-      auto [alt, az] = sun_at(h);
-      set(kAltitude, alt);
-      set(kAzimuth, az);
-    }
-    if (obj.contains("SunAltitude")) {
-      const double a = number(obj, "SunAltitude", key("SunAltitude"));
-      if (a < -90 || a > 90) bad(key("SunAltitude"), "must be in [-90, 90] degrees");
-      set(kAltitude, a);
-    }
-    if (obj.contains("SunAzimuth")) set(kAzimuth, number(obj, "SunAzimuth", key("SunAzimuth")));
-    if (obj.contains("WindSpeed")) {
-      const double w = number(obj, "WindSpeed", key("WindSpeed"));
-      if (w < 0) bad(key("WindSpeed"), "must be >= 0 m/s, got " + obj["WindSpeed"].dump());
-      set(kWindSpeed, w);
-    }
-    if (obj.contains("WindDirection"))
-      set(kWindDirection, number(obj, "WindDirection", key("WindDirection")));
-  };
-
   Change initial;
-  read(config, "", false, &initial);
+  read_keys(config, "", false, {}, &initial);
   for (int k = 0; k < kKeys; ++k)
     if (initial.has[k]) initial_[k] = initial.to[k];
   if (!initial.surface.empty()) initial_surface_ = initial.surface;
@@ -191,7 +191,7 @@ WeatherModel::WeatherModel(const json& config) {
         c.transition = number(e, "Transition", where + ".Transition");
         if (c.transition < 0) bad(where + ".Transition", "must be >= 0 s");
       }
-      read(e, where, true, &c);
+      read_keys(e, where, true, {"Time", "Transition"}, &c);
       changes_.push_back(std::move(c));
     }
     // Each change starts from the values its keys have at its time.
@@ -220,7 +220,39 @@ double WeatherModel::value_at(int key, double t, size_t changes_before) const {
   return v;
 }
 
+double WeatherModel::current(int key, double t) const {
+  for (auto it = controls_.rbegin(); it != controls_.rend(); ++it) {
+    if (it->time > t || !it->has[key]) continue;
+    const double f = it->transition > 0 ? std::min(1.0, (t - it->time) / it->transition) : 1.0;
+    return it->from[key] + (it->to[key] - it->from[key]) * f;
+  }
+  return value_at(key, t, changes_.size());
+}
+
+bool WeatherModel::control(const json& keys, double t, const std::string& where) {
+  if (!keys.is_object()) bad(where, "expected a JSON object of weather keys, got " + keys.dump());
+  if (keys == last_control_) return false;
+  Change c;
+  c.time = t;
+  if (keys.contains("TransitionTime")) {
+    c.transition = number(keys, "TransitionTime", where + ".TransitionTime");
+    if (c.transition < 0)
+      bad(where + ".TransitionTime", "must be >= 0 s, got " + keys["TransitionTime"].dump());
+  }
+  read_keys(keys, where, true, {"TransitionTime"}, &c);
+  for (int k = 0; k < kKeys; ++k) {
+    if (!c.has[k]) continue;
+    c.from[k] = current(k, t);
+    if (k == kAzimuth || k == kWindDirection) c.to[k] = c.from[k] + wrap180(c.to[k] - c.from[k]);
+  }
+  controls_.push_back(std::move(c));
+  last_control_ = keys;
+  return true;
+}
+
 void WeatherModel::reset() {
+  controls_.clear();
+  last_control_ = json();
   rng_.seed(seed_);
   gust_ = 0;
   last_t_ = -1;
@@ -238,34 +270,47 @@ const WeatherState& WeatherModel::advance(double t) {
     last_t_ = t;
   }
   WeatherState& s = state_;
-  const size_t all = changes_.size();
   s.time_s = t;
   s.seed = seed_;
-  s.precipitation = std::clamp(value_at(kPrecipitation, t, all), 0.0, 1.0);
-  s.visibility_m = std::exp(value_at(kVisibility, t, all));
-  s.mu = value_at(kMu, t, all);
-  s.wetness = value_at(kWetness, t, all);
-  s.snow_cover = value_at(kSnow, t, all);
-  s.sun_altitude_deg = value_at(kAltitude, t, all);
-  s.sun_azimuth_deg = std::fmod(value_at(kAzimuth, t, all) + 720.0, 360.0);
+  s.precipitation = std::clamp(current(kPrecipitation, t), 0.0, 1.0);
+  s.visibility_m = std::exp(current(kVisibility, t));
+  s.mu = current(kMu, t);
+  s.wetness = current(kWetness, t);
+  s.snow_cover = current(kSnow, t);
+  s.sun_altitude_deg = current(kAltitude, t);
+  s.sun_azimuth_deg = std::fmod(current(kAzimuth, t) + 720.0, 360.0);
   s.daylight = smoothstep(-6.0, 6.0, s.sun_altitude_deg);
   s.night = s.sun_altitude_deg < 0;
-  const double base = value_at(kWindSpeed, t, all);
+  const double base = current(kWindSpeed, t);
   s.wind_speed_mps = std::max(0.0, base * (1.0 + gusts_ * gust_));
-  s.wind_direction_deg = std::fmod(value_at(kWindDirection, t, all) + 720.0, 360.0);
+  s.wind_direction_deg = std::fmod(current(kWindDirection, t) + 720.0, 360.0);
   const double dir = s.wind_direction_deg * std::numbers::pi / 180.0;
   s.wind_x = s.wind_speed_mps * std::cos(dir);
   s.wind_y = s.wind_speed_mps * std::sin(dir);
-  // The surface named: the last change's target once it is half done.
+  // The surface named: the last change's target once it is half done; the precipitation
+  // type: the last change's. A control overrides the Schedule's later changes of the same.
+  double surface_ctl = INFINITY, type_ctl = INFINITY;  // time of the first control naming it
+  for (const Change& c : controls_) {
+    if (c.time > t) break;
+    if (!c.surface.empty()) surface_ctl = std::min(surface_ctl, c.time);
+    if (!c.precipitation_type.empty()) type_ctl = std::min(type_ctl, c.time);
+  }
   s.surface = initial_surface_;
   s.precipitation_type = initial_type_;
-  for (const Change& c : changes_) {
-    if (c.time > t) break;
-    if (!c.precipitation_type.empty()) s.precipitation_type = c.precipitation_type;
-    if (!c.surface.empty()) {
+  auto apply = [&](const Change& c, bool surface_ok, bool type_ok) {
+    if (type_ok && !c.precipitation_type.empty()) s.precipitation_type = c.precipitation_type;
+    if (surface_ok && !c.surface.empty()) {
       const double f = c.transition > 0 ? (t - c.time) / c.transition : 1.0;
       if (f >= 0.5) s.surface = c.surface;
     }
+  };
+  for (const Change& c : changes_) {
+    if (c.time > t) break;
+    apply(c, c.time < surface_ctl, c.time < type_ctl);
+  }
+  for (const Change& c : controls_) {
+    if (c.time > t) break;
+    apply(c, true, true);
   }
   return s;
 }

@@ -19,6 +19,13 @@
 //   the sun on a simple path: up at 6, highest (60 degrees, south) at 12, down at 18),
 //   WindSpeed (m/s), WindDirection (degrees, where the wind blows towards, counter-clockwise
 //   from world +x), Gusts (0-1), Schedule ([{Time, Transition, <state keys>}], in time order).
+//
+// Control at run time: control(keys, t) takes a dict of state keys plus TransitionTime (s,
+// default 0) at simulated time t (the `weather` engine's ControlDataPack). From t the keys it
+// names move linearly from their value at t to the new ones over TransitionTime, as a
+// Schedule entry would; from then on the Schedule no longer moves those keys (the control
+// overrides it; a later control overrides an earlier one). Keys it does not name go on as
+// before. The same control received again (equal content) is ignored.
 #pragma once
 
 #include <cstdint>
@@ -68,6 +75,10 @@ class WeatherModel {
   const WeatherState& advance(double t);
   const WeatherState& state() const { return state_; }
   void reset();
+  // A change at run time from simulated time t (>= the last advance's); throws
+  // std::invalid_argument naming "<where>.<Key>" on bad input. Returns false when it was the
+  // same as the previous control (ignored).
+  bool control(const nlohmann::json& keys, double t, const std::string& where);
 
   // The sun's (altitude, azimuth) in degrees at `hours` on the simple path (see above).
   static std::pair<double, double> sun_at(double hours);
@@ -93,12 +104,22 @@ class WeatherModel {
     std::string surface, precipitation_type;
   };
   double value_at(int key, double t, size_t changes_before) const;
+  // With the run-time controls: the last control naming the key at or before t wins, from the
+  // value the key had when it came; else the Schedule.
+  double current(int key, double t) const;
+  // Reads the state keys of `obj` into c; `allowed` are the keys accepted besides the state
+  // keys (unknown keys are errors when strict); errors name where.Key (Key alone when where
+  // is empty).
+  static void read_keys(const nlohmann::json& obj, const std::string& where, bool strict,
+                        const std::vector<std::string>& allowed, Change* c);
 
   double initial_[kKeys] = {};
   std::string initial_surface_, initial_type_;
   double gusts_ = 0;
   uint64_t seed_ = 0;
   std::vector<Change> changes_;
+  std::vector<Change> controls_;  // run-time changes, in order of arrival
+  nlohmann::json last_control_;
   std::mt19937_64 rng_;
   double gust_ = 0, last_t_ = -1;
   WeatherState state_;

@@ -157,5 +157,84 @@ TEST(WeatherModel, BadInputNamesTheKey) {
   EXPECT_EQ(error_of(R"({"WindSpeed": -1})").rfind("WindSpeed: must be >= 0", 0), 0u);
 }
 
+TEST(WeatherModel, ControlAtOnceAndOverTime) {
+  WeatherModel m(json::parse(R"({"Gusts": 0})"));
+  m.advance(1.0);
+  // At once: from the step it arrives.
+  EXPECT_TRUE(m.control(json::parse(R"({"Precipitation": 0.6, "Surface": "wet"})"), 1.0, "wc"));
+  EXPECT_DOUBLE_EQ(m.advance(1.05).precipitation, 0.6);
+  EXPECT_EQ(m.state().surface, "wet");
+  EXPECT_DOUBLE_EQ(m.state().mu, 0.5);
+  EXPECT_NEAR(m.state().visibility_m, 20000.0, 1e-6);  // not named: unchanged
+  // Over 10 s, linearly (visibility in log space), from the value it has when it arrives.
+  EXPECT_TRUE(m.control(json::parse(R"({"Precipitation": 0.0, "Visibility": 200,
+                                        "WindDirection": 350, "TransitionTime": 10})"),
+                        2.0, "wc"));
+  EXPECT_NEAR(m.advance(7.0).precipitation, 0.3, 1e-12);
+  EXPECT_NEAR(m.state().visibility_m, 2000.0, 1e-6);       // geometric mean of 20000 and 200
+  EXPECT_NEAR(m.state().wind_direction_deg, 355.0, 1e-9);  // the short way round
+  EXPECT_NEAR(m.advance(12.0).precipitation, 0.0, 1e-12);
+  EXPECT_NEAR(m.state().visibility_m, 200.0, 1e-9);
+  // The same control again is ignored (it does not restart the transition).
+  EXPECT_FALSE(m.control(json::parse(R"({"Precipitation": 0.0, "Visibility": 200,
+                                         "WindDirection": 350, "TransitionTime": 10})"),
+                         12.0, "wc"));
+}
+
+TEST(WeatherModel, ControlOverridesTheSchedule) {
+  WeatherModel m(json::parse(R"({"Schedule": [
+      {"Time": 0, "Precipitation": 1.0, "Transition": 10},
+      {"Time": 20, "Precipitation": 0.2, "Visibility": 500, "Surface": "snow"}]})"));
+  m.advance(5.0);
+  // Half way through the Schedule's rain, a control takes precipitation to 0 over 5 s.
+  m.control(json::parse(R"({"Precipitation": 0.0, "TransitionTime": 5, "Surface": "ice"})"), 5.0,
+            "wc");
+  EXPECT_NEAR(m.advance(7.5).precipitation, 0.25, 1e-12);
+  EXPECT_EQ(m.state().surface, "ice");  // half way
+  EXPECT_NEAR(m.advance(15.0).precipitation, 0.0, 1e-12);
+  // The Schedule's later change no longer moves the keys the control named ...
+  EXPECT_NEAR(m.advance(25.0).precipitation, 0.0, 1e-12);
+  EXPECT_EQ(m.state().surface, "ice");
+  EXPECT_DOUBLE_EQ(m.state().mu, 0.1);
+  // ... but still the others.
+  EXPECT_NEAR(m.state().visibility_m, 500.0, 1e-9);
+  // reset() forgets the controls.
+  m.reset();
+  EXPECT_NEAR(m.advance(25.0).precipitation, 0.2, 1e-12);
+  EXPECT_EQ(m.state().surface, "snow");
+}
+
+std::string control_error(const char* keys) {
+  WeatherModel m(json::object());
+  try {
+    m.control(json::parse(keys), 0.0, "weather_control");
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(WeatherModel, BadControlNamesTheKey) {
+  EXPECT_EQ(control_error(R"({"Surface": "mud"})")
+                .rfind("weather_control.Surface: unknown surface \"mud\"", 0),
+            0u);
+  EXPECT_EQ(
+      control_error(R"({"Visibility": -5})").rfind("weather_control.Visibility: must be > 0", 0),
+      0u);
+  EXPECT_EQ(control_error(R"({"Rain": 1})").rfind("weather_control.Rain: unknown key", 0), 0u)
+      << control_error(R"({"Rain": 1})");
+  EXPECT_EQ(control_error(R"({"Time": 1})").rfind("weather_control.Time: unknown key", 0), 0u);
+  EXPECT_EQ(control_error(R"({"TransitionTime": -1})")
+                .rfind("weather_control.TransitionTime: must be >= 0", 0),
+            0u);
+  EXPECT_EQ(control_error(R"({"Precipitation": "heavy"})")
+                .rfind("weather_control.Precipitation: expected a number", 0),
+            0u);
+  EXPECT_EQ(control_error(R"({"TimeOfDay": 12, "SunAltitude": 10})")
+                .rfind("weather_control.TimeOfDay: give either", 0),
+            0u);
+  EXPECT_EQ(control_error(R"([1, 2])").rfind("weather_control: expected a JSON object", 0), 0u);
+}
+
 }  // namespace
 }  // namespace convoy::weather
