@@ -21,10 +21,14 @@ Datapacks:
   out `commands`    {"time_ns", "entities": {engine: command}, "weather": {...} | absent}:
                     command = the union of the entity's running actions' targets
                     (`speed`, `lane`, `route`, `trajectory`, `teleport`), every key optional
-  out `scenario`    {"time_ns", "t", "done", "reason", "states": {element: state},
+  out `scenario`    {"time_ns", "t", "done", "ending", "reason", "states": {element: state},
                     "transitions": [[t, type, element, transition]], "running":
                     [[action, actor, kind]], "file"}
   out `route`       {"points": [[x, y], ...], "length"} (the ego's route; empty without one)
+
+The run ends one step after the storyboard ends (or the ego passed its route's end: "ending"),
+so that the last commands reach their engines: "done" is set then, and the status function
+(status.py) ends the run.
 
 Errors of the storyboard end the run with one line naming the file, the element and its line
 (the engine program keeps only the ScenarioError's message)."""
@@ -177,6 +181,7 @@ class Script(EngineScript):
         self.route = read_route(cfg.get("EgoRoute"), os.path.dirname(self.file))
         self.end_at_route_end = bool(cfg.get("EndAtRouteEnd", True)) and len(self.route) >= 2
         self.done = False
+        self.ending = False   # ended at the last step: done at the next
         self.reason = ""
         self.missing_since = None
         for dp in ("road_users", "commands", "scenario", "route"):
@@ -211,6 +216,14 @@ class Script(EngineScript):
         t = self._time_ns * 1e-9
         if self.done:
             return
+        if self.ending:
+            # one step after the end, so that the last step's commands reached their engines
+            self.done = True
+            self._setDataPack("commands", {"time_ns": self._time_ns, "entities": {}})
+            self._setDataPack("scenario", dict(self._getDataPack("scenario"), time_ns=self._time_ns,
+                                               t=t, done=True, transitions=[], running=[]))
+            print("scenario %s done at t=%.2f (%s)" % (self.base, t, self.reason), flush=True)
+            return
         world = self._world()
         missing = [n for n in sorted(self.entities) if n not in world]
         if missing:
@@ -232,12 +245,12 @@ class Script(EngineScript):
             out["weather"] = weather
         self._setDataPack("commands", out)
         if result.done:
-            self.done, self.reason = True, "storyboard"
+            self.ending, self.reason = True, "storyboard"
         elif self.end_at_route_end and self.ego in world and \
                 past_route_end(self.route, world[self.ego]["x"], world[self.ego]["y"]):
-            self.done, self.reason = True, "route_end"
+            self.ending, self.reason = True, "route_end"
         self._setDataPack("scenario", {
-            "time_ns": self._time_ns, "t": t, "done": self.done, "reason": self.reason,
+            "time_ns": self._time_ns, "t": t, "done": False, "ending": self.ending, "reason": self.reason,
             "states": dict([("Storyboard", self.board.root.state)] + [
                 (path, el.state) for (_, path), el in sorted(self.board.elements.items())]),
             "transitions": [[tr.time, tr.element_type, tr.element, tr.transition]
@@ -246,8 +259,6 @@ class Script(EngineScript):
             "file": self.base})
         for tr in result.transitions:
             print("t=%.2f %s %s %s" % (tr.time, tr.element_type, tr.element, tr.transition), flush=True)
-        if self.done:
-            print("scenario %s done at t=%.2f (%s)" % (self.base, t, self.reason), flush=True)
 
     def shutdown(self):
         if getattr(self, "odr", None) is not None:

@@ -83,6 +83,8 @@ class OdrQuery:
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait()
+        for f in (self.proc.stdout, self.proc.stderr):
+            f.close()
 
     def __enter__(self):
         return self
