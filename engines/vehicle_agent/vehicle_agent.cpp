@@ -7,11 +7,17 @@
 // (politeness, threshold, b_safe) into a lane the lane graph allows a change to. Inputs are
 // acted on ReactionTime late. Deterministic: no wall clock, the only randomness is Seed's.
 //
-// Config keys (schema.json): Map, Route {from, to} ("ROAD:LANE") or Seed, StartS,
-// InitialSpeed, Model, Category, Length, Width, Height, Wheelbase, v0, SpeedLimitFactor, T,
-// s0, a, b, delta, MaxDeceleration, politeness, threshold, b_safe, LaneChanges, ReactionTime,
-// NeighbourRadius, StateDataPack, NeighboursDataPack, TrafficLightsDataPack, WeatherDataPack,
-// WeatherAdaptation.
+// Config keys (schema.json): Map, Route {from, to} ("ROAD:LANE") or Seed, StartS, Position,
+// StartPose, InitialSpeed, Model, Category, Length, Width, Height, Wheelbase, v0,
+// SpeedLimitFactor, T, s0, a, b, delta, MaxDeceleration, politeness, threshold, b_safe,
+// JunctionYielding, LaneChanges, Respawn, RespawnDelay, ReactionTime, NeighbourRadius,
+// StateDataPack, NeighboursDataPack, TrafficLightsDataPack, WeatherDataPack,
+// WeatherAdaptation, CommandDataPack.
+//
+// StartPose {x, y, yaw}: it starts exactly there and localises on the nearest driving lane
+// whose direction is within 60 degrees of yaw (docs/road_users.md, "Commands"); with Route.to
+// it is routed there, without a Route it follows the lane graph onward, choosing at each fork
+// by Seed, for as long as the lane graph goes on.
 //
 // Datapacks written:
 //   <StateDataPack> ("state")  convoy.data.RoadUser: its state after each step, with
@@ -22,6 +28,11 @@
 //                    users around it (its own id is skipped).
 //   <TrafficLightsDataPack> ("traffic_lights")  JSON {"time_ns", "signals": {"<signal id>":
 //                    "red"|"yellow"|"green"|"red_yellow"|"off"}}; a missing signal is green.
+//   <CommandDataPack> ("command")  optional JSON, the scenario engine's commands for this
+//                    step (docs/road_users.md, "Commands"): speed, lane, route, trajectory,
+//                    teleport. Each overrides its control domain (longitudinal, lateral) of
+//                    the AI for the step it is given in, at once (no ReactionTime); when a
+//                    command stops coming the AI takes over from the present state.
 //   <WeatherDataPack> ("weather")  optional: the weather engine's JSON. With WeatherAdaptation
 //                    (default on) it drives as people do in bad weather (docs/weather.md):
 //                    on a road of friction mu (0.8 dry) its desired speed is
@@ -30,6 +41,7 @@
 //                    up to 30 % more and its speed is capped so that it stops within V (1.5 s
 //                    of reaction plus braking at 0.5 mu g).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -56,7 +68,9 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double kSampleDs = 0.5;  // m between the path's poses
+constexpr double kSampleDs = 0.5;      // m between the path's poses
+constexpr double kOnwardLength = 600;  // m of lane graph planned ahead when following it onward
+constexpr double kHeadingTolerance = 60.0 * M_PI / 180.0;  // localising: lane direction vs yaw
 
 struct Idm {
   double v0 = 13.9, T = 1.5, s0 = 2.0, a = 1.5, b = 2.0, delta = 4.0;
@@ -134,6 +148,48 @@ struct Snapshot {
   std::shared_ptr<const json> lights;
 };
 
+using Points = std::vector<std::array<double, 2>>;
+
+// One step's command from the scenario engine (docs/road_users.md, "Commands").
+struct Command {
+  struct Speed {
+    double speed = 0;
+    std::optional<double> acceleration;
+  };
+  struct Lane {
+    std::string road;
+    int lane = 0, from_lane = 0;
+    double offset = 0, progress = 0;
+  };
+  struct Pose {
+    double x = 0, y = 0, yaw = 0;
+    std::optional<double> speed;
+  };
+  std::optional<Speed> speed;
+  std::optional<Lane> lane;
+  std::optional<Points> route;
+  std::optional<Pose> timed;       // trajectory with a timing: the pose to take
+  std::optional<Points> polyline;  // trajectory without: the path to follow
+  std::optional<Pose> teleport;
+};
+
+// A lane command under way: the path is the target lane's, the agent `lateral` m left of it.
+struct LaneRun {
+  bool active = false;
+  std::string road;
+  int lane = 0, from_lane = 0;
+  double d_from = 0;  // the from lane's centre, left of the target lane's (m)
+  double e0 = 0;      // the agent's offset from the from lane's centre when it began
+  double progress = 0, lateral = 0;
+  int side = 0;  // +1 to the left, -1 to the right
+};
+
+// A point its route passes: (lane, s) on the lane graph.
+struct Goal {
+  odr::LaneIndex lane = odr::kNoLane;
+  double s = 0;
+};
+
 }  // namespace
 
 class VehicleAgent final : public Engine {
@@ -176,6 +232,31 @@ class VehicleAgent final : public Engine {
   // is red and its front has not passed the light's stop line.
   bool red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const;
   const Snapshot* perceived() const;
+  // Commands and localisation (docs/road_users.md, "Commands").
+  Command parse_command(const std::string& dp, const json& j) const;
+  Points parse_points(const std::string& key, const json& v, size_t min_points) const;
+  std::optional<odr::LanePosition> locate_drivable(double x, double y, double yaw,
+                                                   double max_distance) const;
+  // The lane graph onward from (lane, s), at each fork a choice drawn from Seed, until
+  // `length` m or a dead end (*open: false).
+  odr::LaneRoute onward(odr::LaneIndex lane, double s, double length, bool* open);
+  // A route from (lane, s) through goals_[first..] and then, when onward_, onward. nullopt
+  // with *failed = the index of the goal it cannot reach.
+  std::optional<odr::LaneRoute> route_from(odr::LaneIndex lane, double s, size_t first,
+                                           size_t* failed);
+  // The route on from (lane, s): through its goals when it can still reach them, else
+  // onward (its goals given up).
+  odr::LaneRoute plan_from(odr::LaneIndex lane, double s);
+  void set_path(const odr::LaneRoute& route);
+  void compute_goal_arcs();
+  // Onto the nearest lane from its present pose and a route on from there; false when no
+  // driving lane is near (it stops where it is).
+  bool relocalise();
+  void apply_route(const Points& positions);
+  void begin_lane(const Command::Lane& c);
+  void set_polyline(const Points& points);
+  // Onward: the route from 30 m behind it on, plus the lane graph onward from its end.
+  void extend();
 
   std::string name_;
   std::unique_ptr<odr::Network> net_;
@@ -193,8 +274,12 @@ class VehicleAgent final : public Engine {
   double speed_factor_ = 1.0, visibility_speed_ = INFINITY;
   void adapt_to_weather(double mu, double visibility_m);
   odr::LaneRoute initial_route_;
-  odr::LaneIndex dest_lane_ = odr::kNoLane;
-  double dest_s_ = 0;
+  std::vector<Goal> initial_goals_;
+  bool initial_onward_ = false;
+  std::optional<odr::Pose2> start_pose_;
+  std::string command_dp_;
+  uint64_t seed_ = 0;
+  std::mt19937_64 initial_rng_;  // after the initial route's choices
 
   // State.
   int64_t timestep_ns_ = 0, time_ns_ = 0;
@@ -215,6 +300,24 @@ class VehicleAgent final : public Engine {
   data::RoadUser state_;
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
+  // Route state: the points still to pass (with their arcs on path_), and whether the route
+  // goes on along the lane graph after them (else it ends: absent).
+  std::vector<Goal> goals_;
+  std::vector<double> goal_arcs_;
+  bool onward_ = false;
+  bool open_end_ = false;  // path_ ends where the lane graph goes on (onward: extend it)
+  bool initial_open_end_ = false;
+  std::mt19937_64 rng_;  // onward choices
+  // Commands.
+  std::optional<Command> command_;  // for the coming step
+  std::optional<double> commanded_acc_;
+  LaneRun lane_run_;
+  Points last_route_;
+  Points polyline_;
+  Path traj_path_;
+  bool off_path_ = false;  // a command moved it off path_: relocalise when the AI takes over
+  bool lost_ = false;      // no driving lane near: it stops and looks again every second
+  int64_t next_look_ns_ = 0;
 };
 
 std::pair<std::string, int> VehicleAgent::parse_lane(const std::string& key, const json& v) const {
@@ -414,15 +517,82 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   lights_dp_ = config.at("TrafficLightsDataPack").get<std::string>();
   weather_dp_ = config.at("WeatherDataPack").get<std::string>();
   weather_adaptation_ = config.at("WeatherAdaptation").get<bool>();
+  command_dp_ = config.at("CommandDataPack").get<std::string>();
   base_idm_ = idm_;
+  seed_ = config.at("Seed").get<uint64_t>();
+  rng_.seed(seed_ * 0x9E3779B97F4A7C15ull + 0x0A7Eull);
 
-  initial_route_ = pick_route(config, config.at("Seed").get<uint64_t>());
-  const auto& last = initial_route_.segments.back();
-  dest_lane_ = last.lane;
-  dest_s_ = last.s_to;
+  const json& sp = config.at("StartPose");
+  if (!sp.is_object()) fail("StartPose", "expected {\"x\": ..., \"y\": ..., \"yaw\": ...}");
+  if (!sp.empty()) {
+    for (const auto& [k, v] : sp.items()) {
+      if (k != "x" && k != "y" && k != "yaw")
+        fail("StartPose", "unknown key \"" + k + "\" (x, y, yaw)");
+      if (!v.is_number() || !std::isfinite(v.get<double>()))
+        fail("StartPose." + k, "expected a number");
+    }
+    if (!sp.contains("x") || !sp.contains("y") || !sp.contains("yaw"))
+      fail("StartPose", "expected numbers \"x\", \"y\" and \"yaw\"");
+    const json& r = config.at("Route");
+    if (!r.is_object()) fail("Route", "expected {\"to\": \"ROAD:LANE\"} with StartPose");
+    for (const auto& [k, v] : r.items()) {
+      if (k != "to")
+        fail("Route." + k, "give StartPose or Route.from, not both (Route: {\"to\"} only)");
+    }
+    if (config.at("Position").is_object() && !config.at("Position").empty())
+      fail("StartPose", "give Position or StartPose, not both");
+    if (start_s_ > 0) fail("StartS", "give StartS or StartPose, not both");
+    odr::Pose2 pose;
+    pose.x = sp["x"].get<double>();
+    pose.y = sp["y"].get<double>();
+    pose.heading = sp["yaw"].get<double>();
+    start_pose_ = pose;
+    char where[96];
+    std::snprintf(where, sizeof where, "(%.2f, %.2f)", pose.x, pose.y);
+    const auto loc = locate_drivable(pose.x, pose.y, pose.heading, 50.0);
+    if (!loc)
+      fail("StartPose",
+           std::string(where) + " is not within 50 m of a driving lane of " + net_->source);
+    goals_.clear();
+    onward_ = !r.contains("to");
+    if (r.contains("to")) {
+      const auto [tr, tl] = parse_lane("Route.to", r["to"]);
+      if (!net_->find_road(tr))
+        fail("Route.to", "road " + tr + " is not in the map " + net_->source);
+      odr::LaneIndex dest = odr::kNoLane;
+      try {
+        dest = graph_->exit_lane(tr, tl);
+      } catch (const std::exception& e) {
+        fail("Route.to", e.what());
+      }
+      const odr::LaneNode& dn = graph_->lane(dest);
+      if (!dn.drivable())
+        fail("Route.to", "lane " + tr + ":" + std::to_string(tl) + " is a " + dn.type +
+                             " lane, not a driving lane");
+      goals_.push_back({dest, dn.forward ? dn.s1 : dn.s0});
+    }
+    size_t failed = 0;
+    auto route = route_from(loc->lane, loc->s, 0, &failed);
+    if (!route) {
+      fail("Route", std::string("no route from StartPose ") + where + " (" + loc->road_id + ":" +
+                        std::to_string(loc->lane_id) + ") to " + r["to"].get<std::string>());
+    }
+    initial_route_ = *route;
+  } else {
+    initial_route_ = pick_route(config, seed_);
+    const auto& last = initial_route_.segments.back();
+    goals_ = {{last.lane, last.s_to}};
+    onward_ = false;
+    open_end_ = false;
+  }
+  initial_goals_ = goals_;
+  initial_onward_ = onward_;
+  initial_open_end_ = open_end_;
+  initial_rng_ = rng_;
   {
     Path p = make_path(initial_route_);
-    if (p.poses.size() < 2) fail("Route", "the route is empty");
+    if (p.poses.size() < 2)
+      fail(start_pose_ ? "StartPose" : "Route", "the route is empty (a dead end there)");
     if (start_s_ >= p.length())
       fail("StartS", "placed off its route: " + std::to_string(start_s_) +
                          " m is beyond the route's end (" + std::to_string(p.length()) + " m)");
@@ -449,11 +619,15 @@ bool VehicleAgent::start_free() const {
 
 void VehicleAgent::restart() {
   path_ = make_path(initial_route_);
+  goals_ = initial_goals_;
+  onward_ = initial_onward_;
+  open_end_ = initial_open_end_;
   arc_ = start_s_;
-  const odr::Pose2 p = path_.at(arc_);
+  const odr::Pose2 p = start_pose_ ? *start_pose_ : path_.at(arc_);
   x_ = p.x;
   y_ = p.y;
   yaw_ = p.heading;
+  if (start_pose_) arc_ = path_.project(x_, y_).arc;
   v_ = initial_speed_;
   acc_ = 0;
   yaw_rate_ = 0;
@@ -461,17 +635,26 @@ void VehicleAgent::restart() {
   changing_ = 0;
   next_mobil_ns_ = time_ns_;
   cursor_ = path_.project(x_, y_).index;
+  compute_goal_arcs();
+  lane_run_ = {};
+  off_path_ = lost_ = false;
+  commanded_acc_.reset();
 }
 
 void VehicleAgent::start() {
   path_ = make_path(initial_route_);
+  goals_ = initial_goals_;
+  onward_ = initial_onward_;
+  open_end_ = initial_open_end_;
+  rng_ = initial_rng_;
   time_ns_ = 0;
   arc_ = start_s_;
-  const odr::Pose2 p = path_.at(arc_);
+  const odr::Pose2 p = start_pose_ ? *start_pose_ : path_.at(arc_);
   initial_path_start_ = p;
   x_ = p.x;
   y_ = p.y;
   yaw_ = p.heading;
+  if (start_pose_) arc_ = path_.project(x_, y_).arc;
   v_ = initial_speed_;
   acc_ = 0;
   yaw_rate_ = 0;
@@ -483,6 +666,14 @@ void VehicleAgent::start() {
   last_neighbours_.reset();
   last_lights_.reset();
   cursor_ = path_.project(x_, y_).index;
+  compute_goal_arcs();
+  command_.reset();
+  commanded_acc_.reset();
+  lane_run_ = {};
+  last_route_.clear();
+  polyline_.clear();
+  off_path_ = lost_ = false;
+  next_look_ns_ = 0;
   state_.Clear();
   state_.set_id(name_);
   state_.set_category(category_);
@@ -639,12 +830,32 @@ void VehicleAgent::consider_lane_change() {
     // else any route there.
     odr::RouteOptions keep;
     keep.lane_changes = false;
-    const odr::LaneNode& dest = graph_->lane(dest_lane_);
     std::optional<odr::LaneRoute> route;
-    const int dest_id = dest.lane_id + (tl.lane_id - lane.lane_id);
-    const odr::LaneIndex dest2 = graph_->find(dest.road->id, dest_id, dest_s_);
-    if (dest2 != odr::kNoLane) route = graph_->route(target, loc->s, dest2, dest_s_, keep);
-    if (!route) route = graph_->route(target, loc->s, dest_lane_, dest_s_);
+    if (!goals_.empty()) {
+      const Goal& g = goals_.front();
+      const odr::LaneNode& dest = graph_->lane(g.lane);
+      const int dest_id = dest.lane_id + (tl.lane_id - lane.lane_id);
+      const odr::LaneIndex dest2 = graph_->find(dest.road->id, dest_id, g.s);
+      if (dest2 != odr::kNoLane) route = graph_->route(target, loc->s, dest2, g.s, keep);
+      if (!route) route = graph_->route(target, loc->s, g.lane, g.s);
+      if (route && !route->segments.empty() && (goals_.size() > 1 || onward_)) {
+        // On through the other goals (and onward) from where it reaches the first.
+        size_t failed = 0;
+        const auto& end = route->segments.back();
+        auto rest = route_from(end.lane, end.s_to, 1, &failed);
+        if (!rest) continue;
+        for (auto& seg : rest->segments) {
+          if (seg.lane == route->segments.back().lane &&
+              std::abs(seg.s_from - route->segments.back().s_to) < 1e-9 && !seg.lane_change) {
+            route->segments.back().s_to = seg.s_to;
+          } else {
+            route->segments.push_back(seg);
+          }
+        }
+      }
+    } else if (onward_) {
+      route = onward(target, loc->s, kOnwardLength, &open_end_);
+    }
     if (!route || route->segments.empty()) continue;
     Path p = make_path(*route);
     if (p.poses.size() < 2) continue;
@@ -652,6 +863,7 @@ void VehicleAgent::consider_lane_change() {
     const auto pr = path_.project(x_, y_);
     cursor_ = pr.index;
     arc_ = pr.arc;
+    compute_goal_arcs();
     changing_ = side;
     return;
   }
@@ -745,13 +957,454 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
   return INFINITY;
 }
 
+Points VehicleAgent::parse_points(const std::string& key, const json& v, size_t min_points) const {
+  if (!v.is_array() || v.size() < min_points)
+    fail(key, "expected a list of at least " + std::to_string(min_points) + " points [x, y], got " +
+                  v.dump().substr(0, 80));
+  Points out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const json& p = v[i];
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    if (!p.is_array() || p.size() < 2 || p.size() > 3)
+      fail(k, "expected a point [x, y] (or [x, y, z]), got " + p.dump().substr(0, 80));
+    for (const json& c : p) {
+      if (!c.is_number() || !std::isfinite(c.get<double>()))
+        fail(k, "expected numbers, got " + p.dump().substr(0, 80));
+    }
+    out.push_back({p[0].get<double>(), p[1].get<double>()});
+  }
+  return out;
+}
+
+Command VehicleAgent::parse_command(const std::string& dp, const json& j) const {
+  if (!j.is_object()) fail(dp, "expected a JSON object of commands, got " + j.dump().substr(0, 80));
+  auto object = [&](const std::string& key, const json& v,
+                    std::initializer_list<const char*> known) -> const json& {
+    if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
+    for (const auto& [k, x] : v.items()) {
+      bool ok = false;
+      std::string list;
+      for (const char* n : known) {
+        ok = ok || k == n;
+        list += std::string(list.empty() ? "" : ", ") + n;
+      }
+      if (!ok) fail(key + "." + k, "unknown key (" + list + ")");
+    }
+    return v;
+  };
+  auto number = [&](const std::string& key, const json& obj, const char* k) {
+    if (!obj.contains(k)) fail(key + "." + k, "missing (a number)");
+    const json& v = obj[k];
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      fail(key + "." + k, "expected a number, got " + v.dump().substr(0, 80));
+    return v.get<double>();
+  };
+  auto pose = [&](const std::string& key, const json& v, bool speed_needed) {
+    object(key, v, {"x", "y", "z", "yaw", "speed"});
+    Command::Pose p;
+    p.x = number(key, v, "x");
+    p.y = number(key, v, "y");
+    p.yaw = number(key, v, "yaw");
+    if (v.contains("z")) number(key, v, "z");
+    if (v.contains("speed") || speed_needed) {
+      p.speed = number(key, v, "speed");
+      if (*p.speed < 0) fail(key + ".speed", "must be >= 0 m/s (reversing is not modelled)");
+    }
+    return p;
+  };
+  Command c;
+  for (const auto& [k, v] : j.items()) {
+    const std::string key = dp + "." + k;
+    if (k == "time_ns") {
+      if (!v.is_number()) fail(key, "expected a number (ns)");
+    } else if (k == "speed") {
+      object(key, v, {"speed", "target_speed", "acceleration"});
+      Command::Speed sp;
+      sp.speed = number(key, v, "speed");
+      if (sp.speed < 0) fail(key + ".speed", "must be >= 0 m/s (reversing is not modelled)");
+      if (v.contains("target_speed")) number(key, v, "target_speed");
+      if (v.contains("acceleration")) sp.acceleration = number(key, v, "acceleration");
+      c.speed = sp;
+    } else if (k == "lane") {
+      object(key, v, {"road", "lane", "from_lane", "offset", "progress"});
+      Command::Lane ln;
+      if (!v.contains("road") || !v["road"].is_string())
+        fail(key + ".road", "expected the road's id as a string");
+      ln.road = v["road"].get<std::string>();
+      const odr::Road* road = net_->find_road(ln.road);
+      if (!road) fail(key + ".road", "no road " + ln.road + " in " + net_->source);
+      auto lane_id = [&](const char* n) {
+        if (!v.contains(n) || !v[n].is_number_integer() || v[n].get<int64_t>() == 0)
+          fail(key + "." + n, "expected a non-zero integer lane id, got " +
+                                  (v.contains(n) ? v[n].dump() : std::string("nothing")));
+        const int id = v[n].get<int>();
+        bool found = false;
+        for (const auto& sec : road->sections) found = found || sec.find_lane(id) != nullptr;
+        if (!found) fail(key + "." + n, "road " + ln.road + " has no lane " + std::to_string(id));
+        return id;
+      };
+      ln.lane = lane_id("lane");
+      ln.from_lane = v.contains("from_lane") ? lane_id("from_lane") : ln.lane;
+      ln.offset = v.contains("offset") ? number(key, v, "offset") : 0.0;
+      ln.progress = v.contains("progress") ? number(key, v, "progress") : 1.0;
+      if (ln.progress < 0 || ln.progress > 1)
+        fail(key + ".progress", "must be in [0, 1], got " + v["progress"].dump());
+      c.lane = ln;
+    } else if (k == "route") {
+      object(key, v, {"positions"});
+      if (!v.contains("positions")) fail(key + ".positions", "missing (a list of [x, y])");
+      Points pts = parse_points(key + ".positions", v["positions"], 1);
+      for (size_t i = 0; i < pts.size(); ++i) {
+        const auto loc =
+            graph_->locate_if(pts[i][0], pts[i][1], std::nullopt, 20.0,
+                              [](const odr::LaneNode& n, double) { return n.drivable(); });
+        if (!loc) {
+          char what[160];
+          std::snprintf(what, sizeof what,
+                        "(%.2f, %.2f) is farther than 20 m from any driving lane of ", pts[i][0],
+                        pts[i][1]);
+          fail(key + ".positions[" + std::to_string(i) + "]", what + net_->source);
+        }
+      }
+      c.route = std::move(pts);
+    } else if (k == "trajectory") {
+      if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
+      if (v.contains("polyline")) {
+        object(key, v, {"polyline", "length"});
+        if (v.contains("length")) number(key, v, "length");
+        c.polyline = parse_points(key + ".polyline", v["polyline"], 1);
+      } else {
+        c.timed = pose(key, v, true);
+      }
+    } else if (k == "teleport") {
+      c.teleport = pose(key, v, false);
+    } else {
+      fail(key, "unknown key (time_ns, speed, lane, route, trajectory, teleport)");
+    }
+  }
+  if (c.timed && (c.speed || c.lane))
+    fail(dp + ".trajectory", "a timed trajectory sets both speed and lane: give it alone");
+  if (c.polyline && c.lane)
+    fail(dp + ".trajectory", "both lane and trajectory steer: give one of them");
+  if (c.teleport && (c.timed || c.polyline))
+    fail(dp + ".teleport", "give teleport or trajectory, not both");
+  return c;
+}
+
+std::optional<odr::LanePosition> VehicleAgent::locate_drivable(double x, double y, double yaw,
+                                                               double max_distance) const {
+  // A driving lane whose direction is within kHeadingTolerance of yaw; else any driving lane
+  // (it turns towards it).
+  auto loc = graph_->locate_if(x, y, yaw, max_distance, [&](const odr::LaneNode& n, double h) {
+    return n.drivable() && std::abs(std::remainder(h - yaw, 2 * M_PI)) <= kHeadingTolerance;
+  });
+  if (loc) return loc;
+  return graph_->locate_if(x, y, yaw, max_distance,
+                           [](const odr::LaneNode& n, double) { return n.drivable(); });
+}
+
+odr::LaneRoute VehicleAgent::onward(odr::LaneIndex lane, double s, double length, bool* open) {
+  odr::LaneRoute r;
+  odr::LaneIndex cur = lane;
+  double cs = s;
+  *open = false;
+  for (int guard = 0; guard < 10000; ++guard) {
+    const odr::LaneNode& n = graph_->lane(cur);
+    odr::RouteSegment seg;
+    seg.lane = cur;
+    seg.road_id = n.road->id;
+    seg.lane_id = n.lane_id;
+    seg.junction = n.junction;
+    seg.s_from = std::clamp(cs, n.s0, n.s1);
+    seg.s_to = n.forward ? n.s1 : n.s0;
+    if (n.s1 > n.s0) r.length += std::abs(seg.s_to - seg.s_from) / (n.s1 - n.s0) * n.length;
+    if (n.junction != "-1" && (r.junctions.empty() || r.junctions.back() != n.junction))
+      r.junctions.push_back(n.junction);
+    r.segments.push_back(std::move(seg));
+    if (r.length >= length) {
+      *open = true;
+      break;
+    }
+    std::vector<odr::LaneIndex> next;
+    for (odr::LaneIndex l : graph_->successors(cur)) {
+      if (graph_->lane(l).drivable()) next.push_back(l);
+    }
+    if (next.empty()) break;  // a dead end: the route ends there
+    cur = next.size() == 1 ? next[0] : next[rng_() % next.size()];
+    const odr::LaneNode& nn = graph_->lane(cur);
+    cs = nn.forward ? nn.s0 : nn.s1;
+  }
+  r.cost = r.length;
+  return r;
+}
+
+std::optional<odr::LaneRoute> VehicleAgent::route_from(odr::LaneIndex lane, double s, size_t first,
+                                                       size_t* failed) {
+  odr::LaneRoute out;
+  auto append = [&](const odr::LaneRoute& r) {
+    for (const auto& seg : r.segments) {
+      if (!out.segments.empty() && !seg.lane_change && seg.lane == out.segments.back().lane &&
+          std::abs(seg.s_from - out.segments.back().s_to) < 1e-9) {
+        out.segments.back().s_to = seg.s_to;  // the same lane on
+      } else {
+        out.segments.push_back(seg);
+      }
+    }
+    out.length += r.length;
+    out.cost += r.cost;
+    out.lane_changes += r.lane_changes;
+    for (const auto& j : r.junctions) {
+      if (out.junctions.empty() || out.junctions.back() != j) out.junctions.push_back(j);
+    }
+  };
+  odr::LaneIndex cur = lane;
+  double cs = s;
+  for (size_t i = first; i < goals_.size(); ++i) {
+    auto r = graph_->route(cur, cs, goals_[i].lane, goals_[i].s);
+    if (!r) {
+      *failed = i;
+      return std::nullopt;
+    }
+    append(*r);
+    cur = goals_[i].lane;
+    cs = goals_[i].s;
+  }
+  open_end_ = false;
+  if (onward_) append(onward(cur, cs, kOnwardLength, &open_end_));
+  if (out.segments.empty()) {
+    // At its goal already: a route of no length there.
+    const odr::LaneNode& n = graph_->lane(cur);
+    odr::RouteSegment seg;
+    seg.lane = cur;
+    seg.road_id = n.road->id;
+    seg.lane_id = n.lane_id;
+    seg.junction = n.junction;
+    seg.s_from = seg.s_to = cs;
+    out.segments.push_back(seg);
+  }
+  return out;
+}
+
+odr::LaneRoute VehicleAgent::plan_from(odr::LaneIndex lane, double s) {
+  size_t failed = 0;
+  if (auto r = route_from(lane, s, 0, &failed)) return *r;
+  // Its goals cannot be reached from here any more: the lane graph onward.
+  goals_.clear();
+  onward_ = true;
+  return *route_from(lane, s, 0, &failed);
+}
+
+void VehicleAgent::compute_goal_arcs() {
+  goal_arcs_.clear();
+  size_t lo = 0;
+  for (const Goal& g : goals_) {
+    const odr::LaneNode& n = graph_->lane(g.lane);
+    const double s = std::clamp(g.s, n.s0 + 1e-3, std::max(n.s0 + 1e-3, n.s1 - 1e-3));
+    const odr::WorldPose w = graph_->world_pose(n.road->id, n.lane_id, s);
+    const auto pr = path_.project(w.x, w.y, lo);
+    goal_arcs_.push_back(std::isfinite(pr.d2) ? pr.arc : path_.length());
+    lo = pr.index;
+  }
+}
+
+void VehicleAgent::set_path(const odr::LaneRoute& route) {
+  path_ = make_path(route);
+  const auto pr = path_.project(x_, y_);
+  cursor_ = pr.index;
+  arc_ = pr.arc;
+  compute_goal_arcs();
+  changing_ = 0;
+}
+
+bool VehicleAgent::relocalise() {
+  const auto loc = locate_drivable(x_, y_, yaw_, 50.0);
+  if (!loc) {
+    char where[96];
+    std::snprintf(where, sizeof where, "(%.2f, %.2f)", x_, y_);
+    warn_once("lost", std::string("no driving lane within 50 m of ") + where +
+                          " after a command: it stops there");
+    lost_ = true;
+    next_look_ns_ = time_ns_ + 1000000000;
+    return false;
+  }
+  lost_ = false;
+  set_path(plan_from(loc->lane, loc->s));
+  return true;
+}
+
+void VehicleAgent::apply_route(const Points& positions) {
+  const auto here = locate_drivable(x_, y_, yaw_, 50.0);
+  if (!here) fail(command_dp_ + ".route", "the agent is not within 50 m of a driving lane");
+  std::vector<Goal> goals;
+  std::vector<size_t> index;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const auto [px, py] = positions[i];
+    const auto loc = graph_->locate_if(px, py, std::nullopt, 20.0,
+                                       [](const odr::LaneNode& n, double) { return n.drivable(); });
+    if (!loc) continue;  // checked when it arrived
+    // A point at the agent, or behind it on its own lane, is passed already.
+    if (std::hypot(px - x_, py - y_) < 3.0) continue;
+    if (goals.empty() && loc->lane == here->lane) {
+      const bool fwd = graph_->lane(here->lane).forward;
+      if (fwd ? loc->s <= here->s + 1.0 : loc->s >= here->s - 1.0) continue;
+    }
+    goals.push_back({loc->lane, loc->s});
+    index.push_back(i);
+  }
+  goals_ = goals;
+  onward_ = true;
+  size_t failed = 0;
+  auto route = route_from(here->lane, here->s, 0, &failed);
+  if (!route) {
+    const auto [px, py] = positions[index[failed]];
+    const odr::LaneNode& n = graph_->lane(goals_[failed].lane);
+    char what[200];
+    std::snprintf(what, sizeof what, "no route on the lane graph to (%.2f, %.2f) (lane %s:%d)", px,
+                  py, n.road->id.c_str(), n.lane_id);
+    fail(command_dp_ + ".route.positions[" + std::to_string(index[failed]) + "]", what);
+  }
+  set_path(*route);
+  lane_run_ = {};
+}
+
+void VehicleAgent::begin_lane(const Command::Lane& c) {
+  const bool same = lane_run_.active && lane_run_.road == c.road && lane_run_.lane == c.lane &&
+                    lane_run_.from_lane == c.from_lane && c.progress >= lane_run_.progress - 1e-9;
+  if (same) {
+    lane_run_.progress = c.progress;
+    return;
+  }
+  const std::string key = command_dp_ + ".lane";
+  const auto loc = locate_drivable(x_, y_, yaw_, 50.0);
+  if (!loc) fail(key, "the agent is not within 50 m of a driving lane");
+  std::string road = c.road;
+  int lane = c.lane, from = c.from_lane;
+  if (loc->road_id != c.road) {
+    // Not on that road (it has just left it, say): the same change relative to its lane.
+    warn_once("lane-road", key + ".road: the agent is on road " + loc->road_id + ", not " + c.road +
+                               ": lanes taken relative to its own");
+    // Lanes between (ids, lane 0 skipped), applied to its own lane.
+    int steps = c.lane - c.from_lane;
+    if ((c.lane > 0) != (c.from_lane > 0)) steps -= steps > 0 ? 1 : -1;
+    road = loc->road_id;
+    from = loc->lane_id;
+    lane = from;
+    for (int k = 0; k < std::abs(steps); ++k) {
+      lane += steps > 0 ? 1 : -1;
+      if (lane == 0) lane += steps > 0 ? 1 : -1;
+    }
+  }
+  const odr::LaneIndex tgt = graph_->find(road, lane, loc->s);
+  const odr::LaneIndex frm = graph_->find(road, from, loc->s);
+  char at[48];
+  std::snprintf(at, sizeof at, " at s = %.1f", loc->s);
+  if (tgt == odr::kNoLane)
+    fail(key + ".lane", "road " + road + " has no lane " + std::to_string(lane) + at);
+  if (frm == odr::kNoLane)
+    fail(key + ".from_lane", "road " + road + " has no lane " + std::to_string(from) + at);
+  if (!graph_->lane(tgt).drivable())
+    fail(key + ".lane", "lane " + road + ":" + std::to_string(lane) + " is a " +
+                            graph_->lane(tgt).type + " lane, not a driving lane");
+  const odr::WorldPose wt = graph_->world_pose(road, lane, loc->s);
+  const odr::WorldPose wf = graph_->world_pose(road, from, loc->s);
+  const double h = wt.heading;
+  lane_run_.active = true;
+  lane_run_.road = c.road;
+  lane_run_.lane = c.lane;
+  lane_run_.from_lane = c.from_lane;
+  lane_run_.progress = c.progress;
+  lane_run_.d_from = -(wf.x - wt.x) * std::sin(h) + (wf.y - wt.y) * std::cos(h);
+  // The route on from the target lane (through its goals if it can).
+  set_path(plan_from(tgt, loc->s));
+  lane_run_.lateral = path_.project(x_, y_).lateral;
+  lane_run_.e0 = lane_run_.lateral - lane_run_.d_from;
+  lane_run_.side = lane_run_.d_from + lane_run_.e0 < -0.5  ? 1
+                   : lane_run_.d_from + lane_run_.e0 > 0.5 ? -1
+                                                           : 0;
+}
+
+void VehicleAgent::set_polyline(const Points& points) {
+  if (points == polyline_) return;
+  polyline_ = points;
+  traj_path_ = Path{};
+  for (size_t i = 0; i + 1 < points.size(); ++i) {
+    const auto [ax, ay] = points[i];
+    const auto [bx, by] = points[i + 1];
+    const double len = std::hypot(bx - ax, by - ay);
+    if (len < 1e-9) continue;
+    const double h = std::atan2(by - ay, bx - ax);
+    const int n = std::max(1, static_cast<int>(std::ceil(len / kSampleDs)));
+    for (int k = traj_path_.poses.empty() ? 0 : 1; k <= n; ++k) {
+      odr::Pose2 p;
+      p.x = ax + (bx - ax) * k / n;
+      p.y = ay + (by - ay) * k / n;
+      p.heading = h;
+      const double a = traj_path_.poses.empty()
+                           ? 0.0
+                           : traj_path_.arc.back() + std::hypot(p.x - traj_path_.poses.back().x,
+                                                                p.y - traj_path_.poses.back().y);
+      traj_path_.poses.push_back(p);
+      traj_path_.arc.push_back(a);
+    }
+  }
+  if (traj_path_.poses.empty()) {  // one point (or all the same): towards it
+    odr::Pose2 p;
+    p.x = points[0][0];
+    p.y = points[0][1];
+    p.heading = std::atan2(p.y - y_, p.x - x_);
+    traj_path_.poses = {p};
+    traj_path_.arc = {0.0};
+  }
+}
+
+void VehicleAgent::extend() {
+  // The route so far from 30 m behind it, and the lane graph onward from its end.
+  odr::LaneRoute route = path_.route;
+  size_t lo = 0, keep_from = 0;
+  for (size_t i = 0; i < route.segments.size(); ++i) {
+    const auto& g = route.segments[i];
+    const double dir = g.s_to >= g.s_from ? 1.0 : -1.0;
+    const double probe = std::abs(g.s_to - g.s_from) > 2e-3 ? g.s_to - dir * 1e-3 : g.s_to;
+    const odr::WorldPose w = graph_->world_pose(g.road_id, g.lane_id, probe);
+    const auto pr = path_.project(w.x, w.y, lo);
+    lo = pr.index;
+    if (pr.arc >= arc_ - 30.0) break;
+    keep_from = i + 1;
+  }
+  if (keep_from > 0) keep_from -= 1;  // one more behind, for the lane change blends
+  route.segments.erase(route.segments.begin(), route.segments.begin() + keep_from);
+  if (!route.segments.empty()) route.segments.front().lane_change = false;
+  const odr::RouteSegment last = route.segments.back();
+  bool open = false;
+  const odr::LaneRoute more = onward(last.lane, last.s_to, kOnwardLength, &open);
+  for (const auto& seg : more.segments) {
+    if (seg.lane == route.segments.back().lane &&
+        std::abs(seg.s_from - route.segments.back().s_to) < 1e-9) {
+      route.segments.back().s_to = seg.s_to;
+    } else {
+      route.segments.push_back(seg);
+    }
+  }
+  open_end_ = open;
+  path_ = make_path(route);
+  const auto pr = path_.project(x_, y_);
+  cursor_ = pr.index;
+  arc_ = pr.arc;
+  compute_goal_arcs();
+}
+
 int64_t VehicleAgent::step(int64_t duration_ns) {
   const double dt = duration_ns * 1e-9;
   time_ns_ += duration_ns;
   // Drop inputs no longer needed (keep the newest one old enough).
   const int64_t limit = time_ns_ - static_cast<int64_t>(std::llround(reaction_s_ * 1e9));
   while (inputs_.size() > 1 && inputs_[1].time_ns <= limit) inputs_.pop_front();
-  if (absent_) {
+  // This step's command (it applies to this step only).
+  std::optional<Command> cmd;
+  cmd.swap(command_);
+  commanded_acc_.reset();
+  const bool placed = cmd && (cmd->teleport || cmd->timed);
+  if (absent_ && !placed) {
     if (!respawn_ || time_ns_ - absent_since_ns_ < std::llround(respawn_delay_s_ * 1e9) ||
         !start_free())
       return time_ns_;
@@ -759,85 +1412,201 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
     publish();
     return time_ns_;
   }
+  absent_ = false;
+  if (cmd && cmd->teleport) {
+    // Put there once, then on from the nearest lane.
+    const Command::Pose& p = *cmd->teleport;
+    x_ = p.x;
+    y_ = p.y;
+    yaw_ = std::remainder(p.yaw, 2 * M_PI);
+    if (p.speed) v_ = *p.speed;
+    acc_ = yaw_rate_ = 0;
+    lane_run_ = {};
+    off_path_ = false;
+    polyline_.clear();
+    relocalise();
+    publish();
+    return time_ns_;
+  }
+  if (cmd && cmd->timed) {
+    // Exactly this pose and speed (both domains).
+    const Command::Pose& p = *cmd->timed;
+    const double v = p.speed.value_or(0.0);
+    const double yaw = std::remainder(p.yaw, 2 * M_PI);
+    yaw_rate_ = std::remainder(yaw - yaw_, 2 * M_PI) / dt;
+    acc_ = (v - v_) / dt;
+    x_ = p.x;
+    y_ = p.y;
+    yaw_ = yaw;
+    v_ = v;
+    lane_run_ = {};
+    off_path_ = true;
+    changing_ = 0;
+    publish();
+    return time_ns_;
+  }
+  if (cmd && cmd->route && *cmd->route != last_route_) {
+    last_route_ = *cmd->route;
+    if (off_path_ && !cmd->polyline) off_path_ = false;  // re-planned from here
+    apply_route(*cmd->route);
+  }
+  const bool on_poly = cmd && cmd->polyline;
+  if (on_poly) {
+    set_polyline(*cmd->polyline);
+    off_path_ = true;
+    lane_run_ = {};
+    changing_ = 0;
+  } else if (off_path_) {
+    // Back to the AI from where the command left it.
+    off_path_ = false;
+    polyline_.clear();
+    relocalise();
+  }
+  if (lost_ && !on_poly && time_ns_ >= next_look_ns_) relocalise();
+  if (cmd && cmd->lane && !lost_) {
+    begin_lane(*cmd->lane);
+  } else if (lane_run_.active) {
+    lane_run_ = {};
+    changing_ = 0;
+  }
 
+  // Longitudinal: the speed command, else IDM along the path it follows.
+  const Path& drive = on_poly ? traj_path_ : path_;
+  size_t dcursor = cursor_;
+  double darc = arc_;
+  if (on_poly) {
+    const auto pr = traj_path_.project(x_, y_);
+    dcursor = pr.index;
+    darc = pr.arc;
+  }
   const double my_front_off = 0.5 * length_ + (0.5 * length_ - rear_overhang_);
-  const double my_front = arc_ + my_front_off;
-  const double v0 = desired_speed();
-  auto [gap, vl] = leader_on(path_, my_front, cursor_);
-  // Red lights: a standing virtual leader at the stop line.
-  const Snapshot* snap = perceived();
-  if (snap && snap->lights) {
-    const json& sig =
-        snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
-    for (const auto& [stop_arc, id] : path_.stops) {
-      const double g = stop_arc - my_front;
-      if (g < -0.5) continue;  // passed
-      if (g > radius_) break;
-      auto it = sig.find(id);
-      if (it == sig.end() || !it->is_string()) break;  // green (or unknown): the next one counts
-      const std::string st = it->get<std::string>();
-      bool stop = st == "red" || st == "red_yellow";
-      if (st == "yellow") stop = g > v_ * v_ / (2 * idm_.b);  // stop only if it comfortably can
-      if (stop && g < gap) {
-        gap = std::max(g, 0.0);
+  double acc = 0, v_new = v_;
+  if (cmd && cmd->speed) {
+    v_new = cmd->speed->speed;
+    acc = cmd->speed->acceleration ? *cmd->speed->acceleration : (v_new - v_) / dt;
+    commanded_acc_ = acc;
+  } else if (lost_) {
+    acc = -std::min(idm_.b, v_ / dt);
+    v_new = std::max(0.0, v_ + acc * dt);
+  } else {
+    const double my_front = darc + my_front_off;
+    const double v0 = desired_speed();
+    auto [gap, vl] = leader_on(drive, my_front, dcursor);
+    // Red lights: a standing virtual leader at the stop line.
+    const Snapshot* snap = perceived();
+    if (!on_poly && snap && snap->lights) {
+      const json& sig =
+          snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
+      for (const auto& [stop_arc, id] : path_.stops) {
+        const double g = stop_arc - my_front;
+        if (g < -0.5) continue;  // passed
+        if (g > radius_) break;
+        auto it = sig.find(id);
+        if (it == sig.end() || !it->is_string()) break;  // green (or unknown): the next one counts
+        const std::string st = it->get<std::string>();
+        bool stop = st == "red" || st == "red_yellow";
+        if (st == "yellow") stop = g > v_ * v_ / (2 * idm_.b);  // stop only if it comfortably can
+        if (stop && g < gap) {
+          gap = std::max(g, 0.0);
+          vl = 0;
+        }
+        break;  // only the next light counts
+      }
+    }
+    if (yielding_ && !on_poly) {
+      const double g = junction_wait(my_front, snap);
+      if (g < gap) {
+        gap = g;
         vl = 0;
       }
-      break;  // only the next light counts
+    }
+    acc = idm_.accel(v_, gap, vl, v0);
+    acc = std::clamp(acc, -max_decel_, idm_.a);
+    v_new = v_ + acc * dt;
+    if (v_new < 0) {
+      v_new = 0;
+      acc = -v_ / dt;
     }
   }
-  if (yielding_) {
-    const double g = junction_wait(my_front, snap);
-    if (g < gap) {
-      gap = g;
-      vl = 0;
+
+  // Lateral: the lane command, else pure pursuit on the path it follows.
+  if (lane_run_.active) {
+    const double p = std::clamp(lane_run_.progress, 0.0, 1.0);
+    const double d =
+        (1.0 - p) * (lane_run_.d_from + lane_run_.e0) + p * (cmd->lane ? cmd->lane->offset : 0.0);
+    const double ds = v_new * dt;
+    const odr::Pose2 q = path_.at(arc_ + ds);
+    // Along its motion; at the end (progress 1) along the lane, as a driver straightens up.
+    const double yaw =
+        ds > 1e-6 && p < 1.0
+            ? std::remainder(q.heading + std::atan2(d - lane_run_.lateral, ds), 2 * M_PI)
+            : q.heading;
+    x_ = q.x - d * std::sin(q.heading);
+    y_ = q.y + d * std::cos(q.heading);
+    yaw_rate_ = std::remainder(yaw - yaw_, 2 * M_PI) / dt;
+    yaw_ = yaw;
+    lane_run_.lateral = d;
+    changing_ = p < 1.0 ? lane_run_.side : 0;
+  } else if (lost_) {
+    x_ += v_new * std::cos(yaw_) * dt;
+    y_ += v_new * std::sin(yaw_) * dt;
+    yaw_rate_ = 0;
+  } else {
+    const double lookahead = std::max(4.0, 0.8 * v_ + 2.0);
+    const double a_t = darc + wheelbase_ + lookahead;
+    odr::Pose2 target = drive.at(a_t);
+    if (on_poly && a_t > drive.length()) {  // past its end: straight on
+      target.x += (a_t - drive.length()) * std::cos(target.heading);
+      target.y += (a_t - drive.length()) * std::sin(target.heading);
     }
+    const double dx = target.x - x_, dy = target.y - y_;
+    const double alpha = std::atan2(dy, dx) - yaw_;
+    const double ld = std::max(std::hypot(dx, dy), 1.0);
+    double steer = std::atan2(2.0 * wheelbase_ * std::sin(alpha), ld);
+    steer = std::clamp(steer, -0.6, 0.6);
+    // Kinematic bicycle (rear axle), semi-implicit Euler.
+    yaw_rate_ = v_new * std::tan(steer) / wheelbase_;
+    const double yaw_mid = yaw_ + 0.5 * yaw_rate_ * dt;
+    x_ += v_new * std::cos(yaw_mid) * dt;
+    y_ += v_new * std::sin(yaw_mid) * dt;
+    yaw_ = std::remainder(yaw_ + yaw_rate_ * dt, 2 * M_PI);
   }
-  double acc = idm_.accel(v_, gap, vl, v0);
-  acc = std::clamp(acc, -max_decel_, idm_.a);
-  // Pure pursuit on the path.
-  const double lookahead = std::max(4.0, 0.8 * v_ + 2.0);
-  const odr::Pose2 target = path_.at(arc_ + wheelbase_ + lookahead);
-  const double dx = target.x - x_, dy = target.y - y_;
-  const double alpha = std::atan2(dy, dx) - yaw_;
-  const double ld = std::max(std::hypot(dx, dy), 1.0);
-  double steer = std::atan2(2.0 * wheelbase_ * std::sin(alpha), ld);
-  steer = std::clamp(steer, -0.6, 0.6);
-  // Kinematic bicycle (rear axle), semi-implicit Euler.
-  double v_new = v_ + acc * dt;
-  if (v_new < 0) {
-    v_new = 0;
-    acc = -v_ / dt;
-  }
-  yaw_rate_ = v_new * std::tan(steer) / wheelbase_;
-  const double yaw_mid = yaw_ + 0.5 * yaw_rate_ * dt;
-  x_ += v_new * std::cos(yaw_mid) * dt;
-  y_ += v_new * std::sin(yaw_mid) * dt;
-  yaw_ = std::remainder(yaw_ + yaw_rate_ * dt, 2 * M_PI);
   v_ = v_new;
   acc_ = acc;
-  // Where it is on the path now.
-  const size_t lo = cursor_ > 20 ? cursor_ - 20 : 0;
-  const auto pr =
-      path_.project(x_, y_, lo, cursor_ + 40 + static_cast<size_t>(v_ * dt / kSampleDs));
-  cursor_ = pr.index;
-  arc_ = pr.arc;
-  if (changing_ != 0 && std::abs(pr.lateral) < 0.2) changing_ = 0;
-  if (arc_ >= path_.length() - 0.25) {
-    absent_ = true;
-    absent_since_ns_ = time_ns_;
-    if (respawn_) {  // absent, it waits at its start: its view is around there
-      x_ = initial_path_start_.x;
-      y_ = initial_path_start_.y;
-      yaw_ = initial_path_start_.heading;
+  if (!on_poly && !lost_) {
+    // Where it is on the path now.
+    const size_t lo = cursor_ > 20 ? cursor_ - 20 : 0;
+    const auto pr =
+        path_.project(x_, y_, lo, cursor_ + 40 + static_cast<size_t>(v_ * dt / kSampleDs));
+    cursor_ = pr.index;
+    arc_ = pr.arc;
+    if (!lane_run_.active && changing_ != 0 && std::abs(pr.lateral) < 0.2) changing_ = 0;
+    while (onward_ && !goals_.empty() && arc_ >= goal_arcs_.front() - 1.0) {
+      goals_.erase(goals_.begin());
+      goal_arcs_.erase(goal_arcs_.begin());
     }
-    v_ = 0;
-    acc_ = 0;
-    yaw_rate_ = 0;
+    if (arc_ >= path_.length() - 0.25) {
+      absent_ = true;
+      absent_since_ns_ = time_ns_;
+      if (respawn_) {  // absent, it waits at its start: its view is around there
+        x_ = initial_path_start_.x;
+        y_ = initial_path_start_.y;
+        yaw_ = initial_path_start_.heading;
+      }
+      v_ = 0;
+      acc_ = 0;
+      yaw_rate_ = 0;
+      lane_run_ = {};
+    }
   }
-  if (!absent_ && lane_changes_ && changing_ == 0 && time_ns_ >= next_mobil_ns_) {
+  const bool ai_lateral = !absent_ && !on_poly && !lost_ && !lane_run_.active;
+  if (ai_lateral && lane_changes_ && changing_ == 0 && time_ns_ >= next_mobil_ns_) {
     next_mobil_ns_ = time_ns_ + 500000000;  // every 0.5 s
     consider_lane_change();
   }
+  if (ai_lateral && onward_ && goals_.empty() && open_end_ && changing_ == 0 &&
+      path_.length() - arc_ < std::max(200.0, 10.0 * v_))
+    extend();
   publish();
   return time_ns_;
 }
@@ -853,7 +1622,8 @@ void VehicleAgent::publish() {
   state_.set_vx(v_ * std::cos(yaw_));
   state_.set_vy(v_ * std::sin(yaw_));
   uint32_t lights = 0;
-  if (acc_ < -0.3 || (v_ < 0.1 && !absent_)) lights |= data::RoadUser::BRAKE;
+  const bool braking = commanded_acc_ ? *commanded_acc_ < 0 : acc_ < -0.3;
+  if (braking || (v_ < 0.1 && !absent_)) lights |= data::RoadUser::BRAKE;
   if (changing_ > 0) lights |= data::RoadUser::INDICATOR_LEFT;
   if (changing_ < 0) lights |= data::RoadUser::INDICATOR_RIGHT;
   state_.set_lights(lights);
@@ -896,6 +1666,15 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
     if (!(visibility > 0)) fail(name, "visibility_m: must be > 0");
     adapt_to_weather(mu, visibility);
     return;
+  } else if (name == command_dp_) {
+    if (!dp.is_json()) fail(name, "expected a JSON datapack of commands");
+    const json j = datapack::read_json(dp);
+    if (j.is_object() && j.empty()) {
+      command_.reset();  // on its own AI
+    } else {
+      command_ = parse_command(name, j);
+    }
+    return;
   } else if (name == lights_dp_) {
     if (!dp.is_json()) fail(name, "expected a JSON datapack {\"signals\": {id: state}}");
     auto j = std::make_shared<json>(datapack::read_json(dp));
@@ -903,7 +1682,8 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
     last_lights_ = std::move(j);
   } else {
     warn_once("dp:" + name, "datapack '" + name + "' is not one it reads (" + neighbours_dp_ +
-                                ", " + lights_dp_ + ", " + weather_dp_ + "); ignored");
+                                ", " + lights_dp_ + ", " + weather_dp_ + ", " + command_dp_ +
+                                "); ignored");
     return;
   }
   // Stamped with the time it arrived (the state the TF saw).

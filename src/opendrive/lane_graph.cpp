@@ -760,6 +760,12 @@ WorldPose LaneGraph::world_pose(const std::string& road_id, int lane_id, double 
 
 std::optional<LanePosition> LaneGraph::locate(double x, double y, std::optional<double> heading,
                                               double max_distance) const {
+  return locate_if(x, y, heading, max_distance, {});
+}
+
+std::optional<LanePosition> LaneGraph::locate_if(double x, double y, std::optional<double> heading,
+                                                 double max_distance,
+                                                 const LaneFilter& accept) const {
   std::optional<LanePosition> best;
   double best_key0 = kInf, best_key1 = kInf;
   for (size_t r = 0; r < roads_.size(); ++r) {
@@ -812,6 +818,7 @@ std::optional<LanePosition> LaneGraph::locate(double x, double y, std::optional<
       const LaneNode& n = lanes_[lane_in_section(r, k, lane.id)];
       const Pose2 p = offset_pose(road, s, c.t, c.slope);
       const double lane_heading = wrap(p.heading + (n.forward ? 0 : std::numbers::pi));
+      if (accept && !accept(n, lane_heading)) continue;
       const double key0 = dist > 1e-9 ? dist : 0.0;
       const double key1 = heading ? std::abs(wrap(*heading - lane_heading)) : std::abs(t - c.t);
       if (key0 < best_key0 - 1e-9 ||

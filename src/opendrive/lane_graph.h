@@ -17,6 +17,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -177,6 +178,11 @@ class LaneGraph {
   // nullopt when no road is within max_distance of the point.
   std::optional<LanePosition> locate(double x, double y, std::optional<double> heading = {},
                                      double max_distance = 5.0) const;
+  // The same among the lanes `accept` takes (given the lane and its driving direction's
+  // heading there, rad); the others are not considered at all.
+  using LaneFilter = std::function<bool(const LaneNode& lane, double lane_heading)>;
+  std::optional<LanePosition> locate_if(double x, double y, std::optional<double> heading,
+                                        double max_distance, const LaneFilter& accept) const;
 
   SpeedLimit speed_limit(LaneIndex lane, double s) const;
   const std::vector<Crosswalk>& crosswalks() const { return crosswalks_; }
