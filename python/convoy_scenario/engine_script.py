@@ -14,6 +14,9 @@ Config keys (engines/scenario/schema.json):
   EgoRoute          the ego's route: a CSV (x, y[, heading]) or [[x, y], ...]; published as
                     the `route` datapack (the live score reads it)
   EndAtRouteEnd     true (default): the scenario is done when the ego has passed its route's end
+  EndOnComplete     true (default): the scenario is done when its storyboard completes (all
+                    stories ended); false: only its StopTrigger, the route's end or the run's
+                    SimulationTimeout end it (the generated configs: the ego drives on)
   Map               the .xodr for lane lookups (default the scenario's LogicFile)
 
 Datapacks:
@@ -113,6 +116,18 @@ class Commander:
             pts.append([x, y])
         return pts
 
+    def idle(self, time_ns):
+        """Commands without running actions: the kept routes only."""
+        out = {}
+        for name, (engine, _, command_dp) in sorted(self.entities.items()):
+            if command_dp is None or name == self.ego:
+                continue
+            cmd = {"time_ns": time_ns}
+            if name in self.routes:
+                cmd["route"] = {"positions": self.routes[name]}
+            out[engine] = cmd
+        return out
+
     def commands(self, result, time_ns):
         """(commands by engine, weather control or None) for a StepResult."""
         per = {}
@@ -133,7 +148,10 @@ class Commander:
             if c.kind == "SpeedAction":
                 cmd["speed"] = {k: tg[k] for k in ("speed", "target_speed", "acceleration")}
             elif c.kind == "LaneChangeAction":
-                cmd["lane"] = {k: tg[k] for k in ("road", "lane", "from_lane", "offset", "progress")}
+                cmd["lane"] = {"road": None if tg["road"] is None else str(tg["road"]),
+                               "lane": int(tg["lane"]),
+                               "from_lane": None if tg["from_lane"] is None else int(tg["from_lane"]),
+                               "offset": tg["offset"], "progress": tg["progress"]}
             elif c.kind == "FollowTrajectoryAction":
                 if "x" in tg:
                     cmd["trajectory"] = {k: tg[k] for k in ("x", "y", "yaw", "speed")}
@@ -180,6 +198,8 @@ class Script(EngineScript):
         self.commander = Commander(self.entities, self.ego, self.odr)
         self.route = read_route(cfg.get("EgoRoute"), os.path.dirname(self.file))
         self.end_at_route_end = bool(cfg.get("EndAtRouteEnd", True)) and len(self.route) >= 2
+        self.end_on_complete = bool(cfg.get("EndOnComplete", True))
+        self.board_complete = False
         self.done = False
         self.ending = False   # ended at the last step: done at the next
         self.reason = ""
@@ -216,6 +236,9 @@ class Script(EngineScript):
         t = self._time_ns * 1e-9
         if self.done:
             return
+        if self.board_complete and not self.ending:
+            self._after_complete(t)
+            return
         if self.ending:
             # one step after the end, so that the last step's commands reached their engines
             self.done = True
@@ -244,8 +267,14 @@ class Script(EngineScript):
         if weather is not None:
             out["weather"] = weather
         self._setDataPack("commands", out)
-        if result.done:
-            self.ending, self.reason = True, "storyboard"
+        stopped = any(tr.element_type == "storyboard" and tr.transition == "stopTransition"
+                      for tr in result.transitions)
+        if result.done and (stopped or self.end_on_complete):
+            self.ending, self.reason = True, "stop_trigger" if stopped else "storyboard_complete"
+        elif result.done and not self.board_complete:
+            self.board_complete = True
+            print("scenario %s: storyboard complete at t=%.2f; the run goes on to the ego's route "
+                  "end or the time limit" % (self.base, t), flush=True)
         elif self.end_at_route_end and self.ego in world and \
                 past_route_end(self.route, world[self.ego]["x"], world[self.ego]["y"]):
             self.ending, self.reason = True, "route_end"
@@ -259,6 +288,18 @@ class Script(EngineScript):
             "file": self.base})
         for tr in result.transitions:
             print("t=%.2f %s %s %s" % (tr.time, tr.element_type, tr.element, tr.transition), flush=True)
+
+    def _after_complete(self, t):
+        """The storyboard is complete but the run goes on: no commands (the agents' own AI), the
+        route's end still ends it."""
+        world = self._world()
+        self._setDataPack("commands", {"time_ns": self._time_ns, "entities": self.commander.idle(self._time_ns)})
+        if self.end_at_route_end and self.ego in world and \
+                past_route_end(self.route, world[self.ego]["x"], world[self.ego]["y"]):
+            self.ending, self.reason = True, "route_end"
+        self._setDataPack("scenario", dict(self._getDataPack("scenario"), time_ns=self._time_ns, t=t,
+                                           ending=self.ending, reason=self.reason, transitions=[],
+                                           running=[]))
 
     def shutdown(self):
         if getattr(self, "odr", None) is not None:

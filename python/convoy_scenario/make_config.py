@@ -299,7 +299,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                 if "FrontAxle" in axles and "RearAxle" in axles:
                     wheelbase = dict(axles["FrontAxle"])["positionX"] - dict(axles["RearAxle"])["positionX"]
                 a = {"EngineType": "vehicle_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
-                     "Map": xodr, "Position": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
+                     "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
                      "Route": {"to": "%s:%d" % (onward[0], onward[1])},
                      "InitialSpeed": init_speed(scenario, ent.name), "Model": vehicle_model(ent, cat, models),
                      "Category": cat, "Length": bb.length, "Width": bb.width, "Height": bb.height,
@@ -349,7 +349,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     engines.append({"EngineType": "scenario", "EngineName": "scenario", "EngineTimestep": AGENT_DT,
                     "ScenarioFile": os.path.abspath(xosc), "Parameters": dict(parameters or {}),
                     "Entities": entity_map, "EgoName": ego,
-                    "EgoRoute": [[p[0], p[1]] for p in scored], "Map": xodr})
+                    "EgoRoute": [[p[0], p[1]] for p in scored], "Map": xodr, "EndOnComplete": False})
     engines += agents
     tfs += [{"Name": "scenario_tf", "FileName": os.path.join(HERE, "scenario_tf.py")},
             {"Name": "traffic_tf", "FileName": os.path.join(HERE, "traffic_tf.py")},
