@@ -184,6 +184,8 @@ def route_points(odr, spec, start):
     for w in spec.waypoints:
         x, y, yaw = world_pose(odr, w.position.as_dict())
         loc = lane_of(odr, x, y, yaw, "a route waypoint")
+        if (loc["road"], loc["lane"]) == tuple(prev[:2]) and abs(loc["s"] - prev[2]) < 1.0:
+            continue  # the start itself (a route's first waypoint usually is)
         r = odr.route(prev, (loc["road"], loc["lane"], loc["s"]))
         pts += r["points"] if not pts else r["points"][1:]
         prev = (loc["road"], loc["lane"], loc["s"])
@@ -294,6 +296,11 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                 cat = CATEGORY.get(ent.object.category, "car")
                 loc = lane_of(odr, *pose, "entity %r's Init position" % ent.name)
                 onward = odr.follow(loc["road"], loc["lane"], loc["s"], 400.0)["lanes"][-1]
+                for ia in init_actions(scenario, ent.name):
+                    if isinstance(ia.spec, m.AssignRouteAction):  # routed to its last waypoint
+                        last = lane_of(odr, *world_pose(odr, ia.spec.waypoints[-1].position.as_dict()),
+                                       "entity %r's route's last waypoint" % ent.name)
+                        onward = [last["road"], last["lane"]]
                 wheelbase = None
                 axles = dict(ent.object.axles)
                 if "FrontAxle" in axles and "RearAxle" in axles:
