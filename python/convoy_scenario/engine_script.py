@@ -20,7 +20,8 @@ Config keys (engines/scenario/schema.json):
   Map               the .xodr for lane lookups (default the scenario's LogicFile)
 
 Datapacks:
-  in  `road_users`  {"time_ns", "users": {entity: RoadUser dict}} (scenario_tf.py builds it)
+  in  `road_users`  {"time_ns", "users": {entity: RoadUser dict}} (scenario_tf.py builds it); an
+                    entity that has left the world (absent) keeps its last state
   out `commands`    {"time_ns", "entities": {engine: command}, "weather": {...} | absent}:
                     command = the union of the entity's running actions' targets
                     (`speed`, `lane`, `route`, `trajectory`, `teleport`), every key optional
@@ -204,6 +205,7 @@ class Script(EngineScript):
         self.ending = False   # ended at the last step: done at the next
         self.reason = ""
         self.missing_since = None
+        self.last_seen = {}   # entity -> its last state (kept for road users that left)
         for dp in ("road_users", "commands", "scenario", "route"):
             self._registerDataPack(dp)
         self._setDataPack("commands", {"time_ns": 0, "entities": {}})
@@ -222,6 +224,8 @@ class Script(EngineScript):
         for name in self.entities:
             u = users.get(name)
             if u is None or u.get("absent"):
+                if name in self.last_seen:   # left the world (its route ended): its last state
+                    world[name] = self.last_seen[name]
                 continue
             s = state_dict(u)
             if "road" not in s and self.odr is not None:
@@ -230,6 +234,7 @@ class Script(EngineScript):
                     s.update(road=str(loc["road"]), lane=int(loc["lane"]), s=loc["s"],
                              t=loc["road_t"])
             world[name] = s
+            self.last_seen[name] = s
         return world
 
     def runLoop(self, timestep_ns):

@@ -311,13 +311,15 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                      "InitialSpeed": init_speed(scenario, ent.name), "Model": vehicle_model(ent, cat, models),
                      "Category": cat, "Length": bb.length, "Width": bb.width, "Height": bb.height,
                      "LaneChanges": False, "Seed": i}
+                if not (wheelbase and 0 < wheelbase < bb.length) and bb.length <= 2.7:
+                    wheelbase = 0.6 * bb.length   # small vehicles without axles (a bicycle)
                 if wheelbase and 0 < wheelbase < bb.length:
                     a["Wheelbase"] = wheelbase
             else:
                 loc = lane_of(odr, pose[0], pose[1], None, "pedestrian %r's Init position" % ent.name,
                               types=("sidewalk",))
                 road_len = next(r["length"] for r in odr.info()["roads"] if r["id"] == loc["road"])
-                to_s = loc["s"] + 30.0 if loc["s"] + 30.0 < road_len else max(0.0, loc["s"] - 30.0)
+                to_s = loc["s"] + 60.0 if loc["s"] + 60.0 < road_len else max(0.0, loc["s"] - 60.0)
                 a = {"EngineType": "pedestrian_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
                      "Map": xodr, "Position": {"x": pose[0], "y": pose[1]},
                      "Route": {"to": "%s:%d" % (loc["road"], loc["lane"]), "to_s": to_s},
