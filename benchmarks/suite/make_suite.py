@@ -252,7 +252,7 @@ def cut_in(hw="0.6", change="3", end_speed="6", speed_="12", weather=None, desc=
     return scenario("Cut-in%s: a sedan in the left lane overtakes the ego and, once its rear is $Headway s "
                     "of the ego's travel ahead, changes into the ego's lane in $LaneChangeTime s, then "
                     "slows to $CutterEndSpeed m/s" % desc, p,
-                    [EGO, vehicle("Cutter", "sedan", {"Colour": "blue"})], init, [g])
+                    [EGO, vehicle("Cutter", "sedan", {"Model": "sedan_blue"})], init, [g])
 
 
 def lead_brake(gap="25", decel="-6", lead_speed="8", weather=None, desc=""):
@@ -327,7 +327,7 @@ def stopped_vehicle(desc=""):
                                                          lane_pos("2", "-1", "20")])],
             "Stopped": [teleport(lane_pos("1", "-1", "$StoppedS")), hold("${$StoppedS - 250}", "-1.75", "0")]}
     return scenario("Stopped vehicle ahead%s: a broken-down car stands in the ego's lane; the ego's route "
-                    "passes it in the left lane" % desc, p, [EGO, vehicle("Stopped", "sedan", {"Colour": "red"})],
+                    "passes it in the left lane" % desc, p, [EGO, vehicle("Stopped", "sedan", {"Model": "sedan_red"})],
                     init, [])
 
 
@@ -348,7 +348,7 @@ def left_turn(desc=""):
     g = group("Oncoming", [event("Cruise", speed("$OncomingSpeed"))])
     return scenario("Unprotected left turn across traffic%s: the ego turns left at junction 100 into road 4 "
                     "while two cars come the other way at $OncomingSpeed m/s" % desc, p,
-                    [EGO, vehicle("Oncoming", "suv"), vehicle("Oncoming2", "sedan", {"Colour": "white"})], init, [g])
+                    [EGO, vehicle("Oncoming", "suv"), vehicle("Oncoming2", "sedan", {"Model": "sedan_white"})], init, [g])
 
 
 def merge(desc=""):
