@@ -29,6 +29,7 @@ for a parked car, `convoy.MidBlockProbability`).
 
 Usage: /usr/bin/python3 -m convoy_scenario.make_config SCENARIO.xosc --out CONFIG.json
            [--world WORLD.sdf] [--ego FRAGMENT.json] [--param NAME=VALUE]... [--bin-dir DIR]
+           [--snapshots T1,T2]
 The route CSV is written next to CONFIG.json (ego_route.csv). Every path in the config is
 absolute. Exit 2 with one message on bad input."""
 
@@ -243,7 +244,7 @@ def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs):
     return "gazebo/smart_car::road_user"
 
 
-def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin_dir=None):
+def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin_dir=None, snapshots=None):
     """(config dict, ego route points [[x, y, heading]], scored route length)."""
     scenario = load(xosc, parameters=parameters or None)
     base = os.path.basename(xosc)
@@ -363,6 +364,11 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     tfs += [{"Name": "scenario_tf", "FileName": os.path.join(HERE, "scenario_tf.py")},
             {"Name": "traffic_tf", "FileName": os.path.join(HERE, "traffic_tf.py")},
             {"Name": "metrics_tf", "FileName": os.path.join(PYTHON, "convoy_bench", "metrics_tf.py")}]
+    if snapshots:
+        engines.append({"EngineType": "python_json", "EngineName": "snapshot", "EngineTimestep": WORLD_DT,
+                        "PythonFileName": os.path.join(HERE, "snapshot.py"),
+                        "EngineEnvParams": ["CONVOY_SNAPSHOT_TIMES=" + ",".join("%g" % t for t in snapshots)]})
+        tfs.append({"Name": "snapshot_tf", "FileName": os.path.join(HERE, "snapshot_tf.py")})
     duration = stop_time(scenario)
     timeout = duration + 0.5 if duration else max(20.0, math.ceil(scored_len / (0.5 * CRUISE)))
     config = {
@@ -376,10 +382,10 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     return config, drive, scored_len
 
 
-def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None):
+def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapshots=None):
     out_dir = os.path.dirname(os.path.abspath(out))
     os.makedirs(out_dir, exist_ok=True)
-    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir)
+    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots)
     with open(os.path.join(out_dir, "ego_route.csv"), "w") as f:
         f.write("x,y,heading\n")
         for x, y, h in drive:
@@ -408,9 +414,12 @@ def main(argv=None):
     ap.add_argument("--ego", help="a config fragment {EngineConfigs, DataPackProcessingFunctions, EgoState}: the user's ego")
     ap.add_argument("--param", action="append", type=_param, default=[], help="NAME=VALUE: a scenario parameter")
     ap.add_argument("--bin-dir", help="where convoy-odr is")
+    ap.add_argument("--snapshots", help="T1,T2,...: save the ego camera's frame at these simulated "
+                    "seconds as camera_<t>s.png in the run folder (the default ego only)")
     a = ap.parse_args(argv)
     try:
-        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir)
+        snaps = [float(t) for t in a.snapshots.split(",")] if a.snapshots else None
+        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir, snaps)
     except ScenarioError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2
