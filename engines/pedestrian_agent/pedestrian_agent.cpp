@@ -30,7 +30,17 @@
 //   <TrafficLightsDataPack> ("traffic_lights")  JSON {"signals": {"<signal id>": state}}.
 //   <WeatherDataPack> ("weather")  optional JSON (docs/road_users.md): in rain it walks
 //                    faster, x(1 + 0.2 precipitation).
+//   <CommandDataPack> ("command")  optional JSON, the scenario engine's commands for this step
+//                    (docs/road_users.md, "Commands"): speed (its walking speed, gap acceptance
+//                    ignored), route (positions walked through in straight lines, then back to
+//                    its sidewalk routing), trajectory (timed: the pose to take; untimed: a
+//                    polyline to walk), teleport. `lane` is an error for a pedestrian.
+//
+// StartPose {x, y, yaw}: it starts exactly there and walks to the nearest sidewalk, then to
+// Route.to, or without a Route along the sidewalks onward in the direction it faces (forks
+// chosen by Seed). With no sidewalk within 50 m it stands there until commanded.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -120,6 +130,21 @@ struct Plan {
   double length = INFINITY;
 };
 
+using Points = std::vector<std::array<double, 2>>;
+
+// One step's command from the scenario engine (docs/road_users.md, "Commands").
+struct Command {
+  struct Pose {
+    double x = 0, y = 0, yaw = 0;
+    std::optional<double> speed;
+  };
+  std::optional<double> speed;
+  std::optional<Points> route;
+  std::optional<Pose> timed;
+  std::optional<Points> polyline;
+  std::optional<Pose> teleport;
+};
+
 }  // namespace
 
 class PedestrianAgent final : public Engine {
@@ -160,6 +185,19 @@ class PedestrianAgent final : public Engine {
   };
   std::vector<Threat> threats(const Crossing& c) const;
   double walker_ahead_speed(double v) const;
+  // Commands (docs/road_users.md, "Commands").
+  Command parse_command(const std::string& dp, const json& j) const;
+  Points parse_points(const std::string& key, const json& v) const;
+  std::optional<odr::LanePosition> nearest_sidewalk(double x, double y) const;
+  // A straight leg from a to b; the part of it off the sidewalks is a crossing (with gap
+  // acceptance), `committed` when it starts on the road already.
+  void append_leg(Path& path, double ax, double ay, double bx, double by) const;
+  // From (x, y): to the nearest sidewalk, then to its destination over sidewalks and
+  // crosswalks, or along the sidewalks onward in the direction `yaw`; false without a
+  // sidewalk near (the path is then where it stands).
+  bool path_from(Path& path, double x, double y, double yaw, double* join = nullptr);
+  void replan(const Points& via);  // from where it stands, through `via`, then as path_from
+  void set_polyline(const Points& points);
 
   std::string name_;
   std::unique_ptr<odr::Network> net_;
@@ -167,8 +205,12 @@ class PedestrianAgent final : public Engine {
   double speed_ = 1.35, gap_ = 4.0, stop_distance_ = 8, step_back_distance_ = 4;
   double length_ = 0.5, width_ = 0.6, height_ = 1.75, stride_ = 1.4, radius_ = 100;
   bool obey_lights_ = true;
-  std::string model_, state_dp_, neighbours_dp_, lights_dp_, weather_dp_;
+  std::string model_, state_dp_, neighbours_dp_, lights_dp_, weather_dp_, command_dp_;
   Path initial_path_;
+  std::optional<Spot> dest_;  // where its route ends (none: onward)
+  std::optional<odr::Pose2> start_pose_;
+  bool initial_idle_ = false;
+  std::mt19937_64 rng_, initial_rng_;  // onward choices
 
   // State.
   int64_t time_ns_ = 0;
@@ -186,6 +228,15 @@ class PedestrianAgent final : public Engine {
   data::RoadUser state_;
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
+  // Commands.
+  double kr_ = kKeepRight;  // how far right of the path it walks (0 at a new path's start)
+  double kr_from_ = 0;      // the arc from which it eases over to kKeepRight (on the sidewalk)
+  double initial_kr_from_ = 0;
+  bool idle_ = false;  // no sidewalk near: it stands until commanded
+  std::optional<Command> command_;
+  Points last_route_, polyline_;
+  Path traj_path_;
+  bool off_path_ = false;  // a command moved it off path_: re-plan when the AI takes over
 };
 
 Spot PedestrianAgent::sidewalk(const std::string& key, const json& v, const json* s_value,
@@ -488,10 +539,55 @@ std::vector<engine::DataPackId> PedestrianAgent::initialize(const std::string& n
   lights_dp_ = config.at("TrafficLightsDataPack").get<std::string>();
   weather_dp_ = config.at("WeatherDataPack").get<std::string>();
 
-  const Plan p = pick_plan(config, rng, u_mid < p_mid, mid_dist);
-  initial_path_ = make_path(p);
-  if (initial_path_.poses.size() < 2 || initial_path_.length() < 0.5)
-    fail("Route", "the route is empty (its start and end are the same point)");
+  command_dp_ = config.at("CommandDataPack").get<std::string>();
+  rng_.seed(seed * 0x9E3779B97F4A7C15ull + 0x0A7Eull);
+
+  const json& sp = config.at("StartPose");
+  if (!sp.is_object()) fail("StartPose", "expected {\"x\": ..., \"y\": ..., \"yaw\": ...}");
+  if (!sp.empty()) {
+    for (const auto& [k, v] : sp.items()) {
+      if (k != "x" && k != "y" && k != "yaw")
+        fail("StartPose", "unknown key \"" + k + "\" (x, y, yaw)");
+      if (!v.is_number() || !std::isfinite(v.get<double>()))
+        fail("StartPose." + k, "expected a number");
+    }
+    if (!sp.contains("x") || !sp.contains("y") || !sp.contains("yaw"))
+      fail("StartPose", "expected numbers \"x\", \"y\" and \"yaw\"");
+    const json& r = config.at("Route");
+    if (!r.is_object()) fail("Route", "expected {\"to\": \"ROAD:LANE\"} with StartPose");
+    for (const auto& [k, v] : r.items()) {
+      if (k != "to" && k != "to_s")
+        fail("Route." + k,
+             "give StartPose or Route." + k + ", not both (Route: {\"to\"[, \"to_s\"]})");
+    }
+    if (config.at("Position").is_object() && !config.at("Position").empty())
+      fail("StartPose", "give Position or StartPose, not both");
+    odr::Pose2 pose;
+    pose.x = sp["x"].get<double>();
+    pose.y = sp["y"].get<double>();
+    pose.heading = sp["yaw"].get<double>();
+    start_pose_ = pose;
+    if (r.contains("to"))
+      dest_ = sidewalk("Route.to", r["to"], r.contains("to_s") ? &r["to_s"] : nullptr, false);
+    initial_path_ = Path{};
+    initial_path_.append({pose});
+    initial_kr_from_ = INFINITY;
+    if (!path_from(initial_path_, pose.x, pose.y, pose.heading, &initial_kr_from_)) {
+      char where[96];
+      std::snprintf(where, sizeof where, "(%.2f, %.2f)", pose.x, pose.y);
+      warn_once("idle", std::string("no sidewalk within 50 m of its StartPose ") + where +
+                            ": it stands there until commanded");
+    }
+    initial_idle_ = initial_path_.length() < 1e-6;
+  } else {
+    const Plan p = pick_plan(config, rng, u_mid < p_mid, mid_dist);
+    initial_path_ = make_path(p);
+    if (initial_path_.poses.size() < 2 || initial_path_.length() < 0.5)
+      fail("Route", "the route is empty (its start and end are the same point)");
+    const odr::LaneRoute& last = p.after && !p.after->segments.empty() ? *p.after : *p.before;
+    if (!last.segments.empty()) dest_ = Spot{last.segments.back().lane, last.segments.back().s_to};
+  }
+  initial_rng_ = rng_;
   start();
 
   std::vector<engine::DataPackId> ids(1);
@@ -503,13 +599,21 @@ std::vector<engine::DataPackId> PedestrianAgent::initialize(const std::string& n
 
 void PedestrianAgent::start() {
   path_ = initial_path_;
+  idle_ = initial_idle_;
+  rng_ = initial_rng_;
+  kr_ = start_pose_ ? 0.0 : kKeepRight;
+  kr_from_ = initial_kr_from_;
+  command_.reset();
+  last_route_.clear();
+  polyline_.clear();
+  off_path_ = false;
   time_ns_ = 0;
   arc_ = 0;
   v_ = acc_ = walked_ = yaw_rate_ = 0;
   const odr::Pose2 p = path_.at(0);
-  x_ = p.x + kKeepRight * std::sin(p.heading);
-  y_ = p.y - kKeepRight * std::cos(p.heading);
-  yaw_ = p.heading;
+  x_ = p.x + kr_ * std::sin(p.heading);
+  y_ = p.y - kr_ * std::cos(p.heading);
+  yaw_ = start_pose_ ? start_pose_->heading : p.heading;
   committed_ = SIZE_MAX;
   absent_ = false;
   neighbours_.reset();
@@ -604,16 +708,270 @@ std::vector<PedestrianAgent::Threat> PedestrianAgent::threats(const Crossing& c)
   return out;
 }
 
+Points PedestrianAgent::parse_points(const std::string& key, const json& v) const {
+  if (!v.is_array() || v.empty())
+    fail(key, "expected a list of points [x, y], got " + v.dump().substr(0, 80));
+  Points out;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const json& p = v[i];
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    if (!p.is_array() || p.size() < 2 || p.size() > 3)
+      fail(k, "expected a point [x, y] (or [x, y, z]), got " + p.dump().substr(0, 80));
+    for (const json& c : p) {
+      if (!c.is_number() || !std::isfinite(c.get<double>()))
+        fail(k, "expected numbers, got " + p.dump().substr(0, 80));
+    }
+    out.push_back({p[0].get<double>(), p[1].get<double>()});
+  }
+  return out;
+}
+
+Command PedestrianAgent::parse_command(const std::string& dp, const json& j) const {
+  if (!j.is_object()) fail(dp, "expected a JSON object of commands, got " + j.dump().substr(0, 80));
+  auto object = [&](const std::string& key, const json& v,
+                    std::initializer_list<const char*> known) {
+    if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
+    for (const auto& [k, x] : v.items()) {
+      bool ok = false;
+      std::string list;
+      for (const char* n : known) {
+        ok = ok || k == n;
+        list += std::string(list.empty() ? "" : ", ") + n;
+      }
+      if (!ok) fail(key + "." + k, "unknown key (" + list + ")");
+    }
+  };
+  auto number = [&](const std::string& key, const json& obj, const char* k) {
+    if (!obj.contains(k)) fail(key + "." + k, "missing (a number)");
+    const json& v = obj[k];
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      fail(key + "." + k, "expected a number, got " + v.dump().substr(0, 80));
+    return v.get<double>();
+  };
+  auto pose = [&](const std::string& key, const json& v, bool speed_needed) {
+    object(key, v, {"x", "y", "z", "yaw", "speed"});
+    Command::Pose p;
+    p.x = number(key, v, "x");
+    p.y = number(key, v, "y");
+    p.yaw = number(key, v, "yaw");
+    if (v.contains("z")) number(key, v, "z");
+    if (v.contains("speed") || speed_needed) {
+      p.speed = number(key, v, "speed");
+      if (*p.speed < 0) fail(key + ".speed", "must be >= 0 m/s");
+    }
+    return p;
+  };
+  Command c;
+  for (const auto& [k, v] : j.items()) {
+    const std::string key = dp + "." + k;
+    if (k == "time_ns") {
+      if (!v.is_number()) fail(key, "expected a number (ns)");
+    } else if (k == "speed") {
+      object(key, v, {"speed", "target_speed", "acceleration"});
+      c.speed = number(key, v, "speed");
+      if (*c.speed < 0) fail(key + ".speed", "must be >= 0 m/s");
+      if (v.contains("target_speed")) number(key, v, "target_speed");
+      if (v.contains("acceleration")) number(key, v, "acceleration");
+    } else if (k == "lane") {
+      fail(key,
+           "a pedestrian has no lane to change to (a pedestrian_agent takes speed, route, "
+           "trajectory and teleport)");
+    } else if (k == "route") {
+      object(key, v, {"positions"});
+      if (!v.contains("positions")) fail(key + ".positions", "missing (a list of [x, y])");
+      Points pts = parse_points(key + ".positions", v["positions"]);
+      for (size_t i = 0; i < pts.size(); ++i) {
+        if (!graph_->locate(pts[i][0], pts[i][1], std::nullopt, 20.0)) {
+          char what[160];
+          std::snprintf(what, sizeof what, "(%.2f, %.2f) is farther than 20 m from any lane of ",
+                        pts[i][0], pts[i][1]);
+          fail(key + ".positions[" + std::to_string(i) + "]", what + net_->source);
+        }
+      }
+      c.route = std::move(pts);
+    } else if (k == "trajectory") {
+      if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
+      if (v.contains("polyline")) {
+        object(key, v, {"polyline", "length"});
+        if (v.contains("length")) number(key, v, "length");
+        c.polyline = parse_points(key + ".polyline", v["polyline"]);
+      } else {
+        c.timed = pose(key, v, true);
+      }
+    } else if (k == "teleport") {
+      c.teleport = pose(key, v, false);
+    } else {
+      fail(key, "unknown key (time_ns, speed, route, trajectory, teleport)");
+    }
+  }
+  if (c.timed && c.speed)
+    fail(dp + ".trajectory", "a timed trajectory sets the speed too: give it alone");
+  if (c.teleport && (c.timed || c.polyline))
+    fail(dp + ".teleport", "give teleport or trajectory, not both");
+  return c;
+}
+
+std::optional<odr::LanePosition> PedestrianAgent::nearest_sidewalk(double x, double y) const {
+  return graph_->locate_if(x, y, std::nullopt, 50.0,
+                           [](const odr::LaneNode& n, double) { return n.type == "sidewalk"; });
+}
+
+void PedestrianAgent::append_leg(Path& path, double ax, double ay, double bx, double by) const {
+  const double len = std::hypot(bx - ax, by - ay);
+  if (len < 1e-6) return;
+  const double heading = std::atan2(by - ay, bx - ax);
+  if (!path.poses.empty()) path.poses.back().heading = heading;
+  std::vector<odr::Pose2> line;
+  line.push_back(odr::Pose2{ax, ay, heading});
+  const int n = std::max(1, static_cast<int>(std::ceil(len / kSampleDs)));
+  for (int i = 1; i <= n; ++i) {
+    const double f = static_cast<double>(i) / n;
+    line.push_back(odr::Pose2{ax + f * (bx - ax), ay + f * (by - ay), heading});
+  }
+  const size_t first = path.poses.size();
+  path.append(line);
+  const size_t i0 = first > 0 ? first - 1 : 0;
+  Crossing cr;
+  cr.start = path.arc[i0];
+  cr.end = path.arc.back();
+  cr.enter = cr.end;
+  cr.exit = cr.start;
+  for (size_t i = i0; i < path.poses.size(); ++i) {
+    const auto loc = graph_->locate(path.poses[i].x, path.poses[i].y, std::nullopt, 2.0);
+    if (loc && loc->distance <= 0 && graph_->lane(loc->lane).type == "sidewalk") continue;
+    cr.enter = std::min(cr.enter, path.arc[i] - 0.5 * kSampleDs);
+    cr.exit = std::max(cr.exit, path.arc[i] + 0.5 * kSampleDs);
+  }
+  if (cr.exit > cr.enter) {
+    cr.enter = std::max(cr.enter, cr.start);
+    cr.exit = std::min(cr.exit, cr.end);
+    path.crossings.push_back(cr);
+  }
+}
+
+bool PedestrianAgent::path_from(Path& path, double x, double y, double yaw, double* join) {
+  const auto loc = nearest_sidewalk(x, y);
+  if (!loc) return false;
+  const odr::WorldPose w = graph_->world_pose(loc->road_id, loc->lane_id, loc->s);
+  append_leg(path, x, y, w.x, w.y);
+  if (join) *join = (path.arc.empty() ? 0.0 : path.arc.back()) + 0.5;  // past the corner
+  const Spot from{loc->lane, loc->s};
+  if (dest_) {
+    const Plan p = plan(from, *dest_, nullptr);
+    if (p.before) {
+      const Path rest = make_path(p);
+      if (rest.poses.empty()) return true;
+      const double base = path.arc.empty() ? 0.0 : path.arc.back();
+      const double gap = path.poses.empty() ? 0.0
+                                            : std::hypot(rest.poses[0].x - path.poses.back().x,
+                                                         rest.poses[0].y - path.poses.back().y);
+      const double offset = base + (gap < 1e-6 ? 0.0 : gap);
+      path.append(rest.poses);
+      for (Crossing c : rest.crossings) {
+        c.start += offset;
+        c.end += offset;
+        c.enter += offset;
+        c.exit += offset;
+        path.crossings.push_back(c);
+      }
+      return true;
+    }
+  }
+  // Along the sidewalks onward, the way it faces; at each fork a choice drawn from Seed.
+  const odr::LaneNode& n0 = graph_->lane(loc->lane);
+  const double h_s = w.heading + (n0.forward ? 0.0 : M_PI);  // the lane's +s direction
+  bool with_s = std::abs(std::remainder(yaw - h_s, 2 * M_PI)) <= M_PI / 2;
+  odr::LaneRoute route;
+  odr::LaneIndex cur = loc->lane;
+  double cs = loc->s, length = 0;
+  for (int guard = 0; guard < 10000 && length < 1000.0; ++guard) {
+    const odr::LaneNode& n = graph_->lane(cur);
+    odr::RouteSegment seg;
+    seg.lane = cur;
+    seg.road_id = n.road->id;
+    seg.lane_id = n.lane_id;
+    seg.junction = n.junction;
+    seg.s_from = std::clamp(cs, n.s0, n.s1);
+    seg.s_to = with_s ? n.s1 : n.s0;
+    if (n.s1 > n.s0) length += std::abs(seg.s_to - seg.s_from) / (n.s1 - n.s0) * n.length;
+    route.segments.push_back(seg);
+    std::vector<odr::LaneEndRef> next;
+    for (const odr::LaneEndRef& r : with_s ? n.at_end : n.at_start) {
+      if (graph_->lane(r.lane).type == "sidewalk") next.push_back(r);
+    }
+    if (next.empty()) break;
+    const odr::LaneEndRef r = next.size() == 1 ? next[0] : next[rng_() % next.size()];
+    cur = r.lane;
+    with_s = r.end == odr::LaneEnd::kStart;
+    cs = with_s ? graph_->lane(cur).s0 : graph_->lane(cur).s1;
+  }
+  route.length = length;
+  path.append(graph_->sample(route, kSampleDs));
+  return true;
+}
+
+void PedestrianAgent::replan(const Points& via) {
+  Path path;
+  path.append({odr::Pose2{x_, y_, yaw_}});
+  for (const auto& [px, py] : via)
+    append_leg(path, path.poses.back().x, path.poses.back().y, px, py);
+  const double yaw = path.poses.size() > 1 ? path.poses.back().heading : yaw_;
+  kr_from_ = INFINITY;
+  if (!path_from(path, path.poses.back().x, path.poses.back().y, yaw, &kr_from_) && via.empty()) {
+    char where[96];
+    std::snprintf(where, sizeof where, "(%.2f, %.2f)", x_, y_);
+    warn_once("idle", std::string("no sidewalk within 50 m of ") + where +
+                          ": it stands there until commanded");
+  }
+  path_ = std::move(path);
+  idle_ = path_.length() < 1e-6;
+  arc_ = 0;
+  kr_ = 0;
+  // Already on the road where the path starts: it is crossing, it does not wait.
+  committed_ = SIZE_MAX;
+  for (size_t i = 0; i < path_.crossings.size(); ++i) {
+    if (path_.crossings[i].enter - kCurbWait <= 1e-9) committed_ = i;
+    break;
+  }
+}
+
+void PedestrianAgent::set_polyline(const Points& points) {
+  if (points == polyline_) return;
+  polyline_ = points;
+  traj_path_ = Path{};
+  std::vector<odr::Pose2> poses;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const size_t j = i + 1 < points.size() ? i + 1 : i;
+    const double h = j != i ? std::atan2(points[j][1] - points[i][1], points[j][0] - points[i][0])
+                            : (poses.empty() ? yaw_ : poses.back().heading);
+    if (i + 1 < points.size()) {
+      const double len = std::hypot(points[j][0] - points[i][0], points[j][1] - points[i][1]);
+      const int n = std::max(1, static_cast<int>(std::ceil(len / kSampleDs)));
+      for (int k = 0; k < n; ++k) {
+        const double f = static_cast<double>(k) / n;
+        poses.push_back(odr::Pose2{points[i][0] + f * (points[j][0] - points[i][0]),
+                                   points[i][1] + f * (points[j][1] - points[i][1]), h});
+      }
+    } else {
+      poses.push_back(odr::Pose2{points[i][0], points[i][1], h});
+    }
+  }
+  traj_path_.append(poses);
+}
+
 int64_t PedestrianAgent::step(int64_t duration_ns) {
   const double dt = duration_ns * 1e-9;
   time_ns_ += duration_ns;
-  if (absent_) {
+  std::optional<Command> cmd;
+  cmd.swap(command_);
+  if (absent_ && !(cmd && (cmd->teleport || cmd->timed))) {
     // Respawn: at its start again, once RespawnDelay has passed and no walker is within 1 m.
     if (!respawn_ || time_ns_ - absent_since_ns_ < std::llround(respawn_delay_s_ * 1e9))
       return time_ns_;
     const odr::Pose2 p0 = initial_path_.at(0);
-    const double sx = p0.x + kKeepRight * std::sin(p0.heading);
-    const double sy = p0.y - kKeepRight * std::cos(p0.heading);
+    const double kr0 = start_pose_ ? 0.0 : kKeepRight;
+    const double sx = p0.x + kr0 * std::sin(p0.heading);
+    const double sy = p0.y - kr0 * std::cos(p0.heading);
     if (neighbours_) {
       for (const auto& u : neighbours_->users()) {
         if (!u.absent() && u.id() != name_ && std::hypot(u.x() - sx, u.y() - sy) < 1.0)
@@ -621,17 +979,100 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
       }
     }
     path_ = initial_path_;
+    idle_ = initial_idle_;
+    kr_ = kr0;
+    kr_from_ = initial_kr_from_;
     arc_ = 0;
     v_ = acc_ = yaw_rate_ = 0;
     x_ = sx;
     y_ = sy;
-    yaw_ = p0.heading;
+    yaw_ = start_pose_ ? start_pose_->heading : p0.heading;
     committed_ = SIZE_MAX;
     absent_ = false;
     publish();
     return time_ns_;
   }
-  const double v_des = speed_ * rain_factor_;
+  absent_ = false;
+  if (cmd && cmd->teleport) {
+    // Put there once, then back to its routing from there.
+    const Command::Pose& p = *cmd->teleport;
+    x_ = p.x;
+    y_ = p.y;
+    yaw_ = std::remainder(p.yaw, 2 * M_PI);
+    if (p.speed) v_ = *p.speed;
+    acc_ = yaw_rate_ = 0;
+    off_path_ = false;
+    polyline_.clear();
+    replan({});
+    publish();
+    return time_ns_;
+  }
+  if (cmd && cmd->timed) {
+    const Command::Pose& p = *cmd->timed;
+    const double v = p.speed.value_or(0.0);
+    const double yaw = std::remainder(p.yaw, 2 * M_PI);
+    walked_ += std::hypot(p.x - x_, p.y - y_);
+    yaw_rate_ = std::remainder(yaw - yaw_, 2 * M_PI) / dt;
+    acc_ = (v - v_) / dt;
+    x_ = p.x;
+    y_ = p.y;
+    yaw_ = yaw;
+    v_ = v;
+    off_path_ = true;
+    publish();
+    return time_ns_;
+  }
+  if (cmd && cmd->route && *cmd->route != last_route_) {
+    last_route_ = *cmd->route;
+    if (!cmd->polyline) off_path_ = false;
+    replan(*cmd->route);
+  }
+  const bool on_poly = cmd && cmd->polyline;
+  if (on_poly) {
+    set_polyline(*cmd->polyline);
+    off_path_ = true;
+  } else if (off_path_) {
+    off_path_ = false;
+    polyline_.clear();
+    replan({});
+  }
+  const double v_des = cmd && cmd->speed ? *cmd->speed : speed_ * rain_factor_;
+  if (on_poly) {
+    // Towards a point 0.5 m ahead on the polyline (its end at the last), at its speed.
+    const Path& t = traj_path_;
+    size_t best = 0;
+    double d2 = INFINITY;
+    for (size_t i = 0; i < t.poses.size(); ++i) {
+      const double dx = t.poses[i].x - x_, dy = t.poses[i].y - y_;
+      if (dx * dx + dy * dy < d2) {
+        d2 = dx * dx + dy * dy;
+        best = i;
+      }
+    }
+    const odr::Pose2& end = t.poses.back();
+    const double ahead = t.arc[best] + 0.5;
+    const odr::Pose2 target = ahead >= t.length() ? end : t.at(ahead);
+    const double dx = target.x - x_, dy = target.y - y_;
+    const double dist = std::hypot(dx, dy);
+    double v = cmd->speed ? v_des : walker_ahead_speed(v_des);
+    double step = v * dt;
+    if (ahead >= t.length()) step = std::min(step, dist);  // stops at its end
+    if (dist > 1e-9 && step > 0) {
+      const double yaw = std::atan2(dy, dx);
+      x_ += step * dx / dist;
+      y_ += step * dy / dist;
+      yaw_rate_ = std::remainder(yaw - yaw_, 2 * M_PI) / dt;
+      yaw_ = yaw;
+    } else {
+      step = 0;
+      yaw_rate_ = 0;
+    }
+    walked_ += step;
+    acc_ = (step / dt - v_) / dt;
+    v_ = step / dt;
+    publish();
+    return time_ns_;
+  }
   double limit = path_.length();  // the farthest arc it may be at
   // The next crossing not yet behind it.
   size_t ci = SIZE_MAX;
@@ -677,7 +1118,19 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
     }
   }
   double v = 0;
-  if (limit < arc_ - 1e-9) {
+  if (idle_) {
+    v = 0;
+  } else if (cmd && cmd->speed) {
+    // Commanded: on along its path at that speed, whatever the traffic.
+    v = std::min(v_des, (path_.length() - arc_) / dt);
+    for (size_t i = 0; i < path_.crossings.size(); ++i) {
+      const Crossing& c = path_.crossings[i];
+      if (c.exit > c.enter && c.enter - kCurbWait <= arc_ + v * dt && c.exit > arc_) {
+        committed_ = i;  // on it: the AI finishes the crossing
+        break;
+      }
+    }
+  } else if (limit < arc_ - 1e-9) {
     v = -std::min(v_des, (arc_ - limit) / dt);  // stepping back
   } else {
     v = std::min(v_des, (limit - arc_) / dt);
@@ -688,12 +1141,14 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   acc_ = (v - v_) / dt;
   v_ = v;
   const odr::Pose2 p = path_.at(arc_);
-  const double yaw_new = p.heading;
+  const double yaw_new = idle_ ? yaw_ : p.heading;
   yaw_rate_ = std::remainder(yaw_new - yaw_, 2 * M_PI) / dt;
-  x_ = p.x + kKeepRight * std::sin(p.heading);  // keeps right, so oncoming walkers pass
-  y_ = p.y - kKeepRight * std::cos(p.heading);
+  // Keeps right, so oncoming walkers pass (on a new path from where it stood, easing over).
+  if (arc_ > kr_from_) kr_ = std::min(kKeepRight, kr_ + 0.25 * std::abs(v) * dt);
+  x_ = p.x + kr_ * std::sin(p.heading);
+  y_ = p.y - kr_ * std::cos(p.heading);
   yaw_ = yaw_new;
-  if (arc_ >= path_.length() - 1e-6) {
+  if (!idle_ && arc_ >= path_.length() - 1e-6) {
     absent_ = true;
     absent_since_ns_ = time_ns_;
     if (respawn_) {  // absent, it waits at its start: its view is around there
@@ -749,6 +1204,14 @@ void PedestrianAgent::set_datapack(const datapack::View& dp) {
     auto j = std::make_shared<json>(datapack::read_json(dp));
     if (!j->is_object()) fail(name, "expected a JSON object {\"signals\": {id: state}}");
     lights_ = std::move(j);
+  } else if (name == command_dp_) {
+    if (!dp.is_json()) fail(name, "expected a JSON datapack of commands");
+    const json j = datapack::read_json(dp);
+    if (j.is_object() && j.empty()) {
+      command_.reset();  // on its own AI
+    } else {
+      command_ = parse_command(name, j);
+    }
   } else if (name == weather_dp_) {
     if (!dp.is_json()) fail(name, "expected the JSON weather datapack");
     const json w = datapack::read_json(dp);
@@ -758,7 +1221,8 @@ void PedestrianAgent::set_datapack(const datapack::View& dp) {
     rain_factor_ = rain && p > 0 ? 1.0 + 0.2 * std::clamp(p, 0.0, 1.0) : 1.0;
   } else {
     warn_once("dp:" + name, "datapack '" + name + "' is not one it reads (" + neighbours_dp_ +
-                                ", " + lights_dp_ + ", " + weather_dp_ + "); ignored");
+                                ", " + lights_dp_ + ", " + weather_dp_ + ", " + command_dp_ +
+                                "); ignored");
   }
 }
 

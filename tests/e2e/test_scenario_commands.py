@@ -20,7 +20,7 @@ import unittest
 
 from e2e_util import BIN_DIR, E2ETestCase
 from test_vehicle_agent import CONSTANT, XODR, LENGTH, W, front, rear
-from test_pedestrian_agent import NO_CROSSWALK
+from test_pedestrian_agent import CITY, NO_CROSSWALK
 
 AGENT = os.path.join(BIN_DIR, "convoy-engine-vehicle_agent")
 PED = os.path.join(BIN_DIR, "convoy-engine-pedestrian_agent")
@@ -381,6 +381,43 @@ class VehicleStartPose(CommandCase):
         self.assertAlmostEqual(rows[-1]["y"], 1.75, delta=0.05)
         self.assertLess(rows[-1]["x"], 480.0)
 
+    def test_onward_through_the_city_by_seed(self):
+        # On the city map from road 1 (west of junction 100), no Route: at each junction a
+        # way drawn from Seed, the route planned on as it goes, until a map edge.
+        seqs = {}
+        for seed in (0, 1, 2, 3, 0):
+            out = self.experiment("def command(t, me):\n    return None\n",
+                                  agent={"Map": CITY, "Route": {}, "Seed": seed,
+                                         "StartPose": {"x": -230.0, "y": -1.75, "yaw": 0.0},
+                                         "InitialSpeed": 12.0, "v0": 13.9, "LaneChanges": True},
+                                  timeout=70.0)
+            self.run_ok()
+            rows = self.rows(out)
+            os.remove(out)
+            present = [u for u in rows if not u["absent"]]
+            for k in range(1, len(present)):
+                self.assertContinuous(present, k, max_speed=15.0, max_dv=0.5)
+            roads = []
+            for u in present:
+                if not roads or roads[-1] != u["road"]:
+                    roads.append(u["road"])
+            self.assertGreater(len(roads), 2, roads)  # through a junction at least
+            if seed in seqs:
+                self.assertEqual(seqs[seed], roads, "the same seed, the same way")
+            seqs[seed] = roads
+            # It drove more than its first plan's 600 m, or ended at a map edge.
+            last = present[-1]
+            travelled = sum(math.hypot(b["x"] - a["x"], b["y"] - a["y"])
+                            for a, b in zip(present, present[1:]))
+            at_edge = abs(last["x"]) > 440 or abs(last["y"]) > 140
+            if os.environ.get("CONVOY_E2E_SHOW"):
+                print(seed, roads, round(travelled), rows[-1]["absent"], last["x"], last["y"])
+            self.assertTrue(travelled > 600.0 or (rows[-1]["absent"] and at_edge),
+                            (seed, roads, travelled, last))
+        if os.environ.get("CONVOY_E2E_SHOW"):
+            print(seqs)
+        self.assertGreater(len({tuple(v) for v in seqs.values()}), 1, seqs)
+
     def test_start_pose_with_route_to(self):
         out = self.experiment("def command(t, me):\n    return None\n",
                               agent={"Route": {"to": "1:-2"},
@@ -467,6 +504,333 @@ class VehicleBadCommand(CommandCase):
         r = self.run_convoy(timeout=60)
         self.assertNotEqual(r.code, 0)
         self.assertStderrHas(r, "car", "Route.from", "StartPose")
+        self.assertNoEngineLeft()
+
+
+class PedestrianCase(CommandCase):
+    binary = PED
+
+    def ped(self, command, agent=None, others=(), timeout=10.0):
+        return self.experiment(command, agent=dict({"EngineName": "ped"}, **(agent or {})),
+                               others=others, timeout=timeout, pedestrian=True)
+
+
+class PedestrianSpeed(PedestrianCase):
+    def test_walking_speed_and_walk_phase(self):
+        command = """\
+def command(t, me):
+    if 1.0 <= t < 3.0:
+        return {"speed": {"speed": 2.5}}
+    return None
+"""
+        out = self.ped(command, timeout=5.0)
+        self.run_ok()
+        rows = self.rows(out, "ped")
+        for u in rows:
+            if 1.0 <= u["t"] < 3.0 - 1e-9:
+                self.assertEqual(u["speed"], 2.5)
+            elif u["t"] >= 3.0 or u["t"] < 1.0:
+                self.assertAlmostEqual(u["speed"], 1.4, places=9)
+        a = next(u for u in rows if u["t"] == 1.5)
+        b = next(u for u in rows if u["t"] == 2.0)
+        self.assertAlmostEqual(b["x"] - a["x"], 1.25, places=6)
+        # walk_phase: the distance walked / StrideLength (1.4 m), mod 1.
+        self.assertAlmostEqual((b["walk_phase"] - a["walk_phase"]) % 1.0, 1.25 / 1.4 % 1.0,
+                               places=6)
+
+    CROSS = """\
+def command(t, me):
+    c = {{}}
+    if abs(t - 0.5) < 1e-6:
+        c["route"] = {{"positions": [[3.0, -4.75], [3.0, 4.75], [10.0, 4.75]]}}
+    if {commanded} and t >= 0.5:
+        c["speed"] = {{"speed": 1.4}}
+    return c or None
+"""
+
+    def crossing(self, commanded):
+        # A car comes along lane -1 (y = -1.75) at 10 m/s, at x = 3 at t = 6.3 s.
+        out = self.ped(self.CROSS.format(commanded=commanded),
+                       agent={"CriticalGap": 4.0, "CriticalGapSd": 0.0},
+                       others=[("car", -60.0, -1.75, 10.0)], timeout=22.0)
+        self.run_ok()
+        with open(out) as f:
+            rows = [json.loads(line) for line in f]
+        both = [r for r in rows if "ped" in r and "car" in r and r["ped"]["time_ns"] > 0]
+        on_road = next(r for r in both if r["ped"]["y"] > -3.5)
+        return both, on_road
+
+    def test_route_across_the_road_waits_for_the_gap_on_its_own(self):
+        both, on_road = self.crossing(False)
+        self.assertGreater(rear(on_road["car"]), 3.5, "it stepped out after the car had passed")
+        # Then it crossed, and walks on along the far sidewalk the way its route ended (+x).
+        last = both[-1]["ped"]
+        self.assertEqual(last["lane"], 2)
+        self.assertGreater(last["x"], 10.0)
+        self.assertAlmostEqual(last["y"], 4.75 - 0.55, delta=0.05)
+
+    def test_with_a_speed_command_it_does_not_wait(self):
+        both, on_road = self.crossing(True)
+        self.assertLess(front(on_road["car"]), 0.0, "it stepped out before the car came")
+        self.assertTrue(all(r["ped"]["speed"] == 1.4 for r in both if r["ped"]["time_ns"] > 0.5e9))
+
+
+class PedestrianTrajectory(PedestrianCase):
+    def test_timed_then_back_to_the_sidewalk(self):
+        command = """\
+_start = []
+def command(t, me):
+    if 1.0 <= t <= 3.0 + 1e-9:
+        if not _start:
+            _start.append((me["x"], me["y"]))
+        x0, y0 = _start[0]
+        u = t - 1.0
+        return {"trajectory": {"x": x0 + 0.5 * u, "y": y0 + 2.0 * u, "yaw": math.atan2(2.0, 0.5),
+                               "speed": math.hypot(0.5, 2.0)}}
+    return None
+"""
+        out = self.ped(command, timeout=10.0)
+        self.run_ok()
+        rows = self.rows(out, "ped")
+        timed = [u for u in rows if u["cmd"]]
+        for u in timed:
+            c = u["cmd"]["trajectory"]
+            self.assertEqual((u["x"], u["y"], u["yaw"], u["speed"]),
+                             (c["x"], c["y"], c["yaw"], c["speed"]))
+        self.assertGreater(timed[-1]["y"], -1.5)  # on the road
+        # walk_phase advanced with the distance moved.
+        d = math.hypot(0.5, 2.0) * 1.0
+        a = next(u for u in timed if abs(u["t"] - 2.0) < 1e-6)
+        b = next(u for u in timed if abs(u["t"] - 3.0) < 1e-6)
+        self.assertAlmostEqual((b["walk_phase"] - a["walk_phase"]) % 1.0, d / 1.4 % 1.0, places=6)
+        # Then back onto sidewalk -2 (the nearest) and on to its destination (x = 100).
+        i = rows.index(timed[-1]) + 1
+        for k in range(i, len(rows)):
+            self.assertContinuous(rows, k, max_speed=1.5, max_dv=1.5)
+        self.assertEqual(rows[-1]["lane"], -2)
+        self.assertGreater(rows[-1]["x"], timed[-1]["x"] + 3.0)
+        self.assertAlmostEqual(rows[-1]["y"], -4.75 - 0.55, delta=0.05)
+
+    def test_untimed_polyline(self):
+        command = """\
+_start = []
+def command(t, me):
+    if not _start:
+        _start.append(me["x"])
+    x0 = _start[0]
+    if 1.0 <= t <= 12.0:
+        return {"trajectory": {"polyline": [[x0 + 2.0, -4.75], [x0 + 6.0, -4.75], [x0 + 6.0, 0.0]],
+                               "length": 10.0}}
+    return None
+"""
+        out = self.ped(command, timeout=14.0)
+        self.run_ok()
+        rows = self.rows(out, "ped")
+        followed = [u for u in rows if u["cmd"]]
+        x0 = followed[0]["cmd"]["trajectory"]["polyline"][0][0] - 2.0
+        for k in range(1, len(rows)):
+            self.assertContinuous(rows, k, max_speed=1.5, max_dv=1.5)
+        # At its own speed, then standing at the end while the command lasts.
+        self.assertAlmostEqual(followed[10]["speed"], 1.4, places=6)
+        end = followed[-1]
+        self.assertAlmostEqual(end["x"], x0 + 6.0, delta=0.05)
+        self.assertAlmostEqual(end["y"], 0.0, delta=0.05)
+        self.assertEqual(end["speed"], 0.0)
+        mid = [u for u in followed if u["y"] > -3.5 and u["y"] < -1.0]
+        self.assertTrue(all(abs(u["x"] - (x0 + 6.0)) < 0.1 for u in mid))
+        self.assertTrue(all(abs(abs(u["yaw"]) - math.pi / 2) < 0.1 for u in mid))
+
+
+class PedestrianTeleport(PedestrianCase):
+    def test_teleport_then_on_along_that_sidewalk(self):
+        command = """\
+def command(t, me):
+    if abs(t - 2.0) < 1e-6:
+        return {"teleport": {"x": 50.0, "y": 4.75, "yaw": 0.0}}
+    return None
+"""
+        out = self.ped(command, timeout=6.0)
+        self.run_ok()
+        rows = self.rows(out, "ped")
+        at = next(u for u in rows if u["t"] == 2.0)
+        self.assertEqual((at["x"], at["y"], at["yaw"]), (50.0, 4.75, 0.0))
+        after = [u for u in rows if u["t"] > 2.0]
+        for k in range(rows.index(after[0]), len(rows)):
+            self.assertContinuous(rows, k, max_speed=1.5, max_dv=1.5)
+        # No way back across (no crosswalk): on along sidewalk 2 the way it faces.
+        self.assertEqual({u["lane"] for u in after}, {2})
+        self.assertGreater(after[-1]["x"], 54.0)
+        self.assertAlmostEqual(after[-1]["y"], 4.75 - 0.55, delta=0.05)
+
+
+class PedestrianStartPose(PedestrianCase):
+    def test_starts_at_its_pose_and_walks_the_sidewalk(self):
+        out = self.ped("def command(t, me):\n    return None\n",
+                       agent={"Route": {}, "StartPose": {"x": 20.0, "y": -3.9, "yaw": 0.0}},
+                       timeout=8.0)
+        self.run_ok()
+        rows = self.rows(out, "ped")
+        # (easing 0.25 m sideways per m walked to its keep-right offset)
+        self.assertLess(math.hypot(rows[0]["x"] - 20.0, rows[0]["y"] + 3.9),
+                        1.4 * DT * math.hypot(1.0, 0.25) + 1e-6)
+        for k in range(1, len(rows)):
+            self.assertContinuous(rows, k, max_speed=1.5, max_dv=1.5)
+        self.assertEqual(rows[-1]["lane"], -2)
+        self.assertGreater(rows[-1]["x"], 25.0)
+
+    def test_without_sidewalks_it_stands_until_commanded(self):
+        command = """\
+def command(t, me):
+    if t >= 2.0:
+        return {"speed": {"speed": 1.5},
+                "trajectory": {"polyline": [[60.0, -9.0], [60.0, 9.0]], "length": 18.0}}
+    return None
+"""
+        out = self.experiment(command, agent={"EngineType": "pedestrian_agent", "EngineName": "ped",
+                                              "Route": {}, "v0": None, "LaneChanges": None,
+                                              "StartPose": {"x": 60.0, "y": -9.0,
+                                                            "yaw": math.pi / 2}},
+                              timeout=8.0)
+        # (the vehicle test road: no sidewalks; drop the vehicle keys)
+        with open(os.path.join(self.dir, "simulation_config.json")) as f:
+            cfg = json.load(f)
+        for key in ("v0", "LaneChanges"):
+            del cfg["EngineConfigs"][0][key]
+        self.write_config(cfg)
+        r = self.run_ok()
+        self.assertRegex(r.stderr, "(?i)warning.*no sidewalk within 50 m")
+        rows = self.rows(out, "ped")
+        before = [u for u in rows if u["t"] < 2.0]
+        self.assertTrue(all((u["x"], u["y"], u["speed"]) == (60.0, -9.0, 0.0) for u in before))
+        self.assertAlmostEqual(rows[-1]["x"], 60.0, places=6)
+        # commanded from the step ending at 2.0 s: 121 steps of 1.5 m/s x 0.05 s
+        self.assertAlmostEqual(rows[-1]["y"], -9.0 + 1.5 * (8.0 - 2.0 + DT), delta=1e-6)
+
+
+class PedestrianDeterminism(PedestrianCase):
+    def test_two_runs_are_identical(self):
+        command = """\
+def command(t, me):
+    if abs(t - 0.5) < 1e-6:
+        return {"route": {"positions": [[3.0, -4.75], [3.0, 4.75], [10.0, 4.75]]}}
+    if 5.0 <= t < 6.0:
+        return {"speed": {"speed": 2.0}}
+    if 8.0 <= t < 9.0:
+        return {"trajectory": {"polyline": [[me["x"], me["y"]], [me["x"] + 3.0, 0.0]]}}
+    return None
+"""
+        digests = []
+        for _ in range(2):
+            out = self.ped(command, others=[("car", -60.0, -1.75, 10.0)], timeout=12.0)
+            self.run_ok()
+            with open(out) as f:
+                rows = [json.loads(line)["_digest"] for line in f if "_digest" in line]
+            self.assertGreater(len(rows), 200)
+            digests.append(hashlib.sha1("".join(rows).encode()).hexdigest())
+            os.remove(out)
+        self.assertEqual(digests[0], digests[1])
+
+
+class PedestrianBadCommand(PedestrianCase):
+    def bad(self, cmd, *needles):
+        self.ped("def command(t, me):\n    return %r if t >= 1.0 else None\n" % (cmd,),
+                 timeout=3.0)
+        r = self.run_convoy(timeout=60)
+        self.assertExit(r, EXIT_ENGINE)
+        self.assertOneError(r)
+        self.assertStderrHas(r, "pedestrian_agent 'ped'", *needles)
+        self.assertNoEngineLeft()
+        self.assertLogsKept("ped")
+
+    def test_lane_is_an_error(self):
+        self.bad({"lane": {"road": "1", "lane": -1, "from_lane": -2, "progress": 0.5}},
+                 "command.lane", "a pedestrian has no lane")
+
+    def test_route_position_far_off(self):
+        self.bad({"route": {"positions": [[50.0, 80.0]]}}, "command.route.positions[0]",
+                 "farther than 20 m")
+
+    def test_bad_polyline(self):
+        self.bad({"trajectory": {"polyline": [[1.0, "a"]]}}, "command.trajectory.polyline[0]",
+                 "expected numbers")
+
+
+WEATHER_TF = """\
+import json, os
+from nrp_core import *
+from nrp_core.data.nrp_json import JsonDataPack
+_OUT = open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "weather.jsonl"), "a")
+CONTROLS = {controls!r}
+
+
+@EngineDataPack(keyword='weather', id=DataPackIdentifier('weather', 'weather'))
+@TransceiverFunction("weather")
+def control_tf(weather):
+    if weather.isEmpty():
+        return []
+    _OUT.write(json.dumps(weather.data, sort_keys=True) + "\\n")
+    _OUT.flush()
+    c = CONTROLS.get("%.2f" % weather.data["time_s"])
+    return [JsonDataPack("weather_control", "weather", c)] if c is not None else []
+"""
+
+
+class WeatherControl(E2ETestCase):
+    def run_weather(self, controls, timeout=6.0, schedule=()):
+        self.write("control_tf.py", WEATHER_TF.format(controls=controls))
+        path = os.path.join(self.dir, "weather.jsonl")
+        if os.path.exists(path):
+            os.remove(path)
+        self.write_config({"SimulationName": "w", "SimulationTimeout": timeout,
+                           "EngineConfigs": [{"EngineType": "weather", "EngineName": "weather",
+                                              "EngineTimestep": 0.1, "Seed": 2, "WindSpeed": 3.0,
+                                              "Schedule": list(schedule)}],
+                           "DataPackProcessingFunctions": [{"Name": "control_tf",
+                                                            "FileName": "control_tf.py"}]})
+        r = self.run_convoy(timeout=60)
+        return r, path
+
+    def test_a_step_and_a_transition_override_the_schedule(self):
+        controls = {"1.00": {"Precipitation": 0.8, "Surface": "wet"},
+                    "2.00": {"Visibility": 100.0, "TransitionTime": 2.0}}
+        r, path = self.run_weather(controls, schedule=[{"Time": 5.0, "Precipitation": 0.1,
+                                                        "WindSpeed": 9.0}])
+        self.assertExit(r, 0)
+        with open(path) as f:
+            rows = [json.loads(line) for line in f]
+        at = {"%.1f" % w["time_s"]: w for w in rows}
+        self.assertEqual(at["1.0"]["precipitation"], 0.0)
+        self.assertEqual(at["1.0"]["surface"], "dry")
+        self.assertEqual(at["1.1"]["precipitation"], 0.8)   # from the step it arrived
+        self.assertEqual(at["1.1"]["surface"], "wet")
+        self.assertEqual(at["1.1"]["mu"], 0.5)
+        self.assertAlmostEqual(at["2.0"]["visibility_m"], 20000.0, places=6)
+        self.assertAlmostEqual(at["3.0"]["visibility_m"], math.sqrt(20000.0 * 100.0), places=6)
+        self.assertAlmostEqual(at["4.0"]["visibility_m"], 100.0, places=6)
+        self.assertTrue(at["4.0"]["fog"])
+        # The Schedule's change at 5 s: precipitation stays the control's, wind still moves.
+        self.assertEqual(at["5.5"]["precipitation"], 0.8)
+        self.assertGreater(at["5.5"]["wind_speed_mps"], 5.0)
+        # Deterministic: the same run again gives the same stream.
+        shutil_rows = rows
+        r, path = self.run_weather(controls, schedule=[{"Time": 5.0, "Precipitation": 0.1,
+                                                        "WindSpeed": 9.0}])
+        self.assertExit(r, 0)
+        with open(path) as f:
+            self.assertEqual([json.loads(line) for line in f], shutil_rows)
+
+    def test_bad_control_names_the_key(self):
+        r, _ = self.run_weather({"1.00": {"Surface": "mud"}}, timeout=2.0)
+        self.assertExit(r, EXIT_ENGINE)
+        self.assertOneError(r)
+        self.assertStderrHas(r, "weather engine 'weather'", "weather_control.Surface",
+                             "unknown surface \"mud\"")
+        self.assertNoEngineLeft()
+
+    def test_unknown_control_key(self):
+        r, _ = self.run_weather({"1.00": {"Rain": 1.0}}, timeout=2.0)
+        self.assertExit(r, EXIT_ENGINE)
+        self.assertStderrHas(r, "weather_control.Rain", "unknown key")
         self.assertNoEngineLeft()
 
 
