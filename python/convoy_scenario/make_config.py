@@ -6,7 +6,7 @@ runs; docs/scenarios.md, "Running a scenario"):
   map needs --world FILE.sdf), the ego (the report's smart car with its camera) inserted at its
   Init teleport;
 - one vehicle_agent per other Vehicle entity and one pedestrian_agent per Pedestrian entity,
-  started at their Init teleports (Position) with their Init AbsoluteTargetSpeed
+  started at their Init teleports (StartPose) with their Init AbsoluteTargetSpeed
   (InitialSpeed), sized from their BoundingBox, their model from the catalog entry or the
   vehicle's name when the actor-model table has it, else from the category;
 - the weather engine with the Init EnvironmentActions; the traffic_lights engine when the map
@@ -322,7 +322,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                 road_len = next(r["length"] for r in odr.info()["roads"] if r["id"] == loc["road"])
                 to_s = loc["s"] + 60.0 if loc["s"] + 60.0 < road_len else max(0.0, loc["s"] - 60.0)
                 a = {"EngineType": "pedestrian_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
-                     "Map": xodr, "Position": {"x": pose[0], "y": pose[1]},
+                     "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
                      "Route": {"to": "%s:%d" % (loc["road"], loc["lane"]), "to_s": to_s},
                      "Seed": 100 + i, "Length": max(bb.length, 0.3), "Width": max(bb.width, 0.3),
                      "Height": bb.height}
