@@ -332,7 +332,9 @@ def stopped_vehicle(desc=""):
 
 
 def red_light(desc=""):
-    p = {"EgoS": ("double", "150"), "RouteLength": ("double", "140"), "Duration": ("double", "45")}
+    # junction 100's approaches from the west are green for 15 s from t = 0 (then yellow 3 s,
+    # all red 2 s, the other road's 20 s): from s = 20 the ego reaches the stop line at ~27 s
+    p = {"EgoS": ("double", "20"), "RouteLength": ("double", "260"), "Duration": ("double", "60")}
     init = {"Ego": ego_init()}
     return scenario("Red light%s: the ego reaches junction 100 on its approach's red (the traffic_lights "
                     "engine's fixed program: 15 s green, 3 s yellow, 2 s all red) and must wait" % desc,

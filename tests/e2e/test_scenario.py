@@ -257,6 +257,26 @@ class Run(ScenarioCase):
         self.assertGreater(runs[0]["route_completion"], 0.0)
 
 
+    def test_own_ego(self):
+        # --ego: a user's ego (a kinematic stand-in at the ego's Init pose, 5 m/s east) instead of
+        # the report's smart car; it drives the scenario's route and is scored
+        frag = os.path.join(self.dir, "ego.json")
+        with open(frag, "w") as f:
+            json.dump({"EngineConfigs": [{"EngineType": "python_json", "EngineName": "myego",
+                                          "PythonFileName": STAND_IN, "EngineTimestep": 0.05,
+                                          "Start": {"x": -220.0, "y": -1.75, "yaw": 0.0, "speed": 5.0}}],
+                       "EgoState": "myego/state"}, f)
+        code, out, err = self.run_scenario(os.path.join(SUITE, "following.xosc"), "--ego", frag)
+        self.assertEqual(code, 0, err)
+        with open(os.path.join(self.run_dir, "scenario_config.json")) as f:
+            names = [e["EngineName"] for e in json.load(f)["EngineConfigs"]]
+        self.assertIn("myego", names)
+        self.assertNotIn("car_ctl_engine", names)
+        s = self.summary()
+        self.assertAlmostEqual(s["route_completion"], 100.0, places=6)
+        self.assertEqual(s["score"]["route_length_m"], 150.0)
+
+
 class Campaign(ScenarioCase):
     def test_local_campaign(self):
         suite = os.path.join(self.dir, "suite")
