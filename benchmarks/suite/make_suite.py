@@ -82,12 +82,22 @@ def lane_change(target, time, relative_to=None):
             % (time, tgt))
 
 
-def walk(name, points):
-    verts = "".join("<Vertex><Position>%s</Position></Vertex>" % world_pos(x, y) for x, y in points)
+def walk(name, points, speed_param="$WalkSpeed"):
+    """Walk the polyline at speed_param m/s from the event's start: a timed trajectory (relative
+    timing), which controls the walker's both domains, so its own AI (gap acceptance) does not
+    stop it at the kerb."""
+    verts, t, prev = [], 0.0, None
+    for x, y in points:
+        if prev is not None:
+            t += abs(float(y) - float(prev[1])) if prev[0] == x else 0.0
+        time = "0" if prev is None else "${%g / %s}" % (t, speed_param)
+        verts.append('<Vertex time="%s"><Position>%s</Position></Vertex>' % (time, world_pos(x, y)))
+        prev = (x, y)
     return ('<PrivateAction><RoutingAction><FollowTrajectoryAction><Trajectory name="%s" closed="false">'
-            '<Shape><Polyline>%s</Polyline></Shape></Trajectory><TimeReference><None/></TimeReference>'
-            '<TrajectoryFollowingMode followingMode="follow"/></FollowTrajectoryAction></RoutingAction>'
-            '</PrivateAction>' % (name, verts))
+            '<Shape><Polyline>%s</Polyline></Shape></Trajectory><TimeReference><Timing '
+            'domainAbsoluteRelative="relative" scale="1" offset="0"/></TimeReference>'
+            '<TrajectoryFollowingMode followingMode="position"/></FollowTrajectoryAction></RoutingAction>'
+            '</PrivateAction>' % (name, "".join(verts)))
 
 
 def route(name, positions):
@@ -247,7 +257,7 @@ def cut_in(hw="0.6", change="3", end_speed="6", speed_="12", weather=None, desc=
     g = group("Cutter", [
         event("KeepSpeed", speed("$CutterSpeed")),
         event("CutIn", lane_change(None, "$LaneChangeTime", relative_to="Ego"), headway("Ego", "Cutter", "$Headway", "CutterAhead")),
-        event("SlowDown", speed("$CutterEndSpeed", "linear", "rate", "-2"), after("CutIn", "CutInDone")),
+        event("SlowDown", speed("$CutterEndSpeed", "linear", "time", "10"), after("CutIn", "CutInDone")),
     ])
     return scenario("Cut-in%s: a sedan in the left lane overtakes the ego and, once its rear is $Headway s "
                     "of the ego's travel ahead, changes into the ego's lane in $LaneChangeTime s, then "
@@ -292,8 +302,7 @@ def jaywalker(entry="adult", walk_speed="1.6", trigger_m="30", x="-100", weather
     if weather:
         init[None] = [weather]
     g = group("Walker", [
-        event("Walk", speed("$WalkSpeed", "linear", "time", "0.5"), near("Ego", "Walker", "$TriggerDistance", "EgoNear")),
-        event("Cross", walk("Crossing", [("$CrossX", y0), ("$CrossX", y1)]), near("Ego", "Walker", "$TriggerDistance", "EgoNear2")),
+        event("Cross", walk("Crossing", [("$CrossX", y0), ("$CrossX", y1)]), near("Ego", "Walker", "$TriggerDistance", "EgoNear")),
     ])
     return scenario("Jaywalker%s: a pedestrian crosses the road mid-block at x = $CrossX at $WalkSpeed m/s when "
                     "the ego is $TriggerDistance m away" % desc, p, [EGO, pedestrian("Walker", entry)], init, [g])
@@ -309,9 +318,8 @@ def pedestrian_behind_parked(weather=None, desc=""):
     if weather:
         init[None] = [weather]
     g = group("Walker", [
-        event("Walk", speed("$WalkSpeed", "linear", "time", "0.3"), near("Ego", "Walker", "$TriggerDistance", "EgoNear")),
         event("StepOut", walk("StepOut", [("${$ParkedS - 247}", "-8.0"), ("${$ParkedS - 247}", "3.0")]),
-              near("Ego", "Walker", "$TriggerDistance", "EgoNear2")),
+              near("Ego", "Walker", "$TriggerDistance", "EgoNear")),
     ])
     ent = [EGO, vehicle("Parked", "van"), pedestrian("Walker", "child")]
     text = scenario("Pedestrian steps out behind a parked car%s: a child walks out from behind a van parked "

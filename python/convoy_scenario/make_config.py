@@ -7,7 +7,7 @@ runs; docs/scenarios.md, "Running a scenario"):
   Init teleport;
 - one vehicle_agent per other Vehicle entity and one pedestrian_agent per Pedestrian entity,
   started at their Init teleports (StartPose) with their Init AbsoluteTargetSpeed
-  (InitialSpeed), sized from their BoundingBox, their model from the catalog entry or the
+  (InitialSpeed, and a vehicle's desired speed v0 when its own AI drives it), sized from their BoundingBox, their model from the catalog entry or the
   vehicle's name when the actor-model table has it, else from the category;
 - the weather engine with the Init EnvironmentActions; the traffic_lights engine when the map
   has traffic lights;
@@ -316,6 +316,8 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                     wheelbase = 0.6 * bb.length   # small vehicles without axles (a bicycle)
                 if wheelbase and 0 < wheelbase < bb.length:
                     a["Wheelbase"] = wheelbase
+                if a["InitialSpeed"] > 0:
+                    a["v0"] = a["InitialSpeed"]   # its desired speed when its own AI drives
             else:
                 loc = lane_of(odr, pose[0], pose[1], None, "pedestrian %r's Init position" % ent.name,
                               types=("sidewalk",))
