@@ -1,8 +1,9 @@
 """Where points lie on an OpenDRIVE map, read with the standard library and numpy: the road,
 the lane and its type, whether the road is in a junction, the lane's direction of travel and
-its speed limit. Enough for the city map (experiments/city_traffic/city.xodr): line, arc and
-paramPoly3 geometries, lane sections, lane width polynomials, speeds of road types or lanes.
-Other geometries (spiral, poly3) and lane offsets are refused (ValueError).
+its speed limit. Enough for the city map (experiments/city_traffic/city.xodr) and the Parkring
+(experiments/autonomous_driving/parkring.xodr): line, arc, spiral (integrated numerically) and
+paramPoly3 geometries, lane offsets, lane sections, lane width polynomials, speeds of road types
+or lanes. Other geometries (poly3) are refused (ValueError).
 
 Rules:
 - Each road's reference line is sampled every SAMPLE_M (0.25 m). A point lies on a road when
@@ -55,7 +56,16 @@ def _geometry_points(g, step):
         dv = c["bV"] + 2 * c["cV"] * p + 3 * c["dV"] * p ** 2
         ch, sh = math.cos(h0), math.sin(h0)
         return s0 + ds, x0 + u * ch - v * sh, y0 + u * sh + v * ch, h0 + np.arctan2(dv, du)
-    raise ValueError("geometry %r at s=%g is not supported (line, arc, paramPoly3)" % (kind, s0))
+    if kind == "spiral":
+        # a clothoid: curvature from curvStart to curvEnd linearly; integrated numerically on a
+        # grid 10 times finer than the samples (trapezoids on cos / sin of the heading)
+        k0, k1 = float(g[0].get("curvStart")), float(g[0].get("curvEnd"))
+        fine = np.linspace(0.0, length, 10 * (n - 1) + 1)
+        hf = h0 + k0 * fine + 0.5 * (k1 - k0) / length * fine * fine
+        dx = np.concatenate([[0.0], np.cumsum(0.5 * (np.cos(hf[1:]) + np.cos(hf[:-1])) * np.diff(fine))])
+        dy = np.concatenate([[0.0], np.cumsum(0.5 * (np.sin(hf[1:]) + np.sin(hf[:-1])) * np.diff(fine))])
+        return s0 + fine[::10], x0 + dx[::10], y0 + dy[::10], hf[::10]
+    raise ValueError("geometry %r at s=%g is not supported (line, arc, spiral, paramPoly3)" % (kind, s0))
 
 
 def _speed(elem):
@@ -70,8 +80,8 @@ def load(path):
     roads = []
     for r in root.findall("road"):
         rid = r.get("id")
-        if r.find("lanes/laneOffset") is not None:
-            raise ValueError("%s: road %s: lane offsets are not supported" % (path, rid))
+        offsets = sorted((float(o.get("s", 0.0)), [float(o.get(k, 0.0)) for k in "abcd"])
+                         for o in r.findall("lanes/laneOffset"))
         parts = [_geometry_points(g, SAMPLE_M) for g in r.find("planView").findall("geometry")]
         s, x, y, h = (np.concatenate([p[i] for p in parts]) for i in range(4))
         sections = []
@@ -90,7 +100,8 @@ def load(path):
                  for e in r.findall("link/" + tag) if e.get("elementType", "road") == "road"]
         road = {"id": rid, "junction": r.get("junction", "-1") != "-1", "length": float(r.get("length")),
                 "s": s, "x": x, "y": y, "h": h, "sections": sorted(sections, key=lambda p: p[0]),
-                "speed": _speed(r.find("type/speed")), "links": links, "lht": r.get("rule") == "LHT"}
+                "speed": _speed(r.find("type/speed")), "links": links, "lht": r.get("rule") == "LHT",
+                "offsets": offsets}
         road["bbox"] = (x.min(), x.max(), y.min(), y.max(), _max_extent(road))
         roads.append(road)
     return {"roads": roads, "by_id": {r["id"]: r for r in roads}}
@@ -108,8 +119,12 @@ def _lane_spans(road, s):
         if ss <= s + 1e-9:
             sec_s, lanes = ss, ls
     spans = {}
+    base = 0.0
+    applicable = [o for o in road.get("offsets", ()) if o[0] <= s + 1e-9]
+    if applicable:
+        base = _width(applicable[-1][1], s - applicable[-1][0])  # <laneOffset>: the centre lane's t
     for side in (1, -1):
-        edge = 0.0
+        edge = base
         for lid in sorted((k for k in lanes if k * side > 0), key=abs):
             ws = lanes[lid]["widths"]
             w = 0.0

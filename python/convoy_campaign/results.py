@@ -72,8 +72,12 @@ def collect(plan, state, scorer=None, scorer_missing=None):
                "attempts": st["attempts"], "log": st["log"], "reason": st["reason"],
                "summary": _read_json(os.path.join(task["run_dir"], "summary.json")),
                "score": None, "score_error": None}
+        live = rec["summary"]
         if st["exit_code"] != 0:
             rec["score_error"] = "the run did not succeed"
+        elif isinstance(live.get("score"), dict) and "driving_score" in live:
+            # scored while it ran (a scenario run: convoy_bench/metrics_tf.py)
+            rec["score"] = dict(live["score"], infractions=live.get("infractions") or [])
         elif scorer is None:
             rec["score_error"] = scorer_missing
         else:

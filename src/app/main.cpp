@@ -1,15 +1,22 @@
 // convoy: the coordinator's command line. Also installed as NRPCoreSim, which behaves like
 // `convoy run` and takes NRP-Core's options.
 #include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "app/simulation.h"
 #include "core/memory.h"
+#include "python/interpreter.h"
+
+extern char** environ;
 
 namespace {
 
@@ -17,8 +24,12 @@ void usage(const char* prog) {
   std::printf(
       "usage: %s run -c simulation_config.json [-o Key=Value]... [--run-dir DIR] [--quiet]\n"
       "                  [--record] [--record-blobs]\n"
+      "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--ego FRAGMENT.json]\n"
+      "                [-o Key=Value]... [--run-dir DIR] [--quiet] [--record]\n"
       "       %s replay RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
+      "       %s campaign SUITE_DIR [--seeds N] [--workers N] [--backend local|slurm] [--out DIR]\n"
+      "                [...]  (tools/campaign/campaign.py; --help for its options)\n"
       "       NRPCoreSim -c simulation_config.json [-o Key=Value]...\n"
       "\n"
       "  --record            record every datapack that crosses the coordinator into\n"
@@ -30,6 +41,11 @@ void usage(const char* prog) {
       "                      wrote (driving_score...) with the live ones; exit 5 if one differs\n"
       "\n"
       "  -c, --config FILE   the simulation config (NRP-Core format)\n"
+      "  --scenario FILE     run an OpenSCENARIO file with a default config (written into the\n"
+      "                      run folder as scenario_config.json; docs/scenarios.md)\n"
+      "  --world FILE        with --scenario: the world SDF (without the ego) for a map the\n"
+      "                      project does not know\n"
+      "  --ego FILE          with --scenario: a config fragment with the user's ego engines\n"
       "  -o, --param K=V     override a config key; K may be a path like "
       "EngineConfigs/0/EngineTimestep\n"
       "  --run-dir DIR       where to write logs, steps.csv and summary.json\n"
@@ -45,7 +61,7 @@ void usage(const char* prog) {
       "  --logoutput all|engines|silent   all: this program's output into --logfilename;\n"
       "                      silent: none; engines: (engines log into the run folder anyway)\n"
       "  --logfilename FILE  default .console_output.log\n",
-      prog, prog, prog);
+      prog, prog, prog, prog, prog);
 }
 
 // convoy replay|score RUN_DIR [--out DIR] [-c CONFIG] [-o K=V]... [-q]
@@ -109,6 +125,93 @@ bool redirect_output(const std::string& mode, const std::string& file) {
   return true;
 }
 
+// Runs argv (argv[0] a path) and waits; its exit status, or -1 when it cannot start.
+int run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid;
+  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+std::string python_exe() {
+  if (const char* p = std::getenv("CONVOY_PYTHON"); p && *p) return p;
+  return "/usr/bin/python3";
+}
+
+// `convoy campaign ...`: tools/campaign/campaign.py's command line, with this build.
+int campaign(int argc, char** argv) {
+  const auto repo = convoy::python::package_dir().parent_path();
+  std::vector<std::string> args = {python_exe(),
+                                   (repo / "tools" / "campaign" / "campaign.py").string()};
+  bool has_build = false;
+  for (int i = 2; i < argc; ++i) {
+    args.push_back(argv[i]);
+    if (std::strcmp(argv[i], "--build") == 0 || std::strncmp(argv[i], "--build=", 8) == 0)
+      has_build = true;
+  }
+  if (!has_build) setenv("CONVOY_BIN_DIR", convoy::app::bin_dir().c_str(), 0);
+  const int rc = run_program(args);
+  if (rc < 0) {
+    std::fprintf(stderr, "error: cannot run %s %s\n", args[0].c_str(), args[1].c_str());
+    return 2;
+  }
+  return rc;
+}
+
+// --scenario: writes the scenario's default config into the run folder (creating it) with
+// python/convoy_scenario/make_config.py; points `options` at it. False after saying why.
+bool prepare_scenario(const std::string& scenario, const std::string& world, const std::string& ego,
+                      convoy::app::RunOptions& options) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(scenario, ec)) {
+    std::fprintf(stderr, "error: --scenario %s: no such file\n", scenario.c_str());
+    return false;
+  }
+  if (options.run_dir.empty()) {
+    fs::path base = fs::current_path() / "runs";
+    if (const char* b = std::getenv("CONVOY_RUNS_DIR"); b && *b) base = b;
+    char stamp[32];
+    std::time_t t = std::time(nullptr);
+    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&t));
+    options.run_dir = base / ("scenario_" + fs::path(scenario).stem().string() + "-" + stamp + "-" +
+                              std::to_string(getpid()));
+  }
+  fs::create_directories(options.run_dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "error: cannot create the run folder %s: %s\n", options.run_dir.c_str(),
+                 ec.message().c_str());
+    return false;
+  }
+  options.run_dir = fs::absolute(options.run_dir);
+  const fs::path config = options.run_dir / "scenario_config.json";
+  std::vector<std::string> args = {
+      python_exe(),
+      (convoy::python::package_dir() / "convoy_scenario" / "make_config.py").string(),
+      fs::absolute(scenario).string(),
+      "--out",
+      config.string(),
+      "--bin-dir",
+      convoy::app::bin_dir().string()};
+  if (!world.empty()) args.insert(args.end(), {"--world", fs::absolute(world).string()});
+  if (!ego.empty()) args.insert(args.end(), {"--ego", fs::absolute(ego).string()});
+  const int rc = run_program(args);
+  if (rc != 0) {
+    if (rc < 0) std::fprintf(stderr, "error: cannot run %s\n", args[0].c_str());
+    std::fprintf(stderr, "error: --scenario %s: no config could be made (run folder %s)\n",
+                 scenario.c_str(), options.run_dir.c_str());
+    return false;
+  }
+  options.config_file = config;
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -122,6 +225,7 @@ int main(int argc, char** argv) {
     }
     if (!std::strcmp(argv[1], "replay") || !std::strcmp(argv[1], "score"))
       return replay_command(prog.c_str(), !std::strcmp(argv[1], "score"), argc, argv);
+    if (std::strcmp(argv[1], "campaign") == 0) return campaign(argc, argv);
     if (std::strcmp(argv[1], "run") != 0) {
       std::fprintf(stderr, "error: unknown command '%s'\n", argv[1]);
       usage(prog.c_str());
@@ -131,6 +235,7 @@ int main(int argc, char** argv) {
   }
   convoy::app::RunOptions options;
   std::string mode = "standalone", dir, log_output, log_filename = ".console_output.log";
+  std::string scenario, world, ego;
   for (; i < argc; ++i) {
     std::string a = argv[i];
     std::string inline_value;  // --key=value
@@ -156,6 +261,12 @@ int main(int argc, char** argv) {
       options.overrides.push_back(value());
     else if (a == "--run-dir")
       options.run_dir = value();
+    else if (a == "--scenario")
+      scenario = value();
+    else if (a == "--world")
+      world = value();
+    else if (a == "--ego")
+      ego = value();
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
     else if (a == "--record")
@@ -210,6 +321,20 @@ int main(int argc, char** argv) {
     }
   } else if (mode != "standalone") {
     std::fprintf(stderr, "error: -m must be standalone or server, got '%s'\n", mode.c_str());
+    return 2;
+  }
+  if (!scenario.empty()) {
+    if (!options.config_file.empty()) {
+      std::fprintf(stderr, "error: give -c or --scenario, not both\n");
+      return 2;
+    }
+    if (options.server) {
+      std::fprintf(stderr, "error: --scenario runs standalone only\n");
+      return 2;
+    }
+    if (!prepare_scenario(scenario, world, ego, options)) return 2;
+  } else if (!world.empty() || !ego.empty()) {
+    std::fprintf(stderr, "error: --world and --ego go with --scenario\n");
     return 2;
   }
   if (options.config_file.empty()) {

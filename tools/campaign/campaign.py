@@ -12,6 +12,9 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(REPO, "python"))
 
 from convoy_campaign.cli import main  # noqa: E402 (after the path)
+from convoy_scenario.campaign_entry import register as register_xosc  # noqa: E402
+
+register_xosc()  # OpenSCENARIO entries (.xosc): convoy run --scenario
 
 if __name__ == "__main__":
     sys.exit(main())

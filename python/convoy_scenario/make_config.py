@@ -1,0 +1,438 @@
+#!/usr/bin/python3
+"""Builds the default simulation config of an OpenSCENARIO file (what `convoy run --scenario`
+runs; docs/scenarios.md, "Running a scenario"):
+
+- the world engine on the world of the scenario's RoadNetwork LogicFile (MAPS below; another
+  map needs --world FILE.sdf), the ego (the report's smart car with its camera) inserted at its
+  Init teleport;
+- one vehicle_agent per other Vehicle entity and one pedestrian_agent per Pedestrian entity,
+  started at their Init teleports (StartPose) with their Init AbsoluteTargetSpeed
+  (InitialSpeed, and a vehicle's desired speed v0 when its own AI drives it), sized from their BoundingBox, their model from the catalog entry or the
+  vehicle's name when the actor-model table has it, else from the category;
+- the weather engine with the Init EnvironmentActions; the traffic_lights engine when the map
+  has traffic lights;
+- the scenario engine (engines/scenario) driving the entities, and the ego: the report's PID
+  waypoint follower (experiments/city_traffic/ego_driver.py) with the ego planner
+  (ground-truth input), the camera and Convoy's detector, on the ego's route;
+- the transceiver functions (scenario_tf, traffic_tf, the ego's), the live driving score
+  (python/convoy_bench/metrics_tf.py) and the status function that ends the run when the
+  scenario is done.
+
+The ego's route: its AssignRouteAction (the first one for the ego, Init or storyboard) if any,
+else the lane it starts on followed onward (straight on at junctions) for RouteLength m: the
+scenario's parameter RouteLength when declared, else 0.5 x 8.33 m/s x the StopTrigger's time
+(60 s without one), within [40, 300] m. The follower gets the route 30 m longer so that it does
+not stop short of the scored end.
+
+Entity Properties named `convoy.<Key>` set that key of the entity's agent (e.g. `convoy.v0` 0
+for a parked car, `convoy.MidBlockProbability`).
+
+Usage: /usr/bin/python3 -m convoy_scenario.make_config SCENARIO.xosc --out CONFIG.json
+           [--world WORLD.sdf] [--ego FRAGMENT.json] [--param NAME=VALUE]... [--bin-dir DIR]
+           [--snapshots T1,T2]
+The route CSV is written next to CONFIG.json (ego_route.csv). Every path in the config is
+absolute. Exit 2 with one message on bad input."""
+
+import argparse
+import hashlib
+import json
+import math
+import os
+import re
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PYTHON = os.path.dirname(HERE)
+REPO = os.path.dirname(PYTHON)
+if PYTHON not in sys.path:
+    sys.path.insert(0, PYTHON)
+
+from convoy_scenario import ScenarioError, load, weather_config  # noqa: E402
+from convoy_scenario import model as m  # noqa: E402
+from convoy_scenario.odr import OdrQuery, world_pose  # noqa: E402
+
+CITY = os.path.join(REPO, "experiments", "city_traffic")
+AD = os.path.join(REPO, "experiments", "autonomous_driving")
+# The project's maps: the .xodr -> the world without the ego (the ego is inserted at its Init).
+MAPS = {
+    os.path.join(CITY, "city.xodr"): os.path.join(CITY, "city_world_no_ego.sdf"),
+    os.path.join(AD, "parkring.xodr"): os.path.join(AD, "parkring_road_no_ego.sdf"),
+}
+EGO_MODEL = os.path.join(CITY, "models", "smart_car", "model.sdf")
+ACTOR_TABLE = os.path.join(REPO, "engines", "gazebo_grpc", "actors", "actor_models.json")
+AGENT_DT = 0.05
+WORLD_DT = 0.02
+DETECTOR_DT = 0.1
+CRUISE = 8.333              # the ego planner's cruise speed (experiments/city_traffic/ego_planner.json)
+ROUTE_EXTRA_M = 30.0
+DEFAULT_DURATION_S = 60.0
+CATEGORY = {"car": "car", "van": "car", "truck": "truck", "trailer": "truck", "semitrailer": "truck",
+            "bus": "bus", "bicycle": "cyclist", "motorbike": "cyclist", "tram": "bus", "train": "bus"}
+DEFAULT_MODEL = {"car": "sedan", "truck": "truck", "bus": "bus", "cyclist": "bicycle"}
+
+
+def _file_id(path):
+    with open(path, "rb") as f:
+        return hashlib.sha1(f.read()).hexdigest()
+
+
+def world_for(xodr):
+    """The world SDF without ego for a project map (by path or identical content), or None."""
+    real = os.path.realpath(xodr)
+    for known, world in MAPS.items():
+        if os.path.realpath(known) == real:
+            return world
+    digest = _file_id(xodr)
+    for known, world in MAPS.items():
+        if os.path.exists(known) and _file_id(known) == digest:
+            return world
+    return None
+
+
+def engine_name(entity):
+    name = re.sub(r"[^A-Za-z0-9_-]", "_", entity)
+    return name if name and name[0].isalpha() else "e_" + name
+
+
+def stop_time(scenario):
+    """The smallest SimulationTimeCondition value of the storyboard's StopTrigger, or None."""
+    best = None
+    if scenario.stop_trigger is None:
+        return None
+    for group in scenario.stop_trigger.groups:
+        for c in group:
+            if isinstance(c.test, m.SimulationTimeCondition):
+                v = c.test.value + c.delay
+                best = v if best is None else min(best, v)
+    return best
+
+
+def init_actions(scenario, entity):
+    return [a for a in scenario.init if a.entity == entity]
+
+
+def init_pose(scenario, entity, odr):
+    for a in init_actions(scenario, entity):
+        if isinstance(a.spec, m.TeleportAction):
+            return world_pose(odr, a.spec.position.as_dict())
+    return None
+
+
+def init_speed(scenario, entity):
+    for a in init_actions(scenario, entity):
+        if isinstance(a.spec, m.SpeedAction) and isinstance(a.spec.target, m.AbsoluteTargetSpeed):
+            return float(a.spec.target.value)
+    return 0.0
+
+
+def ego_route_action(scenario, ego):
+    """The first AssignRouteAction for the ego: Init's, else the storyboard's."""
+    for a in init_actions(scenario, ego):
+        if isinstance(a.spec, m.AssignRouteAction):
+            return a.spec
+    for story in scenario.stories:
+        for act in story.acts:
+            for grp in act.groups:
+                if ego not in grp.actors:
+                    continue
+                for man in grp.maneuvers:
+                    for ev in man.events:
+                        for action in ev.actions:
+                            if isinstance(action.spec, m.AssignRouteAction):
+                                return action.spec
+    return None
+
+
+def properties(obj):
+    """{Key: value} of the entity's Properties named convoy.<Key> (values read as JSON when
+    they parse)."""
+    out = {}
+    for name, value in getattr(obj, "properties", ()):
+        if name.startswith("convoy."):
+            try:
+                out[name[7:]] = json.loads(value)
+            except ValueError:
+                out[name[7:]] = value
+    return out
+
+
+def actor_models():
+    with open(ACTOR_TABLE) as f:
+        return json.load(f)["models"]
+
+
+def vehicle_model(entity, category, models):
+    """The actor model: the entity's Property `model`, its catalog entry or its name when the
+    actor-model table has it, else the category's default."""
+    prop = dict(entity.object.properties).get("model")
+    for cand in ([prop] if prop else []) + ([entity.catalog.entry] if entity.catalog else []) + [entity.object.name]:
+        if cand in models:
+            return cand
+    return DEFAULT_MODEL[category]
+
+
+def lane_of(odr, x, y, yaw, what, types=("driving",)):
+    loc = odr.locate(x, y, yaw, max_distance=5.0)
+    if loc is None or loc["type"] not in types:
+        raise ScenarioError("%s at (%.2f, %.2f) is not on a %s lane of %s" % (
+            what, x, y, " or ".join(types), os.path.basename(odr.xodr)))
+    return loc
+
+
+def route_points(odr, spec, start):
+    """Points of an AssignRouteAction from the ego's start through its waypoints."""
+    pts, prev = [], start
+    for w in spec.waypoints:
+        x, y, yaw = world_pose(odr, w.position.as_dict())
+        loc = lane_of(odr, x, y, yaw, "a route waypoint")
+        if (loc["road"], loc["lane"]) == tuple(prev[:2]) and abs(loc["s"] - prev[2]) < 1.0:
+            continue  # the start itself (a route's first waypoint usually is)
+        r = odr.route(prev, (loc["road"], loc["lane"], loc["s"]))
+        pts += r["points"] if not pts else r["points"][1:]
+        prev = (loc["road"], loc["lane"], loc["s"])
+    return pts, prev
+
+
+def polyline_length(points):
+    return math.fsum(math.hypot(q[0] - p[0], q[1] - p[1]) for p, q in zip(points, points[1:]))
+
+
+def cut(points, length):
+    """The polyline's first `length` m."""
+    out, acc = [points[0]], 0.0
+    for p, q in zip(points, points[1:]):
+        d = math.hypot(q[0] - p[0], q[1] - p[1])
+        if acc + d >= length:
+            u = (length - acc) / d if d > 0 else 0.0
+            out.append([p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1]), q[2]])
+            return out
+        out.append(q)
+        acc += d
+    return out
+
+
+def route_length(scenario):
+    for name, value in scenario.parameters:
+        if name == "RouteLength":
+            return float(value)
+    duration = stop_time(scenario) or DEFAULT_DURATION_S
+    return max(40.0, min(300.0, 0.5 * CRUISE * duration))
+
+
+def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs):
+    x, y, yaw = pose
+    out_engines[0]["GazeboSDFModels"] = [{"Name": "smart_car", "File": EGO_MODEL,
+                                          "InitPose": [x, y, 0.0, 0.0, 0.0, yaw]}]
+    # the smart car's meshes (model://smart_car/...) are found next to its model
+    out_engines[0]["EngineEnvParams"] = ["CONVOY_MODEL_PATH=" + os.path.dirname(os.path.dirname(EGO_MODEL))]
+    out_engines += [
+        {"EngineType": "python_json", "EngineName": "car_ctl_engine",
+         "PythonFileName": os.path.join(CITY, "ego_driver.py"), "EngineTimestep": WORLD_DT,
+         "EngineEnvParams": ["CONVOY_EGO_ROUTE=" + route_csv, "CONVOY_EGO_ROUTE_SKIP=0"]},
+        {"EngineType": "python_json", "EngineName": "planner",
+         "PythonFileName": os.path.join(REPO, "experiments", "ego_planner", "ego_planner_engine.py"),
+         "EngineTimestep": WORLD_DT,
+         "EngineEnvParams": ["CONVOY_EGO_PLANNER_CONFIG=" + os.path.join(CITY, "ego_planner.json")]},
+        {"EngineType": "detector", "EngineName": "yolo_detector", "Backend": "convoy",
+         "EngineTimestep": DETECTOR_DT},
+    ]
+    out_tfs += [
+        {"Name": "state_tf", "FileName": os.path.join(AD, "state_tf.py")},
+        {"Name": "motor_tf", "FileName": os.path.join(REPO, "experiments", "ego_planner", "motor_tf.py")},
+        {"Name": "camera_tf", "FileName": os.path.join(AD, "camera_tf.py")},
+    ]
+    return "gazebo/smart_car::road_user"
+
+
+def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin_dir=None, snapshots=None):
+    """(config dict, ego route points [[x, y, heading]], scored route length)."""
+    scenario = load(xosc, parameters=parameters or None)
+    base = os.path.basename(xosc)
+    if not scenario.logic_file:
+        raise ScenarioError("%s: no RoadNetwork LogicFile: a scenario needs an OpenDRIVE map" % base)
+    world_sdf = os.path.abspath(world) if world else world_for(scenario.logic_file)
+    if world_sdf is None:
+        raise ScenarioError(
+            "%s: no world for the map %s: supported maps are %s (or give --world FILE.sdf, a "
+            "world without the ego)" % (base, scenario.logic_file, ", ".join(
+                os.path.relpath(p, REPO) for p in MAPS)))
+    if not os.path.exists(world_sdf):
+        raise ScenarioError("%s: the world %s does not exist" % (base, world_sdf))
+    names = [e.name for e in scenario.entities]
+    ego = "Ego" if "Ego" in names else (names[0] if names else None)
+    if ego is None:
+        raise ScenarioError("%s: no entities" % base)
+    models = actor_models()
+    xodr = scenario.logic_file
+    with OdrQuery(xodr, bin_dir) as odr:
+        has_lights = bool(odr.info()["signals"])
+        ego_pose = init_pose(scenario, ego, odr)
+        if ego_pose is None:
+            raise ScenarioError("%s: the ego %r has no Init TeleportAction (where does it start?)" % (base, ego))
+        start = lane_of(odr, *ego_pose, "the ego's Init position")
+        length = route_length(scenario)
+        spec = ego_route_action(scenario, ego)
+        if spec is not None:
+            pts, last = route_points(odr, spec, (start["road"], start["lane"], start["s"]))
+            ext = odr.follow(last[0], last[1], last[2], ROUTE_EXTRA_M)["points"]
+            scored_len = polyline_length(pts)
+            drive = pts + ext[1:]
+            scored = pts
+        else:
+            drive = odr.follow(start["road"], start["lane"], start["s"], length + ROUTE_EXTRA_M)["points"]
+            scored = cut(drive, length)
+            scored_len = polyline_length(scored)
+        agents = []
+        entity_map = {}
+        for i, ent in enumerate(scenario.entities):
+            if ent.name == ego:
+                continue
+            pose = init_pose(scenario, ent.name, odr)
+            if pose is None:
+                raise ScenarioError("%s: entity %r has no Init TeleportAction" % (base, ent.name))
+            name = engine_name(ent.name)
+            entity_map[ent.name] = name
+            bb = ent.object.bounding_box
+            if ent.kind == "vehicle":
+                cat = CATEGORY.get(ent.object.category, "car")
+                loc = lane_of(odr, *pose, "entity %r's Init position" % ent.name)
+                onward = odr.follow(loc["road"], loc["lane"], loc["s"], 400.0)["lanes"][-1]
+                for ia in init_actions(scenario, ent.name):
+                    if isinstance(ia.spec, m.AssignRouteAction):  # routed to its last waypoint
+                        last = lane_of(odr, *world_pose(odr, ia.spec.waypoints[-1].position.as_dict()),
+                                       "entity %r's route's last waypoint" % ent.name)
+                        onward = [last["road"], last["lane"]]
+                wheelbase = None
+                axles = dict(ent.object.axles)
+                if "FrontAxle" in axles and "RearAxle" in axles:
+                    wheelbase = dict(axles["FrontAxle"])["positionX"] - dict(axles["RearAxle"])["positionX"]
+                a = {"EngineType": "vehicle_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
+                     "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
+                     "Route": {"to": "%s:%d" % (onward[0], onward[1])},
+                     "InitialSpeed": init_speed(scenario, ent.name), "Model": vehicle_model(ent, cat, models),
+                     "Category": cat, "Length": bb.length, "Width": bb.width, "Height": bb.height,
+                     "LaneChanges": False, "Seed": i}
+                if not (wheelbase and 0 < wheelbase < bb.length) and bb.length <= 2.7:
+                    wheelbase = 0.6 * bb.length   # small vehicles without axles (a bicycle)
+                if wheelbase and 0 < wheelbase < bb.length:
+                    a["Wheelbase"] = wheelbase
+                if a["InitialSpeed"] > 0:
+                    a["v0"] = a["InitialSpeed"]   # its desired speed when its own AI drives
+            else:
+                loc = lane_of(odr, pose[0], pose[1], None, "pedestrian %r's Init position" % ent.name,
+                              types=("sidewalk",))
+                road_len = next(r["length"] for r in odr.info()["roads"] if r["id"] == loc["road"])
+                to_s = loc["s"] + 60.0 if loc["s"] + 60.0 < road_len else max(0.0, loc["s"] - 60.0)
+                a = {"EngineType": "pedestrian_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
+                     "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
+                     "Route": {"to": "%s:%d" % (loc["road"], loc["lane"]), "to_s": to_s},
+                     "Seed": 100 + i, "Length": max(bb.length, 0.3), "Width": max(bb.width, 0.3),
+                     "Height": bb.height}
+                speed = init_speed(scenario, ent.name)
+                if speed > 0:
+                    a["Speed"], a["SpeedSd"] = speed, 0.0
+            a.update(properties(ent.object))
+            agents.append(a)
+
+    route_csv = os.path.join(os.path.abspath(out_dir), "ego_route.csv")
+    weather = {"EngineType": "weather", "EngineName": "weather", "EngineTimestep": AGENT_DT, "Seed": 0,
+               "Surface": "dry", "Precipitation": 0.0, "Visibility": 20000.0, "WindSpeed": 0.0}
+    init_weather = weather_config(scenario)
+    if "SunAltitude" in init_weather:
+        weather.pop("TimeOfDay", None)
+    weather.update(init_weather)
+    engines = [{"EngineType": "gazebo_grpc", "EngineName": "gazebo", "GazeboWorldFile": world_sdf,
+                "GazeboRNGSeed": 7, "EngineTimestep": WORLD_DT, "ActorTimeout": 1.0}, weather]
+    tfs = [{"Name": "weather_tf", "FileName": os.path.join(REPO, "experiments", "common", "weather_tf.py")}]
+    if ego_fragment:
+        with open(ego_fragment) as f:
+            frag = json.load(f)
+        engines += frag.get("EngineConfigs", [])
+        tfs += frag.get("DataPackProcessingFunctions", [])
+        ego_state = frag.get("EgoState", "gazebo/smart_car::road_user")
+        if "GazeboSDFModels" in frag:
+            engines[0]["GazeboSDFModels"] = frag["GazeboSDFModels"]
+    else:
+        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs)
+    if has_lights:
+        engines.append({"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
+                        "Map": xodr, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0})
+    entity_map[ego] = ego_state
+    engines.append({"EngineType": "scenario", "EngineName": "scenario", "EngineTimestep": AGENT_DT,
+                    "ScenarioFile": os.path.abspath(xosc), "Parameters": dict(parameters or {}),
+                    "Entities": entity_map, "EgoName": ego,
+                    "EgoRoute": [[p[0], p[1]] for p in scored], "Map": xodr, "EndOnComplete": False})
+    engines += agents
+    tfs += [{"Name": "scenario_tf", "FileName": os.path.join(HERE, "scenario_tf.py")},
+            {"Name": "traffic_tf", "FileName": os.path.join(HERE, "traffic_tf.py")},
+            {"Name": "metrics_tf", "FileName": os.path.join(PYTHON, "convoy_bench", "metrics_tf.py")}]
+    if snapshots:
+        engines.append({"EngineType": "python_json", "EngineName": "snapshot", "EngineTimestep": WORLD_DT,
+                        "PythonFileName": os.path.join(HERE, "snapshot.py"),
+                        "EngineEnvParams": ["CONVOY_SNAPSHOT_TIMES=" + ",".join("%g" % t for t in snapshots)]})
+        tfs.append({"Name": "snapshot_tf", "FileName": os.path.join(HERE, "snapshot_tf.py")})
+    duration = stop_time(scenario)
+    timeout = duration + 0.5 if duration else max(20.0, math.ceil(scored_len / (0.5 * CRUISE)))
+    config = {
+        "SimulationName": "scenario_" + os.path.splitext(base)[0],
+        "SimulationDescription": "Generated by python/convoy_scenario/make_config.py from %s" % os.path.abspath(xosc),
+        "SimulationTimeout": timeout,
+        "EngineConfigs": engines,
+        "DataPackProcessingFunctions": tfs,
+        "StatusFunction": {"Name": "scenario_status", "FileName": os.path.join(HERE, "status.py")},
+    }
+    return config, drive, scored_len
+
+
+def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapshots=None):
+    out_dir = os.path.dirname(os.path.abspath(out))
+    os.makedirs(out_dir, exist_ok=True)
+    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots)
+    with open(os.path.join(out_dir, "ego_route.csv"), "w") as f:
+        f.write("x,y,heading\n")
+        for x, y, h in drive:
+            f.write("%.4f,%.4f,%.6f\n" % (x, y, h))
+    with open(out, "w") as f:
+        json.dump(config, f, indent=2)
+        f.write("\n")
+    return config
+
+
+def _param(text):
+    if "=" not in text:
+        raise argparse.ArgumentTypeError("expected NAME=VALUE, got %r" % text)
+    k, v = text.split("=", 1)
+    try:
+        return k, json.loads(v)
+    except ValueError:
+        return k, v
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("scenario")
+    ap.add_argument("--out", required=True, help="the config file to write")
+    ap.add_argument("--world", help="the world SDF (without the ego) for a map the project does not know")
+    ap.add_argument("--ego", help="a config fragment {EngineConfigs, DataPackProcessingFunctions, EgoState}: the user's ego")
+    ap.add_argument("--param", action="append", type=_param, default=[], help="NAME=VALUE: a scenario parameter")
+    ap.add_argument("--bin-dir", help="where convoy-odr is")
+    ap.add_argument("--snapshots", help="T1,T2,...: save the ego camera's frame at these simulated "
+                    "seconds as camera_<t>s.png in the run folder (the default ego only)")
+    a = ap.parse_args(argv)
+    try:
+        snaps = [float(t) for t in a.snapshots.split(",")] if a.snapshots else None
+        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir, snaps)
+    except ScenarioError as e:
+        print("error: %s" % e, file=sys.stderr)
+        return 2
+    except OSError as e:
+        print("error: %s: %s" % (getattr(e, "filename", "") or a.scenario, e.strerror), file=sys.stderr)
+        return 2
+    except ValueError as e:
+        print("error: %s" % e, file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
