@@ -18,7 +18,7 @@ PACKAGES=(
   sumo sumo-tools
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
-  zlib1g-dev nodejs npm
+  zlib1g-dev
   ffmpeg
 )
 
@@ -42,7 +42,8 @@ cmake --build build -j"$(nproc)"
 echo "== built: build/bin/convoy, build/bin/NRPCoreSim"
 
 # A test instrument: the official MCAP library reads Convoy's recordings
-# (tests/e2e/test_recording.py; skipped when it is not installed).
+# (tests/e2e/test_recording.py; skipped when it is not installed). With the machine's own
+# Node.js and npm (Debian's npm package conflicts with a Node.js that bundles npm).
 if command -v npm >/dev/null; then
   (cd tools/mcap_check && npm ci --no-audit --no-fund --loglevel=error) ||
     echo "warning: npm ci in tools/mcap_check failed; the @mcap/core test will be skipped"
