@@ -240,6 +240,7 @@ def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs):
         {"Name": "state_tf", "FileName": os.path.join(AD, "state_tf.py")},
         {"Name": "motor_tf", "FileName": os.path.join(REPO, "experiments", "ego_planner", "motor_tf.py")},
         {"Name": "camera_tf", "FileName": os.path.join(AD, "camera_tf.py")},
+        {"Name": "detection_tf", "FileName": os.path.join(REPO, "python", "convoy_bench", "detection_tf.py")},
     ]
     return "gazebo/smart_car::road_user"
 

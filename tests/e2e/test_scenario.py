@@ -255,6 +255,13 @@ class Run(ScenarioCase):
         self.assertEqual(runs[0]["driving_score"], runs[1]["driving_score"])
         self.assertEqual(runs[0]["infractions"], runs[1]["infractions"])
         self.assertGreater(runs[0]["route_completion"], 0.0)
+        # the detector against ground truth (convoy_bench/detection_tf.py): one scored frame per
+        # detector cycle but the first, the same in both runs
+        self.assertGreater(runs[0]["detector_frames"], 100)
+        self.assertEqual(runs[0]["detector_frames"], runs[1]["detector_frames"])
+        self.assertEqual(runs[0]["detector_map50"], runs[1]["detector_map50"])
+        self.assertIsNotNone(runs[0]["detector_map50"])
+        self.assertGreater(runs[0]["detector_map50"], 0.3)
 
 
     def test_own_ego(self):
