@@ -5,20 +5,33 @@ an earlier invocation with the same --out runs again) runs through worker.run_ta
 `workers` threads, each waiting on its own `convoy run` process; so at most `workers` runs at
 once. Tasks start in index order. campaign.json is saved as each task starts and ends. A
 failed task is not retried within the invocation.
+
+Interrupted (Ctrl-C, or SIGTERM to the campaign alone), it starts no more tasks, passes the
+signal on to the runs in flight (each ends as `convoy run` does on Ctrl-C, its run folder
+kept), waits for them, and re-raises KeyboardInterrupt: the tasks not run stay pending for the
+next invocation.
 """
 
+import signal
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
 from . import worker
 
 
+def _raise_interrupt(signum, _frame):
+    raise KeyboardInterrupt("signal %d" % signum)
+
+
 def run(plan, state, workers, log=print):
     lock = threading.Lock()
+    stop = threading.Event()
     todo = [t["index"] for t in state.tasks if t["state"] != "done"]
 
     def one(index):
         with lock:
+            if stop.is_set():
+                return
             t = state.tasks[index]
             t["attempts"] += 1
             t["state"] = "running"
@@ -31,6 +44,21 @@ def run(plan, state, workers, log=print):
             log("campaign: %s: exit %d, %.1f s" % (record["name"], record["exit_code"],
                                                    record["wall_s"]))
 
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        for f in [pool.submit(one, i) for i in todo]:
+    old_term = None
+    if threading.current_thread() is threading.main_thread():
+        old_term = signal.signal(signal.SIGTERM, _raise_interrupt)
+    pool = ThreadPoolExecutor(max_workers=workers)
+    futures = [pool.submit(one, i) for i in todo]
+    try:
+        for f in futures:
             f.result()
+    except KeyboardInterrupt:
+        with lock:
+            stop.set()
+        worker.interrupt_all(signal.SIGINT)
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    finally:
+        if old_term is not None:
+            signal.signal(signal.SIGTERM, old_term)
+    pool.shutdown(wait=True)

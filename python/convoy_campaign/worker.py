@@ -40,6 +40,21 @@ def _write_json(path, doc):
     os.replace(tmp, path)
 
 
+_running = set()  # the `convoy run` processes of this process's tasks in flight
+_running_lock = threading.Lock()
+
+
+def interrupt_all(signum):
+    """Sends `signum` to every run in flight (the local backend, interrupted)."""
+    with _running_lock:
+        procs = list(_running)
+    for proc in procs:
+        try:
+            proc.send_signal(signum)
+        except ProcessLookupError:
+            pass
+
+
 def run_task(plan, index, job_id=None):
     """Runs task `index` of `plan`; returns its task.json record."""
     task = plan["tasks"][index]
@@ -63,6 +78,9 @@ def run_task(plan, index, job_id=None):
             f.write("campaign worker: cannot start %s: %s\n" % (task["argv"][0], e))
             code = 127
         else:
+            with _running_lock:
+                _running.add(proc)
+
             def forward(signum, _frame):
                 try:
                     proc.send_signal(signum)
@@ -77,6 +95,8 @@ def run_task(plan, index, job_id=None):
             finally:
                 for s, h in old.items():
                     signal.signal(s, h)
+                with _running_lock:
+                    _running.discard(proc)
             if code < 0:
                 code = 128 - code
     record = {"index": index, "name": task["name"], "exit_code": code,

@@ -232,6 +232,48 @@ class Slurm(CampaignTest):
         self.assertEqual([x["exit_code"] for x in read_board(out)], ["0"] * 4)
 
 
+class Interrupt(CampaignTest):
+    def interrupt(self, signum):
+        """A local campaign of four 600 s runs (about 40 s each), one at a time, sent `signum` (to the campaign
+        alone) while its first run is going: it stops within seconds, exit 130, passing the
+        signal on to that run (which ends as convoy run does), starting no other, leaving no
+        process behind; the same command then runs what is left."""
+        suite = self.cut_in_suite()
+        out = os.path.join(self.dir, "out")
+        e = dict(os.environ, CONVOY_BIN_DIR=BIN_DIR)
+        p = subprocess.Popen(["/usr/bin/python3", CAMPAIGN, suite, "--seeds", "4", "--workers", "1",
+                              "--seconds", "600", "--out", out], env=e, stdin=subprocess.DEVNULL,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            first = os.path.join(out, "runs", "cut_in__s0__clear", "summary.json")
+            deadline = time.monotonic() + 60
+            steps = os.path.join(out, "runs", "cut_in__s0__clear", "steps.csv")
+            while time.monotonic() < deadline and not os.path.exists(steps):
+                time.sleep(0.1)
+            time.sleep(1.0)  # the first run is stepping
+            p.send_signal(signum)
+            stdout, stderr = p.communicate(timeout=60)
+        finally:
+            if p.poll() is None:
+                p.kill()
+                p.communicate()
+        self.assertEqual(p.returncode, 130, stdout + stderr)
+        self.assertIn("interrupted", stderr)
+        # the run in flight ended as convoy run does when interrupted: its folder has a summary
+        self.assertTrue(os.path.exists(first))
+        tasks = read_json(os.path.join(out, "campaign.json"))["tasks"]
+        self.assertEqual([t["state"] for t in tasks[1:]], ["pending"] * 3)
+        self.assertEqual([t["attempts"] for t in tasks[1:]], [0] * 3)
+        left = subprocess.run(["pgrep", "-f", out], capture_output=True, text=True).stdout.split()
+        self.assertEqual(left, [], "processes left behind")
+
+    def test_ctrl_c(self):
+        self.interrupt(signal.SIGINT)
+
+    def test_sigterm(self):
+        self.interrupt(signal.SIGTERM)
+
+
 class BadInput(CampaignTest):
     def assertBad(self, r, *needles):
         self.assertExit(r, 2)
