@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
 # Builds (if needed) and runs every test: unit tests (GoogleTest) and end-to-end tests.
+# Tests labelled `long` (soak runs: the scenario suite, 20 repeats) are left out unless a label
+# selection is given (-L / -LE): `scripts/test.sh -L long` runs them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [[ ! -x build/bin/convoy ]] || [[ "${CONVOY_REBUILD:-1}" == 1 ]]; then
   CONVOY_SKIP_APT=${CONVOY_SKIP_APT:-1} scripts/setup.sh >/dev/null
 fi
 cd build
-ctest --output-on-failure -j1 "$@"
+labels=(-LE long)
+for a in "$@"; do
+  [[ "$a" == -L || "$a" == -LE || "$a" == --label-regex* || "$a" == --label-exclude* ]] && labels=()
+done
+ctest --output-on-failure -j1 "${labels[@]}" "$@"
