@@ -15,7 +15,6 @@ A pure function of the datapacks it reads (the detector's `detections`, the came
 gives the same fields. It writes every WRITE_EVERY scored frames and at the end (the scenario
 engine's done, or the last cycle before SimulationTimeout)."""
 
-import json
 import os
 import sys
 
@@ -24,19 +23,14 @@ from nrp_core import *  # noqa: F401,F403
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 from convoy_perception.evaluation import evaluate  # noqa: E402
+from convoy_bench.run_files import load_config, update_summary  # noqa: E402
 
 SCORED_CLASSES = ("bus", "car", "pedestrian")
 WRITE_EVERY = 50  # scored frames (5 s at 10 Hz)
-RUN_DIR = os.environ.get("CONVOY_RUN_DIR", ".")
 CAMERA_BOXES = "smart_camera::camera::boxes"
 
 
-def _config():
-    with open(os.path.join(RUN_DIR, "config.json")) as f:
-        return json.load(f)
-
-
-CONFIG = _config()
+CONFIG = load_config()
 ENGINES = CONFIG.get("EngineConfigs", [])
 SCENARIO = next(e for e in ENGINES if e.get("EngineType") == "scenario")
 DETECTOR = next(e for e in ENGINES if e.get("EngineType") == "detector")
@@ -46,22 +40,6 @@ DT = float(SCENARIO.get("EngineTimestep", 0.05))
 DETECTOR_DT_NS = int(round(float(DETECTOR.get("EngineTimestep", 0.1)) * 1e9))
 
 _state = {"frames": [], "truth": None, "last": None, "final": False, "ground_truth": None}
-
-
-def _write(fields):
-    path = os.path.join(RUN_DIR, "summary.json")
-    try:
-        with open(path) as f:
-            summary = json.load(f)
-        if not isinstance(summary, dict):
-            summary = {}
-    except (OSError, ValueError):
-        summary = {}
-    summary.update(fields)
-    tmp = path + ".detection.tmp"
-    with open(tmp, "w") as f:
-        json.dump(summary, f, indent=1)
-    os.replace(tmp, path)
 
 
 def score_fields(frames, ground_truth_detector=False):
@@ -99,7 +77,7 @@ def _detection(time_ns, detections, boxes, scenario):
     final = done or (TIMEOUT > 0 and t + DT > TIMEOUT + 1e-9)
     n = len(_state["frames"])
     if final or (new and n % WRITE_EVERY == 0):
-        _write(score_fields(_state["frames"], bool(_state["ground_truth"])))
+        update_summary(score_fields(_state["frames"], bool(_state["ground_truth"])))
         _state["final"] = final
     return []
 

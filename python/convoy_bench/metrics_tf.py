@@ -14,25 +14,19 @@ It writes every WRITE_EVERY samples and at the end: when the scenario engine say
 the last cycle before SimulationTimeout. At the end a route not finished is a scenario_timeout
 infraction. Replaying the same datapacks gives the same summary fields, bit for bit."""
 
-import json
 import os
 import sys
 
 from nrp_core import *  # noqa: F401,F403
 
 from convoy_bench.live import LiveScore, summary_fields
+from convoy_bench.run_files import load_config, update_summary
 
 WRITE_EVERY = 100   # samples (5 s at 20 Hz): scoring the drive so far costs ~0.1 s
 HERE = os.path.dirname(os.path.abspath(__file__))
-RUN_DIR = os.environ.get("CONVOY_RUN_DIR", ".")
 
 
-def _config():
-    with open(os.path.join(RUN_DIR, "config.json")) as f:
-        return json.load(f)
-
-
-CONFIG = _config()
+CONFIG = load_config()
 ENGINES = CONFIG.get("EngineConfigs", [])
 SCENARIO = next(e for e in ENGINES if e.get("EngineType") == "scenario")
 WORLD = next((e["EngineName"] for e in ENGINES if e.get("EngineType") == "gazebo_grpc"), None)
@@ -64,22 +58,6 @@ def _user(dp):
                                        "length", "length_offset")}
 
 
-def _write(fields):
-    path = os.path.join(RUN_DIR, "summary.json")
-    try:
-        with open(path) as f:
-            summary = json.load(f)
-        if not isinstance(summary, dict):
-            summary = {}
-    except (OSError, ValueError):
-        summary = {}
-    summary.update(fields)
-    tmp = path + ".metrics.tmp"
-    with open(tmp, "w") as f:
-        json.dump(summary, f, indent=1)
-    os.replace(tmp, path)
-
-
 def _metrics(time_ns, route, scenario, ego, collisions, lights=None, **agents):
     if _state["final"]:
         return []
@@ -108,7 +86,7 @@ def _metrics(time_ns, route, scenario, ego, collisions, lights=None, **agents):
     if final or (_state["n"] and _state["n"] % WRITE_EVERY == 0):
         r = live.result(final=final, timed_out=final)
         if r is not None:
-            _write(summary_fields(r, final))
+            update_summary(summary_fields(r, final))
         _state["final"] = final
     return []
 
