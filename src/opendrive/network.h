@@ -8,8 +8,8 @@
 // outer border (the centre lane's on the lane-offset line).
 //
 // Junctions, speed limits, objects (their outlines) and signals are stored as read; the lane
-// graph (lane_graph.h) turns them into connectivity. Not modelled: superelevation and lateral
-// shape, lane <border> records, <signalReference>s.
+// graph (lane_graph.h) turns them into connectivity. Superelevation tilts the surface
+// (surface_z). Not modelled: lateral shape, lane <border> records, <signalReference>s.
 #pragma once
 
 #include <optional>
@@ -105,12 +105,34 @@ struct LaneBorders {
   double outer_slope = 0;
 };
 
-// One corner of an object's <outline>: <cornerRoad s t> (road = true) or <cornerLocal u v>
-// (road = false, in the object's frame: origin at (s, t), u along hdg relative to the road).
+// One corner of an object's <outline>: <cornerRoad s t dz height> (road = true) or
+// <cornerLocal u v z height> (road = false, in the object's frame: origin at (s, t), u along
+// hdg relative to the road).
 struct OutlineCorner {
   bool road = true;
-  double a = 0;  // s or u
-  double b = 0;  // t or v
+  double a = 0;       // s or u
+  double b = 0;       // t or v
+  double z = 0;       // dz (road) or z (local): the corner's base above the object's
+  double height = 0;  // of the object at this corner (m)
+};
+
+struct Outline {
+  std::vector<OutlineCorner> corners;
+  bool closed = true;
+  std::string fill_type;  // grass, concrete, asphalt, ... or empty
+};
+
+// <repeat>: the object repeated along the road from s over length, every `distance` m (0: one
+// continuous object), its t, width, height and zOffset changing linearly from start to end.
+// Width and height are NaN where the file does not give them (the object's own apply).
+struct ObjectRepeat {
+  double s = 0;
+  double length = 0;
+  double distance = 0;
+  double t_start = 0, t_end = 0;
+  double width_start = 0, width_end = 0;
+  double height_start = 0, height_end = 0;
+  double z_start = 0, z_end = 0;
 };
 
 // An <object> of a road (crosswalks, poles, buildings, ...).
@@ -125,8 +147,21 @@ struct RoadObject {
   double length = 0;
   double width = 0;
   double height = 0;
+  double radius = 0;
   std::string orientation;             // +, - or none
-  std::vector<OutlineCorner> outline;  // the first <outline>'s corners, if any
+  std::vector<OutlineCorner> outline;  // the first outline's corners, if any
+  std::vector<Outline> outlines;       // every outline
+  std::vector<ObjectRepeat> repeats;
+  int line = 0;  // in the file, for messages
+};
+
+// A <tunnel> or <bridge> of a road: from s over length.
+struct RoadSpan {
+  std::string id;
+  std::string name;
+  std::string type;  // tunnel: standard or underpass; bridge: concrete, steel, brick, wood
+  double s = 0;
+  double length = 0;
 };
 
 // A <signal> of a road. Traffic lights are dynamic signals of type 1000001 (OpenDRIVE's
@@ -146,6 +181,9 @@ struct Signal {
   double value = 0;  // NaN when not given
   std::string unit;
   std::vector<std::pair<int, int>> validity;  // <validity fromLane toLane>; empty = all lanes
+  double width = 0;   // of the sign's face, m; 0 when not given
+  double height = 0;  // m; 0 when not given
+  int line = 0;       // in the file, for messages
 };
 
 class Road {
@@ -164,11 +202,19 @@ class Road {
   std::vector<SpeedRecord> speed_limits;  // from <type s><speed>, sorted by s
   std::vector<RoadObject> objects;
   std::vector<Signal> signals;
+  std::vector<RoadSpan> tunnels;
+  std::vector<RoadSpan> bridges;
+  std::vector<CubicRecord> superelevation;  // <lateralProfile><superelevation>: roll (rad)
 
   // Reference line pose at s (clamped to [0, length]).
   Pose2 reference(double s) const;
   // Height of the reference line at s (0 without an elevation profile).
   double elevation(double s) const;
+  // Roll of the road surface at s (rad; positive lowers the right side, as a roll about the
+  // direction of s); 0 without a lateral profile.
+  double superelevation_at(double s) const;
+  // Height of the road surface at (s, t): elevation(s) + t tan(superelevation_at(s)).
+  double surface_z(double s, double t) const;
   // t of the lane-offset line (where the centre lane sits) at s, and its slope.
   double lane_offset(double s, double* slope = nullptr) const;
   // Index into `sections` of the section containing s.

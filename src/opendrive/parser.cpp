@@ -1,5 +1,7 @@
 #include "opendrive/parser.h"
 
+#include "opendrive/parser_fields.h"
+
 #include <tinyxml2.h>
 
 #include <algorithm>
@@ -15,71 +17,16 @@
 namespace convoy::opendrive {
 namespace {
 
+using detail::for_each_child;
 using tinyxml2::XMLElement;
 
-// Walks the children of `parent` named `name` (all children when name is null).
-template <typename F>
-void for_each_child(const XMLElement* parent, const char* name, F&& f) {
-  if (!parent) return;
-  for (const XMLElement* e = parent->FirstChildElement(name); e; e = e->NextSiblingElement(name)) {
-    f(e);
-  }
-}
-
-class Reader {
+class Reader : public detail::XmlFields {
  public:
-  explicit Reader(std::string source) : source_(std::move(source)) { net_.source = source_; }
+  explicit Reader(std::string source) : XmlFields(std::move(source)) { net_.source = source_; }
 
   Network read(const tinyxml2::XMLDocument& doc);
 
  private:
-  [[noreturn]] void fail(const XMLElement* e, const std::string& where,
-                         const std::string& what) const {
-    std::string msg = source_;
-    if (e) msg += ":" + std::to_string(e->GetLineNum());
-    msg += ": ";
-    if (!where.empty()) msg += where + ": ";
-    throw std::runtime_error(msg + what);
-  }
-
-  std::string text(const XMLElement* e, const char* name, const std::string& where) const {
-    const char* v = e->Attribute(name);
-    if (!v) fail(e, where, std::string("missing attribute '") + name + "'");
-    return v;
-  }
-  std::string text_or(const XMLElement* e, const char* name, const std::string& fallback) const {
-    const char* v = e->Attribute(name);
-    return v ? v : fallback;
-  }
-  double number(const XMLElement* e, const char* name, const std::string& where) const {
-    return to_number(e, name, text(e, name, where), where);
-  }
-  double number_or(const XMLElement* e, const char* name, double fallback,
-                   const std::string& where) const {
-    const char* v = e->Attribute(name);
-    return v ? to_number(e, name, v, where) : fallback;
-  }
-  int integer(const XMLElement* e, const char* name, const std::string& where) const {
-    const double v = number(e, name, where);
-    if (v != std::floor(v) || std::abs(v) > 1e9) {
-      fail(e, where,
-           std::string("attribute '") + name + "' must be an integer, got '" +
-               text(e, name, where) + "'");
-    }
-    return static_cast<int>(v);
-  }
-  double to_number(const XMLElement* e, const char* name, const std::string& value,
-                   const std::string& where) const {
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(value.c_str(), &end);
-    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
-    if (value.empty() || end == value.c_str() || *end != '\0' || errno == ERANGE ||
-        !std::isfinite(v)) {
-      fail(e, where, std::string("attribute '") + name + "' is not a number: '" + value + "'");
-    }
-    return v;
-  }
   CubicRecord cubic(const XMLElement* e, const char* start_name, double start_base,
                     const std::string& where) const {
     return {start_base + number(e, start_name, where), number(e, "a", where), number(e, "b", where),
@@ -97,8 +44,6 @@ class Reader {
   Lane read_lane(const XMLElement* e, int side, double section_s, const std::string& where);
   RoadMark read_road_mark(const XMLElement* e, double section_s, const std::string& where);
   double read_speed(const XMLElement* e, const std::string& where);
-  RoadObject read_object(const XMLElement* e, const std::string& where);
-  Signal read_signal(const XMLElement* e, const std::string& where);
   Junction read_junction(const XMLElement* e);
 
   struct PendingLink {
@@ -107,7 +52,6 @@ class Reader {
     std::string target;
   };
 
-  std::string source_;
   Network net_;
   std::vector<PendingLink> links_;
 };
@@ -226,15 +170,25 @@ Road Reader::read_road(const XMLElement* e, size_t index) {
   if (const XMLElement* objects = e->FirstChildElement("objects")) {
     int o = 0;
     for_each_child(objects, "object", [&](const XMLElement* oe) {
-      road.objects.push_back(read_object(oe, where + " object " + std::to_string(o++)));
+      road.objects.push_back(detail::read_object(*this, oe, where + " object " + std::to_string(o++)));
     });
   }
   if (const XMLElement* signals = e->FirstChildElement("signals")) {
     int g = 0;
     for_each_child(signals, "signal", [&](const XMLElement* se) {
-      road.signals.push_back(read_signal(se, where + " signal " + std::to_string(g++)));
+      road.signals.push_back(detail::read_signal(*this, se, where + " signal " + std::to_string(g++)));
     });
   }
+  if (const XMLElement* objects = e->FirstChildElement("objects")) {
+    for_each_child(objects, "tunnel", [&](const XMLElement* te) {
+      road.tunnels.push_back(detail::read_span(*this, te, where + " tunnel"));
+    });
+    for_each_child(objects, "bridge", [&](const XMLElement* be) {
+      road.bridges.push_back(detail::read_span(*this, be, where + " bridge"));
+    });
+  }
+  road.superelevation =
+      read_records(e->FirstChildElement("lateralProfile"), "superelevation", "s", 0, where);
 
   road.elevation_profile =
       read_records(e->FirstChildElement("elevationProfile"), "elevation", "s", 0, where);
@@ -458,60 +412,6 @@ double Reader::read_speed(const XMLElement* e, const std::string& where) {
   if (unit == "km/h") return v / 3.6;
   if (unit == "mph") return v * 0.44704;
   fail(e, where, "unit must be m/s, km/h or mph, got '" + unit + "'");
-}
-
-RoadObject Reader::read_object(const XMLElement* e, const std::string& where) {
-  RoadObject o;
-  o.id = text_or(e, "id", "");
-  o.name = text_or(e, "name", "");
-  o.type = text_or(e, "type", "none");
-  o.s = number(e, "s", where);
-  o.t = number(e, "t", where);
-  o.z_offset = number_or(e, "zOffset", 0, where);
-  o.hdg = number_or(e, "hdg", 0, where);
-  o.length = number_or(e, "length", 0, where);
-  o.width = number_or(e, "width", 0, where);
-  o.height = number_or(e, "height", 0, where);
-  o.orientation = text_or(e, "orientation", "none");
-  const XMLElement* outline = e->FirstChildElement("outline");
-  if (!outline) {
-    if (const XMLElement* outlines = e->FirstChildElement("outlines")) {
-      outline = outlines->FirstChildElement("outline");
-    }
-  }
-  if (outline) {
-    for (const XMLElement* c = outline->FirstChildElement(); c; c = c->NextSiblingElement()) {
-      const std::string name = c->Name();
-      if (name == "cornerRoad") {
-        o.outline.push_back({true, number(c, "s", where), number(c, "t", where)});
-      } else if (name == "cornerLocal") {
-        o.outline.push_back({false, number(c, "u", where), number(c, "v", where)});
-      }
-    }
-  }
-  return o;
-}
-
-Signal Reader::read_signal(const XMLElement* e, const std::string& where) {
-  Signal g;
-  g.id = text(e, "id", where);
-  g.name = text_or(e, "name", "");
-  g.s = number(e, "s", where);
-  g.t = number(e, "t", where);
-  g.z_offset = number_or(e, "zOffset", 0, where);
-  g.h_offset = number_or(e, "hOffset", 0, where);
-  g.dynamic = text_or(e, "dynamic", "no") == "yes";
-  g.orientation = text_or(e, "orientation", "none");
-  g.country = text_or(e, "country", "");
-  g.type = text_or(e, "type", "-1");
-  g.subtype = text_or(e, "subtype", "-1");
-  g.value = number_or(e, "value", std::numeric_limits<double>::quiet_NaN(), where);
-  g.unit = text_or(e, "unit", "");
-  for_each_child(e, "validity", [&](const XMLElement* v) {
-    g.validity.emplace_back(integer(v, "fromLane", where + " validity"),
-                            integer(v, "toLane", where + " validity"));
-  });
-  return g;
 }
 
 Junction Reader::read_junction(const XMLElement* e) {

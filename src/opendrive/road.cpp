@@ -61,6 +61,13 @@ Pose2 Road::reference(double s) const {
 
 double Road::elevation(double s) const { return evaluate(elevation_profile, s); }
 
+double Road::superelevation_at(double s) const { return evaluate(superelevation, s); }
+
+double Road::surface_z(double s, double t) const {
+  const double roll = superelevation_at(s);
+  return elevation(s) + (roll == 0 ? 0.0 : t * std::tan(roll));
+}
+
 double Road::lane_offset(double s, double* slope) const { return evaluate(lane_offsets, s, slope); }
 
 size_t Road::section_index(double s) const {

@@ -16,11 +16,14 @@ struct Station {
   double s = 0;
   Pose2 ref;
   double z = 0;
+  double tilt = 0;  // dz/dt from the superelevation
   std::vector<double> outer;  // outer border t per lane index; the centre lane: lane offset
 };
 
 Station station_at(const Road& road, const LaneSection& sec, double s) {
-  Station st{s, road.reference(s), road.elevation(s), std::vector<double>(sec.lanes.size())};
+  const double roll = road.superelevation_at(s);
+  Station st{s, road.reference(s), road.elevation(s), roll == 0 ? 0.0 : std::tan(roll),
+             std::vector<double>(sec.lanes.size())};
   const size_t c = static_cast<size_t>(-sec.min_lane_id());
   st.outer[c] = road.lane_offset(s);
   for (size_t i = c + 1; i < sec.lanes.size(); ++i) {
@@ -32,7 +35,7 @@ Station station_at(const Road& road, const LaneSection& sec, double s) {
 
 Vec3 point(const Station& st, double t, double dz) {
   return {st.ref.x - t * std::sin(st.ref.heading), st.ref.y + t * std::cos(st.ref.heading),
-          st.z + dz};
+          st.z + t * st.tilt + dz};
 }
 
 double distance(const Vec3& a, const Vec3& b) {
@@ -93,11 +96,26 @@ std::vector<RoadMarkLine> mark_lines(const RoadMark& mark, const MeshOptions& op
       lines.push_back({1, 0, t, 0, mark.width});
     } else if (parts[i] == "broken") {
       lines.push_back({options.dash_length, options.dash_gap, t, 0, mark.width});
+    } else if (parts[i] == "botts" && parts.size() == 2 && parts[1] == "dots" &&
+               options.lane_materials) {
+      // a dash as long as it is wide, drawn as a dot: length = width = the dot's diameter
+      const double dia = 2 * options.botts_dot_radius;
+      return {{dia, std::max(options.botts_dot_spacing - dia, dia), 0, 0, dia}};
     } else {
       return {};  // botts dots, grass, curb, none, custom without lines: no paint
     }
   }
   return lines;
+}
+
+SurfaceKind mark_kind(const std::string& colour, bool all_colours) {
+  if (colour == "yellow") return SurfaceKind::kMarkYellow;
+  if (!all_colours) return SurfaceKind::kMarkWhite;
+  if (colour == "blue") return SurfaceKind::kMarkBlue;
+  if (colour == "red") return SurfaceKind::kMarkRed;
+  if (colour == "green") return SurfaceKind::kMarkGreen;
+  if (colour == "orange") return SurfaceKind::kMarkOrange;
+  return SurfaceKind::kMarkWhite;  // standard, white, black on asphalt reads as nothing
 }
 
 class SectionMesher {
@@ -108,9 +126,15 @@ class SectionMesher {
     for (double s : road_stations(road, sec_.s, sec_.s_end, options.sampling)) {
       stations_.push_back(station_at(road, sec_, s));
     }
+    const bool in_junction = road.junction != "-1" && options.lane_materials;
     for (const Lane& lane : sec_.lanes) {
-      kinds_.push_back(lane.id == 0 ? std::nullopt : surface_for_lane_type(lane.type));
-      heights_.push_back(kinds_.back() && is_raised(*kinds_.back()) ? options.curb_height : 0.0);
+      std::optional<SurfaceKind> kind =
+          lane.id == 0 ? std::nullopt : surface_for_lane_type(lane.type, options.lane_materials);
+      // Connecting roads overlap inside a junction: anything but asphalt and sidewalks would
+      // fight with another connection's asphalt there.
+      if (in_junction && kind && *kind != SurfaceKind::kSidewalk) kind = SurfaceKind::kAsphalt;
+      kinds_.push_back(kind);
+      heights_.push_back(kind && is_raised(*kind) ? options.curb_height : 0.0);
     }
   }
 
@@ -160,8 +184,7 @@ class SectionMesher {
         const double b =
             j + 1 < marks.size() ? std::min(marks[j + 1].start, sec_.s_end) : sec_.s_end;
         if (b - a < 1e-6) continue;
-        Mesh& mesh = out_.parts[marks[j].color == "yellow" ? SurfaceKind::kMarkYellow
-                                                           : SurfaceKind::kMarkWhite];
+        Mesh& mesh = out_.parts[mark_kind(marks[j].color, options_.lane_materials)];
         for (const RoadMarkLine& line : mark_lines(marks[j], options_)) {
           if (line.space <= 0) {
             paint(mesh, i, line, dz, a, b);
@@ -236,48 +259,66 @@ class SectionMesher {
 
 }  // namespace
 
-const char* surface_kind_name(SurfaceKind kind) {
-  switch (kind) {
-    case SurfaceKind::kAsphalt:
-      return "asphalt";
-    case SurfaceKind::kSidewalk:
-      return "sidewalk";
-    case SurfaceKind::kCurb:
-      return "curb";
-    case SurfaceKind::kGrass:
-      return "grass";
-    case SurfaceKind::kMarkWhite:
-      return "mark_white";
-    case SurfaceKind::kMarkYellow:
-      return "mark_yellow";
+namespace {
+
+struct KindInfo {
+  SurfaceKind kind;
+  const char* name;
+  std::array<double, 3> colour;  // diffuse, linear RGB
+};
+
+constexpr KindInfo kKinds[] = {
+    {SurfaceKind::kAsphalt, "asphalt", {0.22, 0.22, 0.23}},
+    {SurfaceKind::kSidewalk, "sidewalk", {0.72, 0.71, 0.68}},
+    {SurfaceKind::kCurb, "curb", {0.6, 0.6, 0.58}},
+    {SurfaceKind::kGrass, "grass", {0.25, 0.48, 0.17}},
+    {SurfaceKind::kMarkWhite, "mark_white", {0.95, 0.95, 0.95}},
+    {SurfaceKind::kMarkYellow, "mark_yellow", {0.95, 0.77, 0.1}},
+    {SurfaceKind::kShoulder, "shoulder", {0.32, 0.31, 0.3}},
+    {SurfaceKind::kBorder, "border", {0.45, 0.43, 0.38}},
+    {SurfaceKind::kParking, "parking", {0.4, 0.4, 0.42}},
+    {SurfaceKind::kBiking, "biking", {0.55, 0.22, 0.18}},
+    {SurfaceKind::kRestricted, "restricted", {0.5, 0.47, 0.4}},
+    {SurfaceKind::kMarkBlue, "mark_blue", {0.1, 0.3, 0.85}},
+    {SurfaceKind::kMarkRed, "mark_red", {0.85, 0.12, 0.1}},
+    {SurfaceKind::kMarkGreen, "mark_green", {0.1, 0.6, 0.2}},
+    {SurfaceKind::kMarkOrange, "mark_orange", {0.95, 0.5, 0.1}},
+};
+
+const KindInfo* kind_info(SurfaceKind kind) {
+  for (const KindInfo& k : kKinds) {
+    if (k.kind == kind) return &k;
   }
-  return "?";
+  return nullptr;
+}
+
+}  // namespace
+
+const char* surface_kind_name(SurfaceKind kind) {
+  const KindInfo* k = kind_info(kind);
+  return k ? k->name : "?";
 }
 
 std::array<double, 3> surface_kind_colour(SurfaceKind kind) {
-  switch (kind) {
-    case SurfaceKind::kAsphalt:
-      return {0.22, 0.22, 0.23};
-    case SurfaceKind::kSidewalk:
-      return {0.72, 0.71, 0.68};
-    case SurfaceKind::kCurb:
-      return {0.6, 0.6, 0.58};
-    case SurfaceKind::kGrass:
-      return {0.25, 0.48, 0.17};
-    case SurfaceKind::kMarkWhite:
-      return {0.95, 0.95, 0.95};
-    case SurfaceKind::kMarkYellow:
-      return {0.95, 0.77, 0.1};
-  }
-  return {1, 0, 1};
+  const KindInfo* k = kind_info(kind);
+  return k ? k->colour : std::array<double, 3>{1, 0, 1};
 }
 
-std::optional<SurfaceKind> surface_for_lane_type(const std::string& type) {
+std::optional<SurfaceKind> surface_for_lane_type(const std::string& type, bool lane_materials) {
   if (type == "none") return std::nullopt;
   if (type == "sidewalk") return SurfaceKind::kSidewalk;
   if (type == "curb") return SurfaceKind::kCurb;
-  if (type == "border" || type == "median") return SurfaceKind::kGrass;
-  return SurfaceKind::kAsphalt;  // driving, shoulder, parking, biking, stop, restricted, ...
+  if (type == "median") return SurfaceKind::kGrass;
+  if (!lane_materials) {
+    if (type == "border") return SurfaceKind::kGrass;
+    return SurfaceKind::kAsphalt;  // driving, shoulder, parking, biking, stop, restricted, ...
+  }
+  if (type == "border") return SurfaceKind::kBorder;
+  if (type == "shoulder" || type == "stop") return SurfaceKind::kShoulder;
+  if (type == "parking") return SurfaceKind::kParking;
+  if (type == "biking" || type == "bicycle") return SurfaceKind::kBiking;
+  if (type == "restricted") return SurfaceKind::kRestricted;
+  return SurfaceKind::kAsphalt;
 }
 
 bool is_raised(SurfaceKind kind) {

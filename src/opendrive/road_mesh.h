@@ -9,8 +9,8 @@
 // lane, a vertical curb face closes the step. Road marks are thin quads mark_height above
 // their lane: solid lines continuous, broken lines dash_length on / dash_gap off unless the
 // file gives explicit <type><line> definitions, double types ("solid broken" ...) as two
-// lines, the first on the left (+t). Types without paint (none, botts dots, grass, curb) are
-// skipped. Normals are per vertex (averaged over each strip's faces); triangles wind
+// lines, the first on the left (+t). Types without paint (none, grass, curb) are skipped,
+// and botts dots unless MeshOptions::lane_materials. Superelevation tilts every surface. Normals are per vertex (averaged over each strip's faces); triangles wind
 // counter-clockwise seen from the side the normal points to.
 #pragma once
 
@@ -26,15 +26,35 @@
 
 namespace convoy::opendrive {
 
-enum class SurfaceKind { kAsphalt, kSidewalk, kCurb, kGrass, kMarkWhite, kMarkYellow };
+enum class SurfaceKind {
+  kAsphalt,
+  kSidewalk,
+  kCurb,
+  kGrass,
+  kMarkWhite,
+  kMarkYellow,
+  // With MeshOptions::lane_materials only:
+  kShoulder,
+  kBorder,
+  kParking,
+  kBiking,
+  kRestricted,
+  kMarkBlue,
+  kMarkRed,
+  kMarkGreen,
+  kMarkOrange,
+};
 
-// "asphalt", "sidewalk", "curb", "grass", "mark_white", "mark_yellow" (OBJ object and
-// material names).
+// "asphalt", "sidewalk", "curb", "grass", "mark_white", "mark_yellow", "shoulder", "border",
+// "parking", "biking", "restricted", "mark_blue", ... (OBJ object and material names).
 const char* surface_kind_name(SurfaceKind kind);
 // Diffuse colour, linear RGB in [0, 1].
 std::array<double, 3> surface_kind_colour(SurfaceKind kind);
-// The surface drawn for an OpenDRIVE lane type; nullopt for "none" (not drawn).
-std::optional<SurfaceKind> surface_for_lane_type(const std::string& type);
+// The surface drawn for an OpenDRIVE lane type; nullopt for "none" (not drawn). With
+// `lane_materials`, shoulders, borders, parking, biking and restricted lanes have surfaces of
+// their own (otherwise asphalt, and borders grass).
+std::optional<SurfaceKind> surface_for_lane_type(const std::string& type,
+                                                 bool lane_materials = false);
 // Whether a surface stands curb_height above the road.
 bool is_raised(SurfaceKind kind);
 
@@ -45,6 +65,12 @@ struct MeshOptions {
   double dash_length = 3.0;      // m, broken lines without explicit <line>s
   double dash_gap = 6.0;         // m
   double double_line_gap = 0.1;  // m, between the two lines of a double type
+  // The world generator's look (convoy-odr world): a material per lane type, borders level
+  // with the road, junction surfaces as asphalt only (no other kinds overlapping there), botts
+  // dots, and marks in every colour. Off: the look of the shipped maps' road models.
+  bool lane_materials = false;
+  double botts_dot_spacing = 1.2;  // m between botts dots
+  double botts_dot_radius = 0.06;  // m
 };
 
 struct Mesh {

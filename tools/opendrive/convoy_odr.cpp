@@ -5,6 +5,9 @@
 //                         [--out FILE]       CSV x,y,heading once around the lane's route
 //   convoy-odr mesh FILE OUTDIR [--curb-height 0.12]
 //                                            OUTDIR/road.obj, road.mtl, road.sdf
+//   convoy-odr world FILE OUTDIR [--scenery none|roadside|urban] [--seed N] [--catalog FILE]
+//                                            OUTDIR/world.sdf and OUTDIR/meshes: a world
+//                                            without an ego (src/worldgen, docs/worlds.md)
 //   convoy-odr bounds FILE                   JSON bounding box
 //   convoy-odr route FILE --from ROAD:LANE --to ROAD:LANE [--ds D --out FILE]
 //                                            shortest route over the lane graph (through
@@ -41,6 +44,9 @@
 namespace odr = convoy::opendrive;
 namespace fs = std::filesystem;
 
+int world_command(const std::vector<std::string>& positional,
+                  const std::map<std::string, std::string>& options);  // world_command.cpp
+
 namespace {
 
 constexpr const char* kUsage =
@@ -48,6 +54,8 @@ constexpr const char* kUsage =
     "       convoy-odr waypoints FILE --lane ID [--ds 2.0] [--road ID]\n"
     "                            [--direction driving|reference] [--out FILE]\n"
     "       convoy-odr mesh FILE OUTDIR [--curb-height 0.12]\n"
+    "       convoy-odr world FILE OUTDIR [--scenery none|roadside|urban] [--seed N]\n"
+    "                            [--catalog FILE]\n"
     "       convoy-odr bounds FILE\n"
     "       convoy-odr route FILE --from ROAD:LANE --to ROAD:LANE [--ds 2.0] [--out FILE]\n"
     "                            [--no-lane-changes 1]\n"
@@ -551,6 +559,10 @@ int main(int argc, char** argv) {
     }
     if (cmd == "mesh") return cmd_mesh(parse_args(argc, argv, 2, {"curb-height"}, 2));
     if (cmd == "bounds") return cmd_bounds(parse_args(argc, argv, 2, {}, 1));
+    if (cmd == "world") {
+      const Args a = parse_args(argc, argv, 2, {"scenery", "seed", "catalog"}, 2);
+      return world_command(a.positional, a.options);
+    }
     if (cmd == "route") {
       return cmd_route(
           parse_args(argc, argv, 2, {"from", "to", "ds", "out", "no-lane-changes"}, 1));

@@ -1,0 +1,187 @@
+// The world generator on esmini's 20 maps (tests/opendrive/data/esmini): every map becomes a
+// world, scenery stays off the road, the same seed gives the same files, signals and objects
+// become models, and what cannot be built is a warning naming it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "opendrive/parser.h"
+#include "worldgen/scenery.h"
+#include "worldgen/world_gen.h"
+
+namespace fs = std::filesystem;
+namespace odr = convoy::opendrive;
+namespace wg = convoy::worldgen;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class WorldGenTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("convoy_worldgen_test_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    catalog_ = wg::Catalog::load(CONVOY_WORLDGEN_TEST_CATALOG);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static std::vector<fs::path> maps() {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::directory_iterator(CONVOY_ESMINI_MAPS)) {
+      if (e.path().extension() == ".xodr") out.push_back(e.path());
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  wg::WorldStats make(const fs::path& map, const std::string& out, wg::Scenery scenery,
+                      uint64_t seed = 1) {
+    const odr::Network net = odr::load(map.string());
+    return wg::generate_world(net, catalog_, {scenery, seed}, dir_ / out);
+  }
+
+  fs::path dir_;
+  wg::Catalog catalog_;
+};
+
+}  // namespace
+
+TEST_F(WorldGenTest, EveryEsminiMapBecomesAWorldWithItsMeshes) {
+  const auto all = maps();
+  ASSERT_EQ(all.size(), 20u);
+  for (const fs::path& map : all) {
+    SCOPED_TRACE(map.filename().string());
+    const auto stats = make(map, map.stem().string(), wg::Scenery::kUrban);
+    const fs::path world = dir_ / map.stem() / "world.sdf";
+    ASSERT_TRUE(fs::exists(world));
+    EXPECT_GT(stats.triangles, 500u);
+    // every mesh of the generator's own that the world names is there
+    const std::string text = slurp(world);
+    const std::regex uri("<uri>(meshes/[^<]+)</uri>");
+    int own = 0;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), uri); it != std::sregex_iterator(); ++it) {
+      EXPECT_TRUE(fs::exists(dir_ / map.stem() / (*it)[1].str())) << (*it)[1].str();
+      ++own;
+    }
+    EXPECT_GE(own, 2);  // the road and the ground
+    EXPECT_FALSE(fs::exists(dir_ / (map.stem().string() + ".partial-" + std::to_string(::getpid()))));
+  }
+}
+
+TEST_F(WorldGenTest, SceneryNeverStandsOnALane) {
+  for (const char* name : {"fabriksgatan.xodr", "e6mini.xodr", "multi_intersections.xodr", "curves.xodr"}) {
+    SCOPED_TRACE(name);
+    const odr::Network net = odr::load(std::string(CONVOY_ESMINI_MAPS) + "/" + name);
+    const auto stats = wg::generate_world(net, catalog_, {wg::Scenery::kUrban, 7}, dir_ / "w");
+    wg::Occupancy lanes(odr::network_bounds(net), 60);
+    lanes.mark_roads(net, 0.0);
+    const std::string text = slurp(dir_ / "w" / "world.sdf");
+    const std::regex pose("<model name='scenery_[0-9]+'>\\s*<static>true</static>\\s*<pose>([-0-9.]+) ([-0-9.]+)");
+    int n = 0;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), pose); it != std::sregex_iterator(); ++it) {
+      const double x = std::stod((*it)[1].str()), y = std::stod((*it)[2].str());
+      EXPECT_FALSE(lanes.taken(x, y)) << "scenery at " << x << ", " << y;
+      ++n;
+    }
+    EXPECT_GT(n, 10);
+  }
+}
+
+TEST_F(WorldGenTest, TheSameSeedGivesTheSameWorldAndAnotherSeedAnother) {
+  const fs::path map = fs::path(CONVOY_ESMINI_MAPS) / "jolengatan.xodr";
+  make(map, "a", wg::Scenery::kRoadside, 3);
+  make(map, "b", wg::Scenery::kRoadside, 3);
+  make(map, "c", wg::Scenery::kRoadside, 4);
+  EXPECT_EQ(slurp(dir_ / "a/world.sdf"), slurp(dir_ / "b/world.sdf"));
+  EXPECT_EQ(slurp(dir_ / "a/meshes/road.obj"), slurp(dir_ / "b/meshes/road.obj"));
+  EXPECT_NE(slurp(dir_ / "a/world.sdf"), slurp(dir_ / "c/world.sdf"));
+}
+
+TEST_F(WorldGenTest, SignalsBecomeLightsSignsAndPaint) {
+  const auto stats = make(fs::path(CONVOY_ESMINI_MAPS) / "multi_intersections.xodr", "m", wg::Scenery::kNone);
+  const std::string text = slurp(dir_ / "m/world.sdf");
+  EXPECT_NE(text.find("<plugin name='convoy_signal' filename='convoy_signal'><signal>"), std::string::npos);
+  EXPECT_NE(text.find("<class>traffic_light</class>"), std::string::npos);
+  EXPECT_NE(text.find("<class>sign</class>"), std::string::npos);
+  EXPECT_GT(stats.signals, 50u);
+  // stop lines and crosswalks are paint: more white triangles than the lane marks alone
+  odr::MeshOptions plain;
+  plain.lane_materials = true;
+  const auto marks = odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/multi_intersections.xodr"), plain)
+                         .parts.at(odr::SurfaceKind::kMarkWhite).triangles.size();
+  const std::string obj = slurp(dir_ / "m/meshes/road.obj");
+  const size_t at = obj.find("o mark_white");
+  ASSERT_NE(at, std::string::npos);
+  const size_t end = obj.find("\no ", at + 1);
+  const std::string part = obj.substr(at, end == std::string::npos ? std::string::npos : end - at);
+  size_t faces = 0;
+  for (size_t p = part.find("\nf "); p != std::string::npos; p = part.find("\nf ", p + 1)) ++faces;
+  EXPECT_GT(faces, marks + 100);
+}
+
+TEST_F(WorldGenTest, UnknownSignalsAreWarningsNamingTheRoadAndSignal) {
+  const auto stats = make(fs::path(CONVOY_ESMINI_MAPS) / "straight_500m_signs.xodr", "s", wg::Scenery::kNone);
+  bool named = false;
+  for (const auto& w : stats.warnings) named |= w.find("road 1 signal 14 (overtaking_ban_begin)") == 0;
+  EXPECT_TRUE(named);
+  EXPECT_GE(stats.signals, 10u);
+}
+
+TEST_F(WorldGenTest, ObjectsTunnelsAndRepeatsBecomeModels) {
+  make(fs::path(CONVOY_ESMINI_MAPS) / "tunnels.xodr", "t", wg::Scenery::kNone);
+  const std::string tunnels = slurp(dir_ / "t/world.sdf");
+  EXPECT_NE(tunnels.find("<model name='tunnel_1_1'>"), std::string::npos);
+  make(fs::path(CONVOY_ESMINI_MAPS) / "e6mini.xodr", "e", wg::Scenery::kNone);
+  const std::string e6 = slurp(dir_ / "e/world.sdf");
+  EXPECT_NE(e6.find("<model name='object_0_4_sweep'>"), std::string::npos);  // a railing along the road
+  EXPECT_NE(e6.find("<model name='object_0_2_12'>"), std::string::npos);      // a rail pole, 13th of its repeat
+  make(fs::path(CONVOY_ESMINI_MAPS) / "crest-curve.xodr", "c", wg::Scenery::kNone);
+  const std::string crest = slurp(dir_ / "c/world.sdf");
+  EXPECT_NE(crest.find("<class>building</class>"), std::string::npos);  // from an outline
+}
+
+TEST_F(WorldGenTest, LaneTypesHaveTheirOwnMaterialsAndSuperelevationTilts) {
+  odr::MeshOptions look;
+  look.lane_materials = true;
+  const auto parking = odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/parking_demo.xodr"), look);
+  EXPECT_TRUE(parking.parts.count(odr::SurfaceKind::kBiking));
+  EXPECT_TRUE(parking.parts.count(odr::SurfaceKind::kShoulder));
+  const auto plain = odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/parking_demo.xodr"));
+  EXPECT_FALSE(plain.parts.count(odr::SurfaceKind::kBiking));  // the shipped maps' look is kept
+  const odr::Network velodrome = odr::load(std::string(CONVOY_ESMINI_MAPS) + "/velodrome.xodr");
+  const odr::Road& road = velodrome.roads.front();
+  double tilt = 0;
+  for (double s = 0; s < road.length; s += 10) tilt = std::max(tilt, std::abs(road.superelevation_at(s)));
+  EXPECT_GT(tilt, 0.1);
+  const auto mesh = odr::build_road_mesh(velodrome, look);
+  double zmin = 1e9, zmax = -1e9;
+  for (const auto& p : mesh.parts.at(odr::SurfaceKind::kAsphalt).positions) {
+    zmin = std::min(zmin, p[2]), zmax = std::max(zmax, p[2]);
+  }
+  EXPECT_GT(zmax - zmin, 1.0);
+}
+
+TEST_F(WorldGenTest, AMapThatCannotBeParsedIsAnErrorNamingFileAndLine) {
+  try {
+    odr::load(std::string(CONVOY_OPENDRIVE_TEST_DATA) + "/malformed.xodr");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("malformed.xodr:"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneryTest, TheSceneryKindIsCheckedByName) {
+  EXPECT_EQ(wg::parse_scenery("urban"), wg::Scenery::kUrban);
+  EXPECT_THROW(wg::parse_scenery("forest"), std::invalid_argument);
+}
