@@ -15,7 +15,6 @@ the last cycle before SimulationTimeout. At the end a route not finished is a sc
 infraction. Replaying the same datapacks gives the same summary fields, bit for bit."""
 
 import os
-import sys
 
 from nrp_core import *  # noqa: F401,F403
 
@@ -41,9 +40,8 @@ MAP = SCENARIO.get("Map")
 
 STOP_LINES = []
 if LIGHTS is not None:
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HERE)), "experiments", "city_traffic"))
-    import city_map  # noqa: E402
-    STOP_LINES = city_map.CityMap(LIGHTS["Map"]).stop_lines
+    from convoy_scenario.stop_lines import stop_lines  # noqa: E402
+    STOP_LINES = stop_lines(LIGHTS["Map"])
 
 _state = {"live": None, "final": False, "n": 0}
 

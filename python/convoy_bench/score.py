@@ -164,7 +164,7 @@ def route_progress(samples, route, end_t=None):
     if given is not None and abs(float(given) - L) > 1e-3:
         raise ValueError("route: length %g does not match its points (%g m)" % (float(given), L))
     proj, s_max, finished = [], 0.0, False
-    off_m, stretches = [], []
+    off_m, stretches, max_offset = [], [], 0.0
     end_x, end_y = pts[-1]
     for i, smp in enumerate(samples):
         if i == 0:
@@ -173,6 +173,8 @@ def route_progress(samples, route, end_t=None):
             s, dist, _ = geometry.project_on_polyline(pts, cum, smp["x"], smp["y"],
                                                       s_max - PROJECTION_BACK_M, s_max + PROJECTION_AHEAD_M)
         proj.append(s)
+        if end_t is None or smp["t"] <= end_t:
+            max_offset = max(max_offset, dist)
         if (end_t is not None and smp["t"] > end_t) or dist > ROUTE_DEVIATION_M:
             continue
         gain = max(0.0, s - s_max) if i else s
@@ -190,7 +192,7 @@ def route_progress(samples, route, end_t=None):
     stretches = [{"t": st["t"], "kind": st["kind"], "distance_m": math.fsum(st["distance_m"])}
                  for st in stretches if math.fsum(st["distance_m"]) > 0.0]
     return {"length": L, "projection": proj, "progress": s_max, "finished": finished,
-            "off_flags_m": math.fsum(off_m), "stretches": stretches}
+            "off_flags_m": math.fsum(off_m), "stretches": stretches, "max_offset_m": max_offset}
 
 
 def min_speed_events(samples, progress, length):
@@ -274,7 +276,8 @@ def _carla(samples, times, route, events):
             "infraction_penalty": penalty, "infractions": infractions, "route_length_m": L,
             "route_progress_m": s, "off_route_m": d_off,
             "off_route_percentage": 100.0 * d_off / s if s > 0.0 else 0.0,
-            "route_finished": rp["finished"], "route_ended_at": end_t}, rp
+            "route_finished": rp["finished"], "route_ended_at": end_t,
+            "route_max_offset_m": rp["max_offset_m"]}, rp
 
 
 # --- nuPlan --------------------------------------------------------------------------------
@@ -343,7 +346,7 @@ def score_drive(trajectory, route, events=(), speed_limits=None):
     "route_completion", "route_completion_raw", "infraction_penalty", "infractions": [{"t",
     "kind", "other", "penalty", "counted", ("percentage" | "distance_m")}], "route_length_m",
     "route_progress_m", "off_route_m", "off_route_percentage", "route_finished",
-    "route_ended_at", "nuplan_score": {"score", "multipliers", "weighted", "weights",
+    "route_ended_at", "route_max_offset_m", "nuplan_score": {"score", "multipliers", "weighted", "weights",
     "collisions", "at_fault_collisions", "min_ttc_s", "ttc_available", "ego_progress_m",
     "expert_progress_m", "max_overspeed_mps", "max_wrong_way_m_per_1s", "comfort"}}.
     ValueError for malformed inputs."""

@@ -46,6 +46,7 @@ from nrp_core.engines.python_json import EngineScript
 from convoy_scenario import load
 from convoy_scenario.odr import OdrQuery, world_pose
 from convoy_scenario.storyboard import ScenarioRuntimeError, Storyboard
+from convoy_scenario.tracks import TracksWriter
 from convoy_scenario.xmltree import ScenarioError
 
 MISSING_STATE_S = 1.0   # an entity without a state this long after the start is an error
@@ -173,7 +174,7 @@ class Commander:
 
 def state_dict(u):
     """A RoadUser dict (proto field names) as the storyboard's world state."""
-    d = {k: float(u.get(k, 0.0)) for k in ("x", "y", "yaw", "speed", "vx", "vy")}
+    d = {k: float(u.get(k, 0.0)) for k in ("x", "y", "z", "yaw", "speed", "vx", "vy")}
     for k in ("length", "width", "length_offset"):
         if u.get(k):
             d[k] = float(u[k])
@@ -206,6 +207,7 @@ class Script(EngineScript):
         self.reason = ""
         self.missing_since = None
         self.last_seen = {}   # entity -> its last state (kept for road users that left)
+        self.tracks = TracksWriter.in_run_dir()
         for dp in ("road_users", "commands", "scenario", "route"):
             self._registerDataPack(dp)
         self._setDataPack("commands", {"time_ns": 0, "entities": {}})
@@ -263,6 +265,8 @@ class Script(EngineScript):
                     t - self.missing_since, ", ".join(
                         "/".join(x for x in self.entities[n][:2]) for n in missing)))
             return
+        if self.tracks is not None:
+            self.tracks.step(t, world)
         try:
             result = self.board.step(t, world)
         except ScenarioRuntimeError as e:
@@ -298,6 +302,8 @@ class Script(EngineScript):
         """The storyboard is complete but the run goes on: no commands (the agents' own AI), the
         route's end still ends it."""
         world = self._world()
+        if self.tracks is not None:
+            self.tracks.step(t, world)
         self._setDataPack("commands", {"time_ns": self._time_ns, "entities": self.commander.idle(self._time_ns)})
         if self.end_at_route_end and self.ego in world and \
                 past_route_end(self.route, world[self.ego]["x"], world[self.ego]["y"]):
@@ -309,3 +315,5 @@ class Script(EngineScript):
     def shutdown(self):
         if getattr(self, "odr", None) is not None:
             self.odr.close()
+        if getattr(self, "tracks", None) is not None:
+            self.tracks.close()

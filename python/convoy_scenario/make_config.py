@@ -2,9 +2,9 @@
 """Builds the default simulation config of an OpenSCENARIO file (what `convoy run --scenario`
 runs; docs/scenarios.md, "Running a scenario"):
 
-- the world engine on the world of the scenario's RoadNetwork LogicFile (MAPS below; another
-  map needs --world FILE.sdf), the ego (the report's smart car with its camera) inserted at its
-  Init teleport;
+- the world engine on the world of the scenario's RoadNetwork LogicFile (MAPS below; for any
+  other map a world generated from it, cached: worlds.py; --world FILE.sdf overrides), the ego
+  (the report's smart car with its camera) inserted at its Init teleport;
 - one vehicle_agent per other Vehicle entity and one pedestrian_agent per Pedestrian entity,
   started at their Init teleports (StartPose) with their Init AbsoluteTargetSpeed
   (InitialSpeed, and a vehicle's desired speed v0 when its own AI drives it), sized from their BoundingBox, their model from the catalog entry or the
@@ -50,6 +50,7 @@ if PYTHON not in sys.path:
 from convoy_scenario import ScenarioError, load, weather_config  # noqa: E402
 from convoy_scenario import model as m  # noqa: E402
 from convoy_scenario.odr import OdrQuery, world_pose  # noqa: E402
+from convoy_scenario.worlds import generated_world  # noqa: E402
 
 CITY = os.path.join(REPO, "experiments", "city_traffic")
 AD = os.path.join(REPO, "experiments", "autonomous_driving")
@@ -219,10 +220,10 @@ def route_length(scenario):
     return max(40.0, min(300.0, 0.5 * CRUISE * duration))
 
 
-def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs):
+def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0):
     x, y, yaw = pose
     out_engines[0]["GazeboSDFModels"] = [{"Name": "smart_car", "File": EGO_MODEL,
-                                          "InitPose": [x, y, 0.0, 0.0, 0.0, yaw]}]
+                                          "InitPose": [x, y, z, 0.0, 0.0, yaw]}]
     # the smart car's meshes (model://smart_car/...) are found next to its model
     out_engines[0]["EngineEnvParams"] = ["CONVOY_MODEL_PATH=" + os.path.dirname(os.path.dirname(EGO_MODEL))]
     out_engines += [
@@ -245,7 +246,8 @@ def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs):
     return "gazebo/smart_car::road_user"
 
 
-def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin_dir=None, snapshots=None):
+def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin_dir=None, snapshots=None,
+          scenery="auto"):
     """(config dict, ego route points [[x, y, heading]], scored route length)."""
     scenario = load(xosc, parameters=parameters or None)
     base = os.path.basename(xosc)
@@ -253,10 +255,10 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         raise ScenarioError("%s: no RoadNetwork LogicFile: a scenario needs an OpenDRIVE map" % base)
     world_sdf = os.path.abspath(world) if world else world_for(scenario.logic_file)
     if world_sdf is None:
-        raise ScenarioError(
-            "%s: no world for the map %s: supported maps are %s (or give --world FILE.sdf, a "
-            "world without the ego)" % (base, scenario.logic_file, ", ".join(
-                os.path.relpath(p, REPO) for p in MAPS)))
+        try:
+            world_sdf = generated_world(scenario.logic_file, bin_dir, scenery, out_dir=out_dir)
+        except ScenarioError as e:
+            raise ScenarioError("%s: %s" % (base, e))
     if not os.path.exists(world_sdf):
         raise ScenarioError("%s: the world %s does not exist" % (base, world_sdf))
     names = [e.name for e in scenario.entities]
@@ -354,7 +356,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         if "GazeboSDFModels" in frag:
             engines[0]["GazeboSDFModels"] = frag["GazeboSDFModels"]
     else:
-        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs)
+        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs, start.get("z", 0.0))
     if has_lights:
         engines.append({"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
                         "Map": xodr, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0})
@@ -385,10 +387,10 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     return config, drive, scored_len
 
 
-def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapshots=None):
+def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapshots=None, scenery="auto"):
     out_dir = os.path.dirname(os.path.abspath(out))
     os.makedirs(out_dir, exist_ok=True)
-    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots)
+    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots, scenery)
     with open(os.path.join(out_dir, "ego_route.csv"), "w") as f:
         f.write("x,y,heading\n")
         for x, y, h in drive:
@@ -413,7 +415,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scenario")
     ap.add_argument("--out", required=True, help="the config file to write")
-    ap.add_argument("--world", help="the world SDF (without the ego) for a map the project does not know")
+    ap.add_argument("--world", help="the world SDF (without the ego); default: the map's shipped world, "
+                    "else one generated from the map (cached)")
+    ap.add_argument("--scenery", default="auto", choices=["auto", "none", "roadside", "urban"],
+                    help="the scenery of a generated world (auto: urban where the map has sidewalks)")
     ap.add_argument("--ego", help="a config fragment {EngineConfigs, DataPackProcessingFunctions, EgoState}: the user's ego")
     ap.add_argument("--param", action="append", type=_param, default=[], help="NAME=VALUE: a scenario parameter")
     ap.add_argument("--bin-dir", help="where convoy-odr is")
@@ -422,7 +427,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     try:
         snaps = [float(t) for t in a.snapshots.split(",")] if a.snapshots else None
-        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir, snaps)
+        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir, snaps, a.scenery)
     except ScenarioError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2

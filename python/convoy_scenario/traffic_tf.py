@@ -16,7 +16,6 @@ engine's Entities entry for its EgoName)."""
 import json
 import math
 import os
-import sys
 
 from nrp_core import *  # noqa: F401,F403
 from nrp_core.data.nrp_json import JsonDataPack
@@ -51,9 +50,8 @@ LINK = SCENARIO["EngineName"] if SCENARIO is not None else (AGENTS[0] if AGENTS 
 
 STOP_LINES = []
 if LIGHTS is not None and PLANNER is not None:
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HERE)), "experiments", "city_traffic"))
-    import city_map  # noqa: E402
-    STOP_LINES = city_map.CityMap(LIGHTS["Map"]).stop_lines
+    from convoy_scenario.stop_lines import stop_lines  # noqa: E402
+    STOP_LINES = stop_lines(LIGHTS["Map"])
 
 
 def _front(u):

@@ -24,7 +24,7 @@ void usage(const char* prog) {
   std::printf(
       "usage: %s run -c simulation_config.json [-o Key=Value]... [--run-dir DIR] [--quiet]\n"
       "                  [--record] [--record-blobs]\n"
-      "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--ego FRAGMENT.json]\n"
+      "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--scenery KIND] [--ego FRAGMENT.json]\n"
       "                [-o Key=Value]... [--run-dir DIR] [--quiet] [--record]\n"
       "       %s replay RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
@@ -43,8 +43,12 @@ void usage(const char* prog) {
       "  -c, --config FILE   the simulation config (NRP-Core format)\n"
       "  --scenario FILE     run an OpenSCENARIO file with a default config (written into the\n"
       "                      run folder as scenario_config.json; docs/scenarios.md)\n"
-      "  --world FILE        with --scenario: the world SDF (without the ego) for a map the\n"
-      "                      project does not know\n"
+      "  --world FILE        with --scenario: the world SDF (without the ego); by default the\n"
+      "                      map's shipped world, else one generated from the map and cached\n"
+      "                      (convoy-odr world; docs/worlds.md)\n"
+      "  --scenery KIND      with --scenario: a generated world's scenery: auto (default:\n"
+      "                      urban where the map has sidewalks, else roadside), none,\n"
+      "                      roadside or urban\n"
       "  --ego FILE          with --scenario: a config fragment with the user's ego engines\n"
       "  -o, --param K=V     override a config key; K may be a path like "
       "EngineConfigs/0/EngineTimestep\n"
@@ -167,7 +171,7 @@ int campaign(int argc, char** argv) {
 // --scenario: writes the scenario's default config into the run folder (creating it) with
 // python/convoy_scenario/make_config.py; points `options` at it. False after saying why.
 bool prepare_scenario(const std::string& scenario, const std::string& world, const std::string& ego,
-                      convoy::app::RunOptions& options) {
+                      const std::string& scenery, convoy::app::RunOptions& options) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_regular_file(scenario, ec)) {
@@ -201,6 +205,7 @@ bool prepare_scenario(const std::string& scenario, const std::string& world, con
       convoy::app::bin_dir().string()};
   if (!world.empty()) args.insert(args.end(), {"--world", fs::absolute(world).string()});
   if (!ego.empty()) args.insert(args.end(), {"--ego", fs::absolute(ego).string()});
+  if (!scenery.empty()) args.insert(args.end(), {"--scenery", scenery});
   const int rc = run_program(args);
   if (rc != 0) {
     if (rc < 0) std::fprintf(stderr, "error: cannot run %s\n", args[0].c_str());
@@ -235,7 +240,7 @@ int main(int argc, char** argv) {
   }
   convoy::app::RunOptions options;
   std::string mode = "standalone", dir, log_output, log_filename = ".console_output.log";
-  std::string scenario, world, ego;
+  std::string scenario, world, ego, scenery;
   for (; i < argc; ++i) {
     std::string a = argv[i];
     std::string inline_value;  // --key=value
@@ -267,6 +272,8 @@ int main(int argc, char** argv) {
       world = value();
     else if (a == "--ego")
       ego = value();
+    else if (a == "--scenery")
+      scenery = value();
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
     else if (a == "--record")
@@ -332,9 +339,9 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "error: --scenario runs standalone only\n");
       return 2;
     }
-    if (!prepare_scenario(scenario, world, ego, options)) return 2;
-  } else if (!world.empty() || !ego.empty()) {
-    std::fprintf(stderr, "error: --world and --ego go with --scenario\n");
+    if (!prepare_scenario(scenario, world, ego, scenery, options)) return 2;
+  } else if (!world.empty() || !ego.empty() || !scenery.empty()) {
+    std::fprintf(stderr, "error: --world, --scenery and --ego go with --scenario\n");
     return 2;
   }
   if (options.config_file.empty()) {

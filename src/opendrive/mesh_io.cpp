@@ -1,5 +1,7 @@
 #include "opendrive/mesh_io.h"
 
+#include "opendrive/text_file.h"
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -7,27 +9,6 @@
 #include <stdexcept>
 
 namespace convoy::opendrive {
-namespace {
-
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-using File = std::unique_ptr<std::FILE, FileCloser>;
-
-File open_for_writing(const std::filesystem::path& path) {
-  File f(std::fopen(path.c_str(), "w"));
-  if (!f) throw std::runtime_error(path.string() + ": cannot write: " + std::strerror(errno));
-  return f;
-}
-
-void close_checked(File f, const std::filesystem::path& path) {
-  const bool bad = std::ferror(f.get()) != 0;
-  if (std::fclose(f.release()) != 0 || bad) {
-    throw std::runtime_error(path.string() + ": write failed: " + std::strerror(errno));
-  }
-}
-
-}  // namespace
 
 void write_obj(const RoadMesh& mesh, const std::filesystem::path& obj,
                const std::string& mtl_file_name) {

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,7 +23,10 @@ using tinyxml2::XMLElement;
 
 class Reader : public detail::XmlFields {
  public:
-  explicit Reader(std::string source) : XmlFields(std::move(source)) { net_.source = source_; }
+  Reader(std::string source, const LoadOptions& options)
+      : XmlFields(std::move(source)), options_(options) {
+    net_.source = source_;
+  }
 
   Network read(const tinyxml2::XMLDocument& doc);
 
@@ -52,6 +56,8 @@ class Reader : public detail::XmlFields {
     std::string target;
   };
 
+  LoadOptions options_;
+  std::set<std::string> skipped_;  // ids of roads skipped (LoadOptions::skip_bad_roads)
   Network net_;
   std::vector<PendingLink> links_;
 };
@@ -65,7 +71,15 @@ Network Reader::read(const tinyxml2::XMLDocument& doc) {
   read_header(root->FirstChildElement("header"));
   size_t index = 0;
   for_each_child(root, "road", [&](const XMLElement* e) {
-    Road road = read_road(e, index++);
+    Road road;
+    try {
+      road = read_road(e, index++);
+    } catch (const std::runtime_error& err) {
+      if (!options_.skip_bad_roads) throw;
+      net_.warnings.push_back(std::string(err.what()) + "; the road is skipped");
+      skipped_.insert(text_or(e, "id", ""));
+      return;
+    }
     if (net_.find_road(road.id)) fail(e, "road " + road.id, "duplicate road id");
     net_.roads.push_back(std::move(road));
   });
@@ -86,6 +100,7 @@ Network Reader::read(const tinyxml2::XMLDocument& doc) {
   });
   for (const PendingLink& link : links_) {
     if (!net_.find_road(link.target)) {
+      if (skipped_.count(link.target)) continue;  // a road skipped above: its links go too
       fail(link.element, link.where, "links to unknown road '" + link.target + "'");
     }
   }
@@ -454,7 +469,7 @@ Junction Reader::read_junction(const XMLElement* e) {
 
 }  // namespace
 
-Network parse(const std::string& xml, const std::string& source_name) {
+Network parse(const std::string& xml, const std::string& source_name, const LoadOptions& options) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
     // ErrorStr() reads "Error=NAME ErrorID=N (0xN) Line number=N: detail"; keep the detail.
@@ -464,15 +479,15 @@ Network parse(const std::string& xml, const std::string& source_name) {
     throw std::runtime_error(source_name + ":" + std::to_string(doc.ErrorLineNum()) +
                              ": malformed XML: " + doc.ErrorName() + detail);
   }
-  return Reader(source_name).read(doc);
+  return Reader(source_name, options).read(doc);
 }
 
-Network load(const std::string& path) {
+Network load(const std::string& path, const LoadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open file: " + std::strerror(errno));
   std::ostringstream text;
   text << in.rdbuf();
-  return parse(text.str(), path);
+  return parse(text.str(), path, options);
 }
 
 }  // namespace convoy::opendrive

@@ -20,10 +20,19 @@
 
 namespace convoy::opendrive {
 
+struct LoadOptions {
+  // A road that cannot be read (an unknown geometry, a bad lane section...) becomes a
+  // warning in Network::warnings naming it, and is left out with the links to it, instead of
+  // failing the whole map (the world generator's reading: only a map that cannot be parsed at
+  // all is an error there).
+  bool skip_bad_roads = false;
+};
+
 // Reads a file. Messages use `path` as given.
-Network load(const std::string& path);
+Network load(const std::string& path, const LoadOptions& options = {});
 
 // Parses a document held in memory; `source_name` stands for the file in messages.
-Network parse(const std::string& xml, const std::string& source_name);
+Network parse(const std::string& xml, const std::string& source_name,
+              const LoadOptions& options = {});
 
 }  // namespace convoy::opendrive

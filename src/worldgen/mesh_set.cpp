@@ -1,5 +1,7 @@
 #include "worldgen/mesh_set.h"
 
+#include "opendrive/text_file.h"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +12,10 @@
 namespace convoy::worldgen {
 namespace {
 
+using opendrive::close_checked;
+using opendrive::File;
+using opendrive::open_for_writing;
+
 Vec3 sub(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 
 Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -17,24 +23,6 @@ Vec3 unit_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
   Vec3 n = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
   const double len = std::hypot(n[0], n[1], n[2]);
   return len > 0 ? Vec3{n[0] / len, n[1] / len, n[2] / len} : Vec3{0, 0, 1};
-}
-
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-using File = std::unique_ptr<std::FILE, FileCloser>;
-
-File open_for_writing(const std::filesystem::path& path) {
-  File f(std::fopen(path.c_str(), "w"));
-  if (!f) throw std::runtime_error(path.string() + ": cannot write: " + std::strerror(errno));
-  return f;
-}
-
-void close_checked(File f, const std::filesystem::path& path) {
-  const bool bad = std::ferror(f.get()) != 0;
-  if (std::fclose(f.release()) != 0 || bad) {
-    throw std::runtime_error(path.string() + ": write failed: " + std::strerror(errno));
-  }
 }
 
 }  // namespace
@@ -100,6 +88,35 @@ void MeshSet::add_box(Part& p, const Vec3& centre, const Vec3& size, double yaw)
   add_quad(p, at(-1, 1, -1), at(-1, -1, -1), at(-1, -1, 1), at(-1, 1, 1));  // -x
   add_quad(p, at(1, 1, -1), at(-1, 1, -1), at(-1, 1, 1), at(1, 1, 1));      // +y
   add_quad(p, at(-1, -1, -1), at(1, -1, -1), at(1, -1, 1), at(-1, -1, 1));  // -y
+}
+
+std::map<std::pair<int, int>, MeshSet> MeshSet::tiles(double size) const {
+  std::map<std::pair<int, int>, MeshSet> out;
+  for (const auto& [name, p] : parts_) {
+    const bool uv = p.uvs.size() == p.positions.size() && !p.uvs.empty();
+    // old vertex -> new vertex, per tile
+    std::map<std::pair<int, int>, std::map<uint32_t, uint32_t>> remap;
+    for (const auto& t : p.triangles) {
+      double cx = 0, cy = 0;
+      for (uint32_t k : t) cx += p.positions[k][0] / 3, cy += p.positions[k][1] / 3;
+      const std::pair<int, int> key{static_cast<int>(std::floor(cx / size)),
+                                    static_cast<int>(std::floor(cy / size))};
+      Part& q = out[key].part(name, p.material);
+      auto& map = remap[key];
+      std::array<uint32_t, 3> nt{};
+      for (int j = 0; j < 3; ++j) {
+        auto [it, added] = map.try_emplace(t[j], static_cast<uint32_t>(q.positions.size()));
+        if (added) {
+          q.positions.push_back(p.positions[t[j]]);
+          q.normals.push_back(p.normals[t[j]]);
+          if (uv) q.uvs.push_back(p.uvs[t[j]]);
+        }
+        nt[j] = it->second;
+      }
+      q.triangles.push_back(nt);
+    }
+  }
+  return out;
 }
 
 size_t MeshSet::triangle_count() const {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "opendrive/road_mesh.h"
@@ -50,6 +51,10 @@ class MeshSet {
   size_t triangle_count() const;
   bool empty() const { return parts_.empty(); }
   const std::map<std::string, Part>& parts() const { return parts_; }
+
+  // The triangles split into square tiles of `size` metres by their centroids (x, y), each
+  // tile a MeshSet with the same parts: so that a renderer can cull and simplify each tile.
+  std::map<std::pair<int, int>, MeshSet> tiles(double size) const;
 
   // Writes `obj` and `mtl` (next to each other; the OBJ names the MTL by file name).
   void write(const std::filesystem::path& obj, const std::filesystem::path& mtl,

@@ -72,6 +72,7 @@ class ObjectBuilder {
     if (r.distance <= 0) return sweep(r, w0, w1, h0, h1);
     const int n = static_cast<int>(std::floor(r.length / r.distance + 1e-9)) + 1;
     if (n > 5000) return plan_.warn(where_ + ": repeat makes " + std::to_string(n) + " objects; skipped");
+    if (n > 12 && is_post()) return posts(r, n, h0, h1);
     for (int k = 0; k < n; ++k) {
       const double u = r.length > 0 ? k * r.distance / r.length : 0;
       single({r.s + k * r.distance, lerp(r.t_start, r.t_end, u), lerp(r.z_start, r.z_end, u),
@@ -96,6 +97,25 @@ class ObjectBuilder {
     }
     MeshModel m = model(type_ == "vegetation" ? "shrub" : sweep_class(), "_sweep");
     add_ribbon(m.mesh.part("solid", material()), st);
+    plan_.models.push_back(std::move(m));
+  }
+
+  bool is_post() const {
+    return type_ == "pole" || type_ == "guide-post" || type_ == "rail-pole" || type_ == "bollard";
+  }
+
+  // A long row of small posts (a railing's, guide posts): one model of simple posts rather
+  // than a model each, which would cost every start-up and every frame.
+  void posts(const odr::ObjectRepeat& r, int n, double h0, double h1) {
+    MeshModel m = model("pole", "_posts");
+    Part& part = m.mesh.part("post", {{0.82, 0.82, 0.8}, 0.2, ""});
+    for (int k = 0; k < n; ++k) {
+      const double u = r.length > 0 ? k * r.distance / r.length : 0;
+      const double s = std::clamp(r.s + k * r.distance, 0.0, road_.length);
+      const double h = std::max(0.3, lerp(h0, h1, u) > 0 ? lerp(h0, h1, u) : 1.0);
+      const Vec3 base = road_point(road_, s, lerp(r.t_start, r.t_end, u), lerp(r.z_start, r.z_end, u));
+      MeshSet::add_box(part, {base[0], base[1], base[2] + 0.5 * h}, {0.12, 0.12, h}, yaw_at(s));
+    }
     plan_.models.push_back(std::move(m));
   }
 

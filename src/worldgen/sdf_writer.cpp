@@ -1,7 +1,9 @@
 #include "worldgen/sdf_writer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -9,6 +11,8 @@ namespace convoy::worldgen {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr double kRoadTile = 64;  // m
 
 std::string num(double v) {
   char buf[32];
@@ -31,10 +35,24 @@ std::string class_plugin(const std::string& cls) {
          "</class></plugin>\n";
 }
 
-void write_mesh_model(std::ostream& out, const MeshModel& m, const fs::path& dir) {
-  const std::string file = "meshes/" + m.name + ".obj";
-  m.mesh.write(dir / file, dir / ("meshes/" + m.name + ".mtl"), "Convoy world generator: " + m.name);
-  out << "    <model name='" << m.name << "'>\n      <static>true</static>\n"
+// Model names unique in the world: a map may give two signals or objects of a road one id.
+class Names {
+ public:
+  std::string operator()(const std::string& name) {
+    std::string n = name;
+    for (int k = 2; !taken_.insert(n).second; ++k) n = name + "_" + std::to_string(k);
+    return n;
+  }
+
+ private:
+  std::set<std::string> taken_;
+};
+
+void write_mesh_model(std::ostream& out, const MeshModel& m, const std::string& name,
+                      const fs::path& dir) {
+  const std::string file = "meshes/" + name + ".obj";
+  m.mesh.write(dir / file, dir / ("meshes/" + name + ".mtl"), "Convoy world generator: " + name);
+  out << "    <model name='" << name << "'>\n      <static>true</static>\n"
       << "      <link name='link'>\n"
       << "        <visual name='visual'><geometry><mesh><uri>" << file
       << "</uri></mesh></geometry></visual>\n";
@@ -47,10 +65,10 @@ void write_mesh_model(std::ostream& out, const MeshModel& m, const fs::path& dir
   out << "      </link>\n" << class_plugin(m.cls) << "    </model>\n";
 }
 
-void write_placement(std::ostream& out, const Placement& p) {
+void write_placement(std::ostream& out, const Placement& p, const std::string& name) {
   const CatalogModel& m = *p.model;
   const std::string scale = num(p.scale[0]) + " " + num(p.scale[1]) + " " + num(p.scale[2]);
-  out << "    <model name='" << p.name << "'>\n      <static>true</static>\n"
+  out << "    <model name='" << name << "'>\n      <static>true</static>\n"
       << "      <pose>" << pose(p.position, p.yaw) << "</pose>\n      <link name='link'>\n";
   for (const CatalogVisual& v : m.visuals) {
     std::array<double, 6> vp = v.pose;
@@ -90,7 +108,14 @@ void write_placement(std::ostream& out, const Placement& p) {
 
 void write_world(const WorldPlan& plan, const fs::path& dir, const WriteOptions& options) {
   fs::create_directories(dir / "meshes");
-  plan.road.write(dir / "meshes/road.obj", dir / "meshes/road.mtl", "Convoy world generator: road");
+  // The road in tiles: the renderer culls each tile outside the view and simplifies the far.
+  std::vector<std::string> road_tiles;
+  for (const auto& [key, tile] : plan.road.tiles(kRoadTile)) {
+    const std::string name = "road_" + std::to_string(key.first) + "_" + std::to_string(key.second);
+    tile.write(dir / ("meshes/" + name + ".obj"), dir / ("meshes/" + name + ".mtl"),
+               "Convoy world generator: road tile " + name);
+    road_tiles.push_back(name);
+  }
   plan.ground.write(dir / "meshes/ground.obj", dir / "meshes/ground.mtl",
                     "Convoy world generator: ground and horizon");
   std::ostringstream out;
@@ -108,14 +133,34 @@ void write_world(const WorldPlan& plan, const fs::path& dir, const WriteOptions&
       << "      <diffuse>0.9 0.9 0.85 1</diffuse>\n      <specular>0.2 0.2 0.2 1</specular>\n"
       << "      <direction>-0.3 0.4 -0.85</direction>\n    </light>\n"
       << "    <model name='road'>\n      <static>true</static>\n      <link name='link'>\n"
-      << "        <collision name='ground'><pose>" << num(cx) << " " << num(cy)
-      << " 0 0 0 0</pose><geometry><plane><normal>0 0 1</normal><size>" << num(sx) << " "
+      << "        <collision name='ground'><pose>" << num(cx) << " " << num(cy) << " "
+      << num(plan.plane_z) << " 0 0 0</pose><geometry><plane><normal>0 0 1</normal><size>" << num(sx) << " "
       << num(sy) << "</size></plane></geometry></collision>\n"
-      << "        <visual name='road'><geometry><mesh><uri>meshes/road.obj</uri></mesh></geometry></visual>\n"
-      << "        <visual name='ground'><geometry><mesh><uri>meshes/ground.obj</uri></mesh></geometry></visual>\n"
-      << "      </link>\n    </model>\n";
-  for (const MeshModel& m : plan.models) write_mesh_model(out, m, dir);
-  for (const Placement& p : plan.placements) write_placement(out, p);
+      << "        <visual name='ground'><geometry><mesh><uri>meshes/ground.obj</uri></mesh></geometry></visual>\n";
+  for (const std::string& t : road_tiles) {
+    out << "        <visual name='" << t << "'><geometry><mesh><uri>meshes/" << t
+        << ".obj</uri></mesh></geometry></visual>\n";
+  }
+  out << "      </link>\n    </model>\n";
+  // The road's surface where it is not flat: in pieces of kBoxesPerModel boxes, so that the
+  // world engine keeps the pieces no vehicle is near out of collision detection. No visual:
+  // the cameras see the road model, and ground truth leaves these out as ground.
+  constexpr size_t kBoxesPerModel = 8;
+  for (size_t first = 0; first < plan.road_boxes.size(); first += kBoxesPerModel) {
+    out << "    <model name='road_surface_" << first / kBoxesPerModel
+        << "'>\n      <static>true</static>\n      <link name='link'>\n";
+    for (size_t k = first; k < std::min(first + kBoxesPerModel, plan.road_boxes.size()); ++k) {
+      const BoxCollision& c = plan.road_boxes[k];
+      out << "        <collision name='s" << k - first << "'><pose>" << num(c.centre[0]) << " "
+          << num(c.centre[1]) << " " << num(c.centre[2]) << " " << num(c.roll) << " "
+          << num(c.pitch) << " " << num(c.yaw) << "</pose><geometry><box><size>" << num(c.size[0])
+          << " " << num(c.size[1]) << " " << num(c.size[2]) << "</size></box></geometry></collision>\n";
+    }
+    out << "      </link>\n    </model>\n";
+  }
+  Names names;
+  for (const MeshModel& m : plan.models) write_mesh_model(out, m, names(m.name), dir);
+  for (const Placement& p : plan.placements) write_placement(out, p, names(p.name));
   out << "  </world>\n</sdf>\n";
   std::ofstream f(dir / "world.sdf");
   f << out.str();

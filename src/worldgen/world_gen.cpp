@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "opendrive/road_mesh.h"
 #include "opendrive/sampling.h"
@@ -10,6 +11,7 @@
 #include "worldgen/objects.h"
 #include "worldgen/sdf_writer.h"
 #include "worldgen/signals.h"
+#include "worldgen/terrain.h"
 
 namespace convoy::worldgen {
 namespace {
@@ -33,6 +35,27 @@ void mark_placed(const WorldPlan& plan, Occupancy& occ) {
   }
 }
 
+// Lanes that have no width anywhere in their section: drawn as nothing, said once.
+void warn_zero_width(const odr::Network& net, WorldPlan& plan) {
+  for (const odr::Road& road : net.roads) {
+    for (size_t k = 0; k < road.sections.size(); ++k) {
+      const odr::LaneSection& sec = road.sections[k];
+      for (const odr::Lane& lane : sec.lanes) {
+        if (lane.id == 0 || lane.type == "none") continue;
+        double widest = 0;
+        for (int i = 0; i <= 8; ++i) {
+          const double s = sec.s + (sec.s_end - sec.s) * i / 8;
+          widest = std::max(widest, std::abs(road.lane_width(k, lane.id, s)));
+        }
+        if (widest < 1e-6) {
+          plan.warn("road " + road.id + " lane section " + std::to_string(k) + " lane " +
+                    std::to_string(lane.id) + " (" + lane.type + "): width 0; not drawn");
+        }
+      }
+    }
+  }
+}
+
 std::string scenery_name(Scenery s) {
   return s == Scenery::kUrban ? "urban" : s == Scenery::kRoadside ? "roadside" : "none";
 }
@@ -46,6 +69,7 @@ WorldStats generate_world(const odr::Network& net, const Catalog& catalog,
   odr::MeshOptions mesh;
   mesh.lane_materials = true;
   plan.road.add_road_mesh(odr::build_road_mesh(net, mesh));
+  warn_zero_width(net, plan);
   place_signals(net, catalog, plan);
   const size_t signals = plan.placements.size();
   place_objects(net, catalog, plan);
@@ -59,6 +83,12 @@ WorldStats generate_world(const odr::Network& net, const Catalog& catalog,
   GroundOptions ground;
   ground.urban = options.scenery == Scenery::kUrban;
   plan.ground_z = build_ground(plan.bounds, ground, options.seed, plan.ground);
+  if (!is_flat(net)) add_embankments(net, plan.ground_z, plan.road);
+  if (!is_flat(net) && options.surface_boxes) {
+    // the road's own surface carries the traffic; the plane catches what leaves it
+    plan.road_boxes = road_collision_boxes(net);
+    plan.plane_z = plan.ground_z;
+  }
 
   WorldStats stats;
   stats.triangles = plan.road.triangle_count() + plan.ground.triangle_count();

@@ -21,11 +21,13 @@ struct Placement {
   std::string signal_id;  // lights: the OpenDRIVE signal whose state they show
 };
 
-// A static box collision in world coordinates.
+// A static box collision in world coordinates (SDF's roll, pitch, yaw).
 struct BoxCollision {
   Vec3 centre{};
   Vec3 size{};
   double yaw = 0;
+  double roll = 0;
+  double pitch = 0;
 };
 
 // A model made of the generator's own geometry: one ground-truth instance of `cls`.
@@ -40,6 +42,8 @@ struct WorldPlan {
   MeshSet road;    // surfaces, marks, stop lines, crosswalks, parking bays, embankments
   MeshSet ground;  // the ground plane and the horizon
   double ground_z = 0;
+  double plane_z = 0;                     // the collision plane under everything
+  std::vector<BoxCollision> road_boxes;   // the road surface where it is not flat
   opendrive::Bounds bounds;  // of the roads
   std::vector<MeshModel> models;
   std::vector<Placement> placements;

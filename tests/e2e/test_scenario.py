@@ -225,12 +225,16 @@ class BadInput(ScenarioCase):
         self.assertNotIn("Traceback", err)
         self.assertEqual(self.scan_engine_processes(), [])
 
-    def test_unknown_map(self):
-        code, out, err = self.run_scenario(os.path.join(FIXTURES, "cut_in.xosc"))
-        self.assertEqual(code, 2)
-        self.assertIn("no world for the map", err)
-        self.assertIn("straight.xodr", err)
-        self.assertIn("--world", err)
+    def test_a_map_without_world_runs_on_a_generated_one(self):
+        os.environ["CONVOY_CACHE_DIR"] = os.path.join(self.dir, "cache")
+        try:
+            code, out, err = self.run_scenario(os.path.join(FIXTURES, "cut_in.xosc"), "-o", "SimulationTimeout=1")
+        finally:
+            del os.environ["CONVOY_CACHE_DIR"]
+        self.assertEqual(code, 0, err)
+        self.assertIn("generated from straight.xodr", err)
+        self.assertIn(os.path.join(self.dir, "cache", "worlds", "straight-"), err)
+        self.assertGreater(self.summary()["cycles"], 10)
         code, out, err = self.run_scenario(os.path.join(self.dir, "missing.xosc"))
         self.assertEqual(code, 2)
         self.assertIn("missing.xosc: no such file", err)

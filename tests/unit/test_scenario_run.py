@@ -6,6 +6,7 @@ the live score against score_drive, the campaign's .xosc entry type, the suite's
 Run: cd tests/unit && PYTHONPATH=../../python /usr/bin/python3 -m unittest -v test_scenario_run
 (convoy-odr from $CONVOY_BIN_DIR or build/bin; tests needing it are skipped without it)."""
 
+import contextlib
 import copy
 import json
 import math
@@ -44,6 +45,20 @@ def have_odr():
         return True
     except ScenarioError:
         return False
+
+
+@contextlib.contextmanager
+def cache_dir(path):
+    """$CONVOY_CACHE_DIR set to `path` within the block."""
+    old = os.environ.get("CONVOY_CACHE_DIR")
+    os.environ["CONVOY_CACHE_DIR"] = path
+    try:
+        yield
+    finally:
+        if old is None:
+            del os.environ["CONVOY_CACHE_DIR"]
+        else:
+            os.environ["CONVOY_CACHE_DIR"] = old
 
 
 def kinematic_world(t, states):
@@ -150,14 +165,32 @@ class MakeConfigTest(unittest.TestCase):
             cfg, drive, length = make_config.build(os.path.join(SUITE, f))
             self.assertGreater(length, 50.0, f)
 
-    def test_unknown_map(self):
-        with self.assertRaises(ScenarioError) as e:
-            make_config.build(os.path.join(FIXTURES, "cut_in.xosc"))
-        msg = str(e.exception)
-        self.assertIn("cut_in.xosc: no world for the map", msg)
-        self.assertIn("straight.xodr", msg)
-        self.assertIn("experiments/city_traffic/city.xodr", msg)
-        self.assertIn("--world", msg)
+    def test_a_map_without_world_gets_one_generated_and_cached(self):
+        cache = os.path.join(self.tmp, "cache")
+        with cache_dir(cache):
+            cfg = make_config.build(os.path.join(FIXTURES, "cut_in.xosc"))[0]
+            world = cfg["EngineConfigs"][0]["GazeboWorldFile"]
+            self.assertTrue(world.startswith(os.path.join(cache, "worlds", "straight-")), world)
+            self.assertTrue(os.path.exists(world))
+            again = make_config.build(os.path.join(FIXTURES, "cut_in.xosc"))[0]
+            self.assertEqual(again["EngineConfigs"][0]["GazeboWorldFile"], world)   # the cached one
+            # the map's bytes name the entry: another map, another world
+            self.assertEqual(len(os.listdir(os.path.join(cache, "worlds"))), 1)
+
+    def test_a_map_that_cannot_be_parsed_leaves_no_world(self):
+        cache = os.path.join(self.tmp, "cache_bad")
+        bad = os.path.join(self.tmp, "bad_map.xosc")
+        with open(os.path.join(FIXTURES, "cut_in.xosc")) as f:
+            text = f.read().replace("straight.xodr", os.path.join(REPO, "tests", "opendrive", "data",
+                                                                  "malformed.xodr"))
+        with open(bad, "w") as f:
+            f.write(text)
+        with cache_dir(cache):
+            with self.assertRaises(ScenarioError) as e:
+                make_config.build(bad)
+        self.assertIn("malformed.xodr:", str(e.exception))
+        worlds = os.path.join(cache, "worlds")
+        self.assertEqual(os.listdir(worlds) if os.path.exists(worlds) else [], [])
 
     def test_cli_errors(self):
         err = os.path.join(self.tmp, "err.txt")

@@ -1,6 +1,7 @@
-"""Small procedural-mesh toolkit for the road-user generators (make_road_users.py): triangles
-in named parts (OBJ groups) with a material each, crease-angle normals, lofts, and an OBJ +
-MTL writer with shared vertices and normals. Stdlib only; output deterministic."""
+"""Small procedural-mesh toolkit for the asset generators (make_road_users.py, make_scenery.py):
+triangles in named parts (OBJ groups) with a material each, optional texture coordinates,
+crease-angle normals, lofts, and an OBJ + MTL writer with shared vertices, normals and texture
+coordinates. Stdlib only; output deterministic."""
 import math
 import os
 
@@ -88,6 +89,7 @@ class Mesh:
 
     def __init__(self):
         self.tris = []  # (part, material, set, (a, b, c))
+        self.uvs = {}  # index in tris: (uv a, uv b, uv c), for the textured triangles only
         self.part, self.material, self.set = "body", "default", 0
         self.crease = {}
 
@@ -128,6 +130,18 @@ class Mesh:
         """A convex polygon as a fan (counter-clockwise seen from the front)."""
         for i in range(1, len(pts) - 1):
             self.tri(pts[0], pts[i], pts[i + 1])
+
+    # -- textured triangles (uv: (u, v), v = 0 at the bottom of the image, as in OBJ)
+    def tri_uv(self, a, b, c, ta, tb, tc):
+        n = len(self.tris)
+        self.tri(a, b, c)
+        if len(self.tris) > n:
+            self.uvs[n] = (tuple(ta), tuple(tb), tuple(tc))
+
+    def poly_uv(self, pts, uvs):
+        """A textured convex polygon as a fan; uvs: one (u, v) per point."""
+        for i in range(1, len(pts) - 1):
+            self.tri_uv(pts[0], pts[i], pts[i + 1], uvs[0], uvs[i], uvs[i + 1])
 
     # -- transforms of what was added since `mark`
     def mark(self):
@@ -209,6 +223,58 @@ class Mesh:
         for a, b, cc, d in q:
             self.quad(corners[a], corners[b], corners[cc], corners[d])
 
+    def block(self, lo, hi, skip=()):
+        """An axis-aligned box from corner lo to corner hi, leaving out the faces named in
+        `skip` ("-x", "+x", "-y", "+y", "-z", "+z"): those that stand against something."""
+        (x0, y0, z0), (x1, y1, z1) = lo, hi
+        faces = {"-z": ((x0, y0, z0), (x0, y1, z0), (x1, y1, z0), (x1, y0, z0)),
+                 "+z": ((x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)),
+                 "-y": ((x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1)),
+                 "+y": ((x1, y1, z0), (x0, y1, z0), (x0, y1, z1), (x1, y1, z1)),
+                 "-x": ((x0, y1, z0), (x0, y0, z0), (x0, y0, z1), (x0, y1, z1)),
+                 "+x": ((x1, y0, z0), (x1, y1, z0), (x1, y1, z1), (x1, y0, z1))}
+        for name in ("-z", "+z", "-y", "+y", "-x", "+x"):
+            if name not in skip:
+                self.quad(*faces[name])
+
+    def cone(self, base, apex, r, n=8, cap=True):
+        """A cone from a disc of radius r about `base` to `apex`, n sides, optionally closed below."""
+        f = frame_along(sub(apex, base))
+        ring = [add(base, mat_vec(f, (r * math.cos(2 * math.pi * i / n), r * math.sin(2 * math.pi * i / n), 0)))
+                for i in range(n)]
+        for i in range(n):
+            self.tri(ring[i], ring[(i + 1) % n], apex)
+        if cap:
+            self.poly(list(reversed(ring)))
+
+    def sweep(self, outline, offset, cap_start=False, cap_end=False):
+        """A prism: the closed outline (points) moved by `offset`. Outward normals when the
+        outline runs counter-clockwise about `offset`; caps only for convex outlines."""
+        self.loft([list(outline), [add(p, offset) for p in outline]], cap_start=cap_start, cap_end=cap_end)
+
+    def lumpy_ellipsoid(self, c, r, rng, lumps=0.15, stacks=5, slices=8, zcut=None):
+        """An ellipsoid whose radius varies smoothly with direction by up to about `lumps`
+        (a fraction): a leaf cluster, a shrub. rng (random.Random) draws the lumps."""
+        waves = [(norm((rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1))), rng.uniform(2.0, 3.5),
+                  rng.uniform(0, 2 * math.pi)) for _ in range(3)]
+        twist = rng.uniform(0, 2 * math.pi)
+        lo = -math.pi / 2 if zcut is None else math.asin(max(-1.0, min(1.0, zcut)))
+        rings = []
+        for i in range(stacks + 1):
+            phi = lo + (math.pi / 2 - lo) * i / stacks
+            ring = []
+            for j in range(slices):
+                t = twist + 2 * math.pi * (j + 0.5 * (i % 2)) / slices
+                d = (math.cos(phi) * math.cos(t), math.cos(phi) * math.sin(t), math.sin(phi))
+                if abs(d[2]) > 0.9999:
+                    d = (0.0, 0.0, 1.0 if d[2] > 0 else -1.0)
+                k = 1 + lumps / 1.6 * sum(math.sin(f * dot(d, w) + ph) for w, f, ph in waves)
+                ring.append(add(c, (r[0] * d[0] * k, r[1] * d[1] * k, r[2] * d[2] * k)))
+            rings.append(ring)
+        self.loft(rings)
+        if zcut is not None:
+            self.poly(list(reversed(rings[0])))
+
     # -- output
     def count(self, select=None):
         return sum(1 for t in self.tris if select is None or select(t[0], t[1]))
@@ -267,13 +333,15 @@ class Mesh:
         OBJ) that the OBJ references. Returns the number of triangles written."""
         ns = self.normals()
         vidx, nidx, vs, vns = {}, {}, [], []
+        tidx, vts = {}, []
         groups = {}
         order = []
         for i, (part, mat, _, t) in enumerate(self.tris):
             if select is not None and not select(part, mat):
                 continue
             face = []
-            for v, n in zip(t, ns[i]):
+            uv = self.uvs.get(i)
+            for corner, (v, n) in enumerate(zip(t, ns[i])):
                 kv = "%.4f %.4f %.4f" % v
                 kn = "%.3f %.3f %.3f" % n
                 if kv not in vidx:
@@ -282,7 +350,14 @@ class Mesh:
                 if kn not in nidx:
                     nidx[kn] = len(vns) + 1
                     vns.append(kn)
-                face.append("%d//%d" % (vidx[kv], nidx[kn]))
+                if uv is None:
+                    face.append("%d//%d" % (vidx[kv], nidx[kn]))
+                else:
+                    kt = "%.4f %.4f" % uv[corner]
+                    if kt not in tidx:
+                        tidx[kt] = len(vts) + 1
+                        vts.append(kt)
+                    face.append("%d/%d/%d" % (vidx[kv], tidx[kt], nidx[kn]))
             k = (part, mat)
             if k not in groups:
                 groups[k] = []
@@ -293,7 +368,7 @@ class Mesh:
         if materials is not None:
             mtl = (mtl_name or base) + ".mtl"
             lines.append("mtllib " + mtl)
-        lines += ["v " + v for v in vs] + ["vn " + n for n in vns]
+        lines += ["v " + v for v in vs] + ["vt " + t for t in vts] + ["vn " + n for n in vns]
         for part, mat in order:
             lines.append("g %s" % part)
             if materials is not None:
@@ -309,7 +384,8 @@ class Mesh:
 
 
 def write_mtl(path, materials, header=""):
-    """materials: {name: {"kd": rgb, "ks": rgb (optional), "ns": float, "ke": rgb (optional)}}."""
+    """materials: {name: {"kd": rgb, "ks": rgb (optional), "ns": float, "ke": rgb (optional),
+    "map": diffuse texture file relative to the MTL (optional)}}."""
     lines = ["# " + line for line in header.splitlines()]
     for name in sorted(materials):
         m = materials[name]
@@ -321,6 +397,8 @@ def write_mtl(path, materials, header=""):
         lines.append("Ns %g" % m.get("ns", 16))
         if "ke" in m:
             lines.append("Ke %.3f %.3f %.3f" % tuple(m["ke"]))
+        if "map" in m:
+            lines.append("map_Kd %s" % m["map"])
         lines.append("")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")

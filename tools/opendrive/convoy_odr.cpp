@@ -46,6 +46,7 @@ namespace fs = std::filesystem;
 
 int world_command(const std::vector<std::string>& positional,
                   const std::map<std::string, std::string>& options);  // world_command.cpp
+nlohmann::json stop_lines_json(const odr::LaneGraph& g);              // query_signals.cpp
 
 namespace {
 
@@ -391,7 +392,7 @@ int cmd_route(const Args& args) {
 //
 // Requests (one JSON object a line) and replies ({"ok": true, ...} or {"ok": false, "error"}):
 //   {"op": "pose", "road", "lane", "s", "offset"}      -> x, y, heading (driving direction)
-//   {"op": "locate", "x", "y"[, "yaw"][, "max_distance"]} -> road, lane, s, t, road_t, heading,
+//   {"op": "locate", "x", "y"[, "yaw"][, "max_distance"]} -> road, lane, s, t, road_t, z, heading,
 //                                                         distance, type, junction (or "found":
 //                                                         false)
 //   {"op": "follow", "road", "lane", "s", "length"[, "ds"]}
@@ -402,6 +403,8 @@ int cmd_route(const Args& args) {
 //   {"op": "route", "from": [road, lane, s], "to": [road, lane, s][, "ds"]}
 //        -> points, length: the shortest route between two lane positions
 //   {"op": "info"} -> roads [{"id", "length", "junction"}], signals (traffic lights' ids)
+//   {"op": "stop_lines"} -> stop_lines [{"id", "road", "x", "y", "heading", "t_min", "t_max",
+//                        "entry_x", "entry_y"}] (query_signals.cpp)
 nlohmann::json points_json(const std::vector<odr::Pose2>& pts) {
   nlohmann::json out = nlohmann::json::array();
   for (const odr::Pose2& p : pts) out.push_back({p.x, p.y, p.heading});
@@ -490,6 +493,7 @@ nlohmann::json query_one(const odr::LaneGraph& g, const nlohmann::json& q) {
             {"s", p->s},
             {"t", p->t},
             {"road_t", p->road_t},
+            {"z", g.network().road(p->road_id).surface_z(p->s, p->road_t)},
             {"heading", p->heading},
             {"distance", p->distance},
             {"type", n.type},
@@ -517,7 +521,8 @@ nlohmann::json query_one(const odr::LaneGraph& g, const nlohmann::json& q) {
       if (s.traffic_light) signals.push_back(s.signal->id);
     return {{"roads", roads}, {"signals", signals}};
   }
-  throw std::runtime_error("unknown op '" + op + "' (pose, locate, follow, route, info)");
+  if (op == "stop_lines") return {{"stop_lines", stop_lines_json(g)}};
+  throw std::runtime_error("unknown op '" + op + "' (pose, locate, follow, route, info, stop_lines)");
 }
 
 int cmd_query(const Args& args) {

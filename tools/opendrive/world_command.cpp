@@ -39,7 +39,9 @@ int world_command(const std::vector<std::string>& positional,
   odr::Network net;
   wg::Catalog catalog;
   try {
-    net = odr::load(positional[0]);
+    odr::LoadOptions lenient;
+    lenient.skip_bad_roads = true;
+    net = odr::load(positional[0], lenient);
     catalog = wg::Catalog::load(catalog_file);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "convoy-odr world: %s\n", e.what());
