@@ -193,7 +193,7 @@ void CameraSensors::build_scene(const WorldDesc& desc) {
           {model_id, physics_.link_index(model.links.front().name), -1, vehicle_extent(model)});
     for (const auto& link : model.links) {
       Tracked tracked{physics_.link_index(link.name), {}, {}};
-      add_visuals(link, link.pose, label, &tracked);
+      add_visuals(link, link.pose, label, &tracked, /*world=*/true);
       if (!model.is_static && !tracked.instances.empty()) tracked_.push_back(std::move(tracked));
     }
   }
@@ -222,7 +222,7 @@ const std::vector<CameraSensors::FilePart>& CameraSensors::file_mesh(const std::
 }
 
 void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& placement,
-                                uint32_t label, Tracked* tracked) {
+                                uint32_t label, Tracked* tracked, bool world) {
   for (const auto& v : link.visuals) {
     std::vector<std::pair<int, render::Material>> parts;  // Scene mesh, material
     auto one = [this](render::MeshData m) {
@@ -273,13 +273,20 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
       int texture = scene_.add_texture_file(v.material.texture.string());
       for (auto& p : parts) p.second.texture = texture;
     }
+    std::vector<int>* named = world ? &visual_instances_[{link.name, v.name}] : nullptr;
     for (auto& [mesh_index, mat] : parts) {
-      render::Pose world = to_pose(placement * offset);
-      int inst = scene_.add_instance(mesh_index, mat, world, label, label);
+      int inst = scene_.add_instance(mesh_index, mat, to_pose(placement * offset), label, label);
       tracked->instances.push_back(inst);
       tracked->offsets.push_back(to_pose(offset));
+      if (named) named->push_back(inst);
     }
   }
+}
+
+std::vector<int> CameraSensors::visual_instances(const std::string& link,
+                                                 const std::string& visual) const {
+  auto it = visual_instances_.find({link, visual});
+  return it == visual_instances_.end() ? std::vector<int>{} : it->second;
 }
 
 int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls,

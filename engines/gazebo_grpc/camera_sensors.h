@@ -51,6 +51,15 @@ class CameraSensors {
   void set_actor_visible(int actor, bool visible);
   void set_actor_shown(int actor, int pose);
 
+  // The scene instances that draw visual `visual` of link `link` (scoped: model::link) of a
+  // world model, in the order added (a mesh file's parts each have one); empty for an
+  // unknown visual or a world without cameras. For systems that change a visual's look.
+  std::vector<int> visual_instances(const std::string& link, const std::string& visual) const;
+  const render::Material& material(int instance) const {
+    return scene_.instances()[instance].material;
+  }
+  void set_material(int instance, const render::Material& m) { scene_.set_material(instance, m); }
+
   // The weather from now on (see weather_effects.h): the sun, the sky, fog, wet or snowy
   // ground, rain or snow over the image, and at night the vehicles' headlights and the street
   // lights (the world's point and spot lights named street_light* or lamp*), which are off by
@@ -133,9 +142,10 @@ class CameraSensors {
   // The scene's lights, sky and atmosphere for camera `cam` under weather_.
   void apply_weather(const Camera& cam, const Eigen::Isometry3d& camera_pose);
   // Adds the scene instances of a link's visuals, the link placed at `placement`, labelled
-  // `label` (0: no ground truth), into `tracked`.
+  // `label` (0: no ground truth), into `tracked`; a world model's (`world`) also into
+  // visual_instances_.
   void add_visuals(const LinkDesc& link, const Eigen::Isometry3d& placement, uint32_t label,
-                   Tracked* tracked);
+                   Tracked* tracked, bool world = false);
   void render(Camera& cam);
   void first_render(Camera& cam);  // on the first request: render now, schedule the next
   void draw_noise(Camera& cam);
@@ -149,7 +159,9 @@ class CameraSensors {
   std::vector<Tracked> tracked_;
   std::vector<Actor> actors_;
   std::map<std::string, std::vector<FilePart>> file_meshes_;  // by path and scale
-  std::vector<std::string> model_names_, model_classes_;      // by model_id - 1
+  std::map<std::pair<std::string, std::string>, std::vector<int>>
+      visual_instances_;                                  // (link, visual) -> scene instances
+  std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
   std::mt19937_64 rng_;
   double now_ = 0;
   std::vector<render::Light> base_lights_;

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '4'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '5'};  // bump on format change
 
 // --- Binary writer and reader -------------------------------------------------------------
 
@@ -237,6 +237,16 @@ void put(Writer& w, const ModelDesc& m) {
       w.pod(k.max_torque);
     }
   }
+  w.size(m.signals.size());
+  for (const auto& s : m.signals) {
+    w.str(s.id);
+    w.size(s.lamps.size());
+    for (const auto& l : s.lamps) {
+      w.str(l.colour);
+      w.str(l.link);
+      w.str(l.visual);
+    }
+  }
 }
 void get(Reader& r, ModelDesc& m) {
   m.name = r.str();
@@ -284,6 +294,16 @@ void get(Reader& r, ModelDesc& m) {
     for (auto& k : b.brakes) {
       k.joint = r.str();
       k.max_torque = r.pod<double>();
+    }
+  }
+  m.signals.resize(r.size());
+  for (auto& s : m.signals) {
+    s.id = r.str();
+    s.lamps.resize(r.size());
+    for (auto& l : s.lamps) {
+      l.colour = r.str();
+      l.link = r.str();
+      l.visual = r.str();
     }
   }
 }

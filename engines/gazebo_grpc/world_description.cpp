@@ -191,6 +191,36 @@ class Loader {
     return a ? a->GetAsString() : "";
   }
 
+  // A convoy_signal plugin: its signal id and lamps, each a visual of the model.
+  SignalDesc signal(const sdf::ElementPtr& p, const std::string& where, const ModelDesc& model) {
+    auto fail = [&](const std::string& what) {
+      throw std::runtime_error(file_.string() + ": " + where + ": " + what);
+    };
+    SignalDesc s;
+    for (auto e = p->GetFirstElement(); e; e = e->GetNextElement()) {
+      const std::string text = e->GetValue() ? e->GetValue()->GetAsString() : "";
+      if (e->GetName() == "signal") {
+        s.id = text;
+      } else if (e->GetName() == "lamp") {
+        LampDesc lamp;
+        lamp.colour = attr(e, "colour");
+        lamp.visual = text;
+        if (lamp.colour != "red" && lamp.colour != "yellow" && lamp.colour != "green")
+          fail("<lamp> '" + text + "': colour '" + lamp.colour +
+               "' is not one of red, yellow, green");
+        for (const auto& other : s.lamps)
+          if (other.colour == lamp.colour) fail("two " + lamp.colour + " lamps");
+        for (const auto& link : model.links)
+          for (const auto& v : link.visuals)
+            if (lamp.link.empty() && v.name == lamp.visual) lamp.link = link.name;
+        if (lamp.link.empty()) fail("<lamp> '" + text + "' is no visual of the model's links");
+        s.lamps.push_back(lamp);
+      }
+    }
+    if (s.id.empty()) fail("no <signal> id");
+    return s;
+  }
+
   void plugins(const sdf::ElementPtr& elem, const std::string& model_name, ModelDesc* model) {
     if (!elem->HasElement("plugin")) return;
     for (auto p = elem->GetElement("plugin"); p; p = p->GetNextElement("plugin")) {
@@ -285,6 +315,8 @@ class Loader {
                                    "' is not one of " + all);
         }
         model->cls = cls;
+      } else if (filename == "convoy_signal") {
+        model->signals.push_back(signal(p, where, *model));
       } else if (filename.find("LinkController") != std::string::npos ||
                  filename.find("LinkPlugin") != std::string::npos) {
         model->link_plugins.push_back(name);

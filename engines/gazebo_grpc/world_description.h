@@ -108,6 +108,22 @@ struct BrakePluginDesc {
   std::vector<BrakeDesc> brakes;
 };
 
+// A signal's lamps (Convoy's own plugin; convoy-odr world writes it into traffic lights):
+//   <plugin name="convoy_signal" filename="convoy_signal"><signal>SIGNAL_ID</signal>
+//     <lamp colour="red">lamp_red</lamp> <lamp colour="yellow">...</lamp> ...</plugin>
+// SIGNAL_ID is the OpenDRIVE signal's id (a key of the traffic_lights engine's `signals`);
+// each lamp names a visual of one of the model's links and its colour: red, yellow or green
+// (a pedestrian light has red and green). Other elements of the plugin are ignored.
+struct LampDesc {
+  std::string colour;  // red, yellow or green
+  std::string link;    // the scoped name of the link that has the visual
+  std::string visual;  // the visual's name
+};
+struct SignalDesc {
+  std::string id;
+  std::vector<LampDesc> lamps;
+};
+
 struct ModelDesc {
   std::string name;
   // Ground-truth class, from the model's annotation
@@ -121,6 +137,7 @@ struct ModelDesc {
   std::vector<std::pair<std::string, std::vector<PidDesc>>> joint_plugins;  // plugin name
   std::vector<std::string> link_plugins;                                    // plugin names
   std::vector<BrakePluginDesc> brake_plugins;
+  std::vector<SignalDesc> signals;  // convoy_signal plugins
 };
 
 struct LightDesc {

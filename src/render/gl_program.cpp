@@ -162,6 +162,10 @@ uniform bool u_double_sided;
 #ifdef TEXTURED
 in vec2 v_uv;
 uniform sampler2D u_texture;
+uniform float u_textured_emissive;  // 1: the texture multiplies the emissive colour too
+#ifdef PER_VERTEX
+uniform vec4 u_emissive;
+#endif
 #endif
 #ifdef FOG
 uniform float u_fog_k;  // 3.912 / visibility
@@ -191,6 +195,7 @@ void main() {
 #ifdef PER_VERTEX
 #ifdef TEXTURED
   vec3 color = v_color * tex + v_added;
+  color += u_textured_emissive * u_emissive.rgb * (tex - 1.0);  // (0 unless asked: unchanged)
 #else
   vec3 color = v_color;
 #endif
@@ -201,6 +206,9 @@ void main() {
   vec3 p = v_position;
   LIGHT_CALLS
   color += g_diffuse * u_diffuse.rgb * tex + g_specular * u_specular.rgb;
+#ifdef TEXTURED
+  color += u_textured_emissive * u_emissive.rgb * (tex - 1.0);
+#endif
 #ifdef SURFACE_WEATHER
   float up = dot(n, u_up);
   if (up > 0.6) {
@@ -319,6 +327,7 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
   p.ambient = at("u_ambient");
   p.specular = at("u_specular");
   p.emissive = at("u_emissive");
+  p.textured_emissive = at("u_textured_emissive");
   p.shininess = at("u_shininess");
   p.double_sided = at("u_double_sided");
   p.scene_ambient = at("u_scene_ambient");

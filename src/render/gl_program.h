@@ -38,6 +38,7 @@ struct SurfaceProgram {
   // Per draw.
   GLint model_view = -1, normal_matrix = -1, instance_id = -1;
   GLint diffuse = -1, ambient = -1, specular = -1, emissive = -1, shininess = -1;
+  GLint textured_emissive = -1;
   GLint double_sided = -1;
   // Per frame.
   GLint projection = -1, scene_ambient = -1;

@@ -331,6 +331,7 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
       glUniform4fv(p.ambient, 1, m.ambient.data());
       glUniform4fv(p.specular, 1, m.specular.data());
       glUniform4fv(p.emissive, 1, m.emissive.data());
+      if (p.textured_emissive >= 0) glUniform1f(p.textured_emissive, m.textured_emissive);
       glUniform1f(p.shininess, std::max(m.shininess, 1e-3f));
       glUniform1i(p.double_sided, m.double_sided);
       last = &m;

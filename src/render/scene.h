@@ -1,10 +1,10 @@
 // What a camera sees: meshes, textures, materials, lights and posed instances.
 //
 // A Scene is the renderer's input. Meshes and textures are added once and never change (the
-// Renderer uploads each to the GPU the first time it renders the Scene); instance poses and
-// visibility change every step. Defaults are SDF 1.6's (<scene>, <light>, <material>
-// specular), except that a Material is mid grey, as Gazebo draws a visual without one.
-// Colours are linear RGBA in [0, 1].
+// Renderer uploads each to the GPU the first time it renders the Scene); instance poses,
+// visibility and materials may change every step. Defaults are SDF 1.6's (<scene>, <light>,
+// <material> specular), except that a Material is mid grey, as Gazebo draws a visual without
+// one. Colours are linear RGBA in [0, 1].
 //
 //   Scene scene;
 //   int box = scene.add_mesh(make_box(1, 1, 1));
@@ -36,6 +36,7 @@ struct Material {
   Rgba ambient{0.7f, 0.7f, 0.7f, 1.0f};   // multiplied by the scene's ambient light
   Rgba specular{0.0f, 0.0f, 0.0f, 1.0f};  // SDF's default: no highlights
   Rgba emissive{0.0f, 0.0f, 0.0f, 0.0f};  // added as is
+  bool textured_emissive = false;         // the texture multiplies emissive too (a lit picture)
   float shininess = 32.0f;                // Blinn-Phong exponent
   int texture = -1;           // Scene::add_texture index; it multiplies diffuse and ambient
   bool double_sided = false;  // draw back faces too (lit with the flipped normal)

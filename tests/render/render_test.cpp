@@ -460,6 +460,60 @@ TEST(RenderTest, TextureAppearsUpright) {
   expect_colour(-0.25, -0.25, {255, 255, 255}, "bottom right");
 }
 
+// Scene::set_material changes how an instance looks from the next frame (the world engine's
+// traffic lights switch their lamps so), and a textured emissive colour glows through the
+// texture: a lit picture, dark where the texture is dark.
+TEST(RenderTest, AnInstancesMaterialChangesAndItsEmissiveCanBeTextured) {
+  GET_RENDERER(renderer);
+  // 2x2 texture, rows top first: white black / black white.
+  const uint8_t texels[16] = {255, 255, 255, 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255, 255};
+  Scene scene;
+  scene.set_ambient({0, 0, 0, 1});
+  scene.set_background({0, 0, 0, 1});
+  Material dark = plain(0.05f, 0.05f, 0.05f);
+  dark.texture = scene.add_texture(texels, 2, 2);
+  const Pose facing = {0, -1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 0, 2, 0, 0, 1};
+  const int lamp = scene.add_instance(scene.add_mesh(make_plane(1, 1)), dark, facing);
+  const CameraSpec spec{200, 200, 1.0, 0.1, 10};
+  auto red_at = [&](const Frame& f, double y, double z) {
+    const auto p = project(spec, 2, y, z);
+    return int(f.rgb[3 * (int(p[1]) * spec.width + int(p[0]))]);
+  };
+  Frame before, lit, pictured;
+  renderer->render(scene, identity_pose(), spec, &before);
+  EXPECT_LT(red_at(before, 0.25, 0.25), 20);  // no light: dark
+  Material glowing = dark;
+  glowing.emissive = {1, 0.1f, 0.05f, 1};
+  scene.set_material(lamp, glowing);
+  renderer->render(scene, identity_pose(), spec, &lit);
+  EXPECT_EQ(red_at(lit, 0.25, 0.25), 255);  // emissive as is: over white and black texels
+  EXPECT_EQ(red_at(lit, -0.25, 0.25), 255);
+  glowing.textured_emissive = true;
+  scene.set_material(lamp, glowing);
+  renderer->render(scene, identity_pose(), spec, &pictured);
+  EXPECT_GT(red_at(pictured, 0.25, 0.25), 240);  // the white texel glows
+  EXPECT_LT(red_at(pictured, -0.25, 0.25), 20);  // the black one stays dark
+  // Lit per vertex (far away, small on screen) the same.
+  Scene far;
+  far.set_ambient({0, 0, 0, 1});
+  far.set_background({0, 0, 0, 1});
+  far.add_light(Light{});
+  Material m = glowing;
+  m.texture = far.add_texture(texels, 2, 2);
+  const Pose away = {0, -1, 0, 0, 0, 0, 1, 0, -1, 0, 0, 0, 40, 0, 0, 1};
+  far.add_instance(far.add_mesh(make_sphere(4.0f, 16, 32)), m, away);
+  Frame small;
+  renderer->render(far, identity_pose(), CameraSpec{200, 200, 1.0, 0.1, 100}, &small);
+  EXPECT_GT(renderer->last_stats().per_vertex_lit, 0);
+  int bright = 0, dim = 0;
+  for (size_t i = 0; i < small.rgb.size(); i += 3) {
+    if (small.rgb[i] > 200) ++bright;
+    if (small.rgb[i] > 0 && small.rgb[i] < 60) ++dim;
+  }
+  EXPECT_GT(bright, 20);
+  EXPECT_GT(dim, 20);
+}
+
 TEST(RenderTest, PerVertexLightingLooksLikePerPixel) {
   GET_RENDERER(renderer);
   // Finely tessellated spheres far enough away that their triangles cover a pixel or two.

@@ -1,0 +1,77 @@
+// Road users as actors of the world (docs/road_users.md; the model library: actors.h).
+//
+// Config keys: ActorTimeout (s, default 1; 0: never), ActorModels (the actor-model table;
+// default share/convoy/actors/actor_models.json).
+// Datapacks, written (any name): a RoadUserDataPack or RoadUsersDataPack, or a JSON datapack
+// holding a RoadUser dict, a list of them or {"users": [...]} (a python_json road user's).
+// This system takes every such datapack that no system registered before it takes, so it is
+// registered after those that take JSON datapacks by name (weather, traffic lights).
+//
+// Each road-user id is one actor: added the first time it is seen, posed at the start of
+// every engine step (before_step) from its latest state, removed (hidden, out of the physics)
+// when a state says `absent` or none has come for ActorTimeout, back when its id is sent
+// again. After every engine step (after_step) the actors' boxes are compared (they do not
+// collide with each other in the physics) and overlaps reported to the Contacts system.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <deque>
+#include <memory>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "actors.h"
+#include "convoy/road_users.pb.h"
+#include "world_system.h"
+
+namespace convoy::world {
+
+class Contacts;
+
+class RoadUserActors final : public WorldSystem {
+ public:
+  // One actor as the world holds it.
+  struct Actor {
+    std::string id, category, cls;
+    int physics = -1, camera = -1;
+    bool present = false;
+    int64_t last_seen_ns = 0;
+    int64_t created_ns = -1;                                 // the step it first appeared in
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // the model's frame
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d half = Eigen::Vector3d::Zero();  // half the box, about the model's frame
+    double length_offset = 0;  // its box centre ahead of the reference point (library's)
+    int walk_poses = 0;        // an animated walker's walking cycle poses (then the camera's
+    bool stand = false;        // pose walk_poses is its standing model, if it has one)
+  };
+
+  const char* name() const override { return "actors"; }
+  void configure(const WorldContext& ctx, const nlohmann::json& config) override;
+  bool set_datapack(const datapack::View& dp) override;
+  void before_step() override;
+  void after_step() override;
+  void reset() override;
+
+  // The actor of road-user `id`, or null if it never came.
+  const Actor* actor(const std::string& id) const;
+
+ private:
+  Actor& actor_for(const std::string& dp_name, const data::RoadUser& u);
+  void set_present(Actor& a, bool present);
+  static bool boxes_overlap(const Actor& a, const Actor& b);
+
+  const WorldContext* ctx_ = nullptr;
+  Contacts* contacts_ = nullptr;  // null: no contacts system
+  double timeout_s_ = 1.0;
+  std::string table_;
+  std::unique_ptr<ActorLibrary> library_;                        // loaded with the first actor
+  std::vector<std::pair<std::string, data::RoadUser>> pending_;  // datapack name, state
+  std::deque<Actor> actors_;  // a deque: the contacts system keeps pointers to velocities
+  std::unordered_map<std::string, size_t> by_id_;
+  std::set<std::string> warned_models_;
+};
+
+}  // namespace convoy::world
