@@ -56,6 +56,7 @@ Shape scaled_shape(Shape sh, const Eigen::Isometry3d& pose, const Eigen::Vector3
       sh.scale = sh.scale.cwiseProduct(ls);
       break;
     case Shape::kPlane:
+    case Shape::kHeightmap:
       break;
   }
   return sh;

@@ -268,6 +268,8 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
           parts.emplace_back(part.mesh, m);
         }
         break;
+      case Shape::kHeightmap:
+        break;  // collisions only: a heightmap visual draws nothing
     }
     if (!v.material.texture.empty()) {
       int texture = scene_.add_texture_file(v.material.texture.string());

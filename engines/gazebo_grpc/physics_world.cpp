@@ -1,5 +1,7 @@
 #include "physics_world.h"
 
+#include "height_map.h"
+
 #include <algorithm>
 #include <dart/collision/bullet/BulletCollisionDetector.hpp>
 #include <set>
@@ -37,6 +39,12 @@ dd::ShapePtr make_shape(const Shape& s, Eigen::Isometry3d* offset) {
       t.translation() = box.computeCenter();
       *offset = *offset * t;
       return std::make_shared<dd::BoxShape>(box.computeFullExtents().cwiseMax(1e-3));
+    }
+    case Shape::kHeightmap: {
+      const HeightMapShape hm = make_height_map(read_height_map(s.mesh, s.size.z()), s.size,
+                                                s.position);
+      *offset = *offset * hm.offset;
+      return hm.shape;
     }
   }
   return nullptr;
@@ -335,7 +343,9 @@ class SkeletonBuilder {
 bool is_scenery(const ModelDesc& model) {
   bool has_plane = false, has_collision = false;
   for (const auto& l : model.links) {
-    for (const auto& c : l.collisions) has_plane |= c.shape.kind == Shape::kPlane;
+    for (const auto& c : l.collisions) {
+      has_plane |= c.shape.kind == Shape::kPlane || c.shape.kind == Shape::kHeightmap;
+    }
     has_collision |= !l.collisions.empty();
   }
   return model.is_static && has_collision && !has_plane;

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '5'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '6'};  // bump on format change
 
 // --- Binary writer and reader -------------------------------------------------------------
 
@@ -91,15 +91,17 @@ void put(Writer& w, const Shape& s) {
   w.v3(s.normal);
   w.path(s.mesh);
   w.v3(s.scale);
+  w.v3(s.position);
 }
 void get(Reader& r, Shape& s) {
   auto kind = r.pod<int32_t>();
-  if (kind < Shape::kBox || kind > Shape::kMesh) throw std::runtime_error("bad shape");
+  if (kind < Shape::kBox || kind > Shape::kHeightmap) throw std::runtime_error("bad shape");
   s.kind = static_cast<Shape::Kind>(kind);
   s.size = r.v3();
   s.normal = r.v3();
   s.mesh = r.path();
   s.scale = r.v3();
+  s.position = r.v3();
 }
 
 void put(Writer& w, const Material& m) {

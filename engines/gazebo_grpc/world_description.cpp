@@ -150,10 +150,24 @@ class Loader {
         s.scale = to_eigen(m->Scale());
         break;
       }
+      case sdf::GeometryType::HEIGHTMAP: {
+        s.kind = Shape::kHeightmap;
+        const sdf::Heightmap* h = g->HeightmapShape();
+        fs::path base =
+            h->FilePath().empty() ? file_.parent_path() : fs::path(h->FilePath()).parent_path();
+        s.mesh = resolve_uri(h->Uri(), base, paths_);
+        if (s.mesh.empty()) {
+          throw std::runtime_error(file_.string() + ": " + where + ": heightmap '" + h->Uri() +
+                                   "' not found");
+        }
+        s.size = to_eigen(h->Size());
+        s.position = to_eigen(h->Position());
+        break;
+      }
       default:
         throw std::runtime_error(file_.string() + ": " + where +
-                                 ": unsupported geometry (box, cylinder, sphere, plane and mesh "
-                                 "are)");
+                                 ": unsupported geometry (box, cylinder, sphere, plane, mesh and "
+                                 "heightmap are)");
     }
     return s;
   }
@@ -521,7 +535,7 @@ bool is_ground(const ModelDesc& model) {
     for (const auto& v : link.visuals) visual_planes &= v.shape.kind == Shape::kPlane;
     for (const auto& c : link.collisions) {
       collides = true;
-      collision_planes &= c.shape.kind == Shape::kPlane;
+      collision_planes &= c.shape.kind == Shape::kPlane || c.shape.kind == Shape::kHeightmap;
     }
   }
   return visual_planes || (model.is_static && collides && collision_planes);

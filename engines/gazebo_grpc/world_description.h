@@ -14,12 +14,15 @@ namespace convoy::world {
 using Rgba = std::array<float, 4>;
 
 struct Shape {
-  enum Kind { kBox, kCylinder, kSphere, kPlane, kMesh } kind = kBox;
+  enum Kind { kBox, kCylinder, kSphere, kPlane, kMesh, kHeightmap } kind = kBox;
   Eigen::Vector3d size = Eigen::Vector3d::Ones();     // box: x y z; cylinder: r r length;
                                                       // sphere: r r r; plane: x y 0
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // plane
   std::filesystem::path mesh;                         // mesh: absolute file path
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();    // mesh
+  // heightmap (collisions only; height_map.h): `mesh` is its image, `size` the extent in x, y
+  // and z, `position` the centre of its x-y extent and its lowest z
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
 };
 
 struct Material {

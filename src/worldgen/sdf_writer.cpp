@@ -137,27 +137,22 @@ void write_world(const WorldPlan& plan, const fs::path& dir, const WriteOptions&
       << num(plan.plane_z) << " 0 0 0</pose><geometry><plane><normal>0 0 1</normal><size>" << num(sx) << " "
       << num(sy) << "</size></plane></geometry></collision>\n"
       << "        <visual name='ground'><geometry><mesh><uri>meshes/ground.obj</uri></mesh></geometry></visual>\n";
+  if (plan.height_field) {
+    // Gazebo's <heightmap>: the image spans <size> (from the first sample's centre to the
+    // last's) around <pos>, its values 0..65535 standing for pos.z .. pos.z + size.z.
+    const HeightField& f = *plan.height_field;
+    write_pgm(f, dir / "meshes/road_heights.pgm");
+    const double sx = (f.columns - 1) * f.cell, sy = (f.rows - 1) * f.cell;
+    out << "        <collision name='surface'><geometry><heightmap><uri>meshes/road_heights.pgm</uri>"
+        << "<size>" << num(sx) << " " << num(sy) << " " << num(std::max(1e-6, f.max() - f.min()))
+        << "</size><pos>" << num(f.x0 + 0.5 * sx) << " " << num(f.y0 + 0.5 * sy) << " "
+        << num(f.min()) << "</pos></heightmap></geometry></collision>\n";
+  }
   for (const std::string& t : road_tiles) {
     out << "        <visual name='" << t << "'><geometry><mesh><uri>meshes/" << t
         << ".obj</uri></mesh></geometry></visual>\n";
   }
   out << "      </link>\n    </model>\n";
-  // The road's surface where it is not flat: in pieces of kBoxesPerModel boxes, so that the
-  // world engine keeps the pieces no vehicle is near out of collision detection. No visual:
-  // the cameras see the road model, and ground truth leaves these out as ground.
-  constexpr size_t kBoxesPerModel = 8;
-  for (size_t first = 0; first < plan.road_boxes.size(); first += kBoxesPerModel) {
-    out << "    <model name='road_surface_" << first / kBoxesPerModel
-        << "'>\n      <static>true</static>\n      <link name='link'>\n";
-    for (size_t k = first; k < std::min(first + kBoxesPerModel, plan.road_boxes.size()); ++k) {
-      const BoxCollision& c = plan.road_boxes[k];
-      out << "        <collision name='s" << k - first << "'><pose>" << num(c.centre[0]) << " "
-          << num(c.centre[1]) << " " << num(c.centre[2]) << " " << num(c.roll) << " "
-          << num(c.pitch) << " " << num(c.yaw) << "</pose><geometry><box><size>" << num(c.size[0])
-          << " " << num(c.size[1]) << " " << num(c.size[2]) << "</size></box></geometry></collision>\n";
-    }
-    out << "      </link>\n    </model>\n";
-  }
   Names names;
   for (const MeshModel& m : plan.models) write_mesh_model(out, m, names(m.name), dir);
   for (const Placement& p : plan.placements) write_placement(out, p, names(p.name));

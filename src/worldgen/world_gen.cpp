@@ -84,10 +84,9 @@ WorldStats generate_world(const odr::Network& net, const Catalog& catalog,
   ground.urban = options.scenery == Scenery::kUrban;
   plan.ground_z = build_ground(plan.bounds, ground, options.seed, plan.ground);
   if (!is_flat(net)) add_embankments(net, plan.ground_z, plan.road);
-  if (!is_flat(net) && options.surface_boxes) {
-    // the road's own surface carries the traffic; the plane catches what leaves it
-    plan.road_boxes = road_collision_boxes(net);
-    plan.plane_z = plan.ground_z;
+  if (!is_flat(net) && options.height_field) {
+    plan.height_field = road_height_field(net, plan.ground_z);
+    plan.plane_z = std::min(plan.ground_z, plan.height_field->min()) - 0.5;
   }
 
   WorldStats stats;

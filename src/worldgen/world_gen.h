@@ -26,11 +26,9 @@ namespace convoy::worldgen {
 struct WorldOptions {
   Scenery scenery = Scenery::kNone;
   uint64_t seed = 1;
-  // Collision boxes along the surface of maps that are not flat (terrain.h). Off by default:
-  // a wheel rolling from one box onto the next catches on the next box's end face (Bullet's
-  // internal-edge contacts) and the car stops; until the world engine collides with a
-  // height field of the roads, the car drives on the plane z = 0 on such maps.
-  bool surface_boxes = false;
+  // The roads' surface of maps that are not flat as a height field (height_field.h): the road
+  // model's <heightmap> collision, the plane moved under the lowest ground.
+  bool height_field = true;
 };
 
 struct WorldStats {

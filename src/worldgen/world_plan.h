@@ -2,12 +2,14 @@
 // its own (extruded buildings, walls, tunnels, markings) and placements of catalog models.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "opendrive/network.h"
 #include "worldgen/catalog.h"
 #include "worldgen/mesh_set.h"
+#include "worldgen/height_field.h"
 
 namespace convoy::worldgen {
 
@@ -21,13 +23,11 @@ struct Placement {
   std::string signal_id;  // lights: the OpenDRIVE signal whose state they show
 };
 
-// A static box collision in world coordinates (SDF's roll, pitch, yaw).
+// A static box collision in world coordinates, turned by yaw.
 struct BoxCollision {
   Vec3 centre{};
   Vec3 size{};
   double yaw = 0;
-  double roll = 0;
-  double pitch = 0;
 };
 
 // A model made of the generator's own geometry: one ground-truth instance of `cls`.
@@ -43,7 +43,7 @@ struct WorldPlan {
   MeshSet ground;  // the ground plane and the horizon
   double ground_z = 0;
   double plane_z = 0;                     // the collision plane under everything
-  std::vector<BoxCollision> road_boxes;   // the road surface where it is not flat
+  std::optional<HeightField> height_field;  // the roads' surface where it is not flat
   opendrive::Bounds bounds;  // of the roads
   std::vector<MeshModel> models;
   std::vector<Placement> placements;

@@ -277,3 +277,58 @@ TEST(WorldErrors, MissingFileBadXmlUnknownJointAndMeshAreNamed) {
 
 }  // namespace
 }  // namespace convoy::world
+
+namespace convoy::world {
+namespace {
+
+// A heightmap collision (as convoy-odr world writes a hilly map's roads): a tilted plane of
+// 11 x 11 samples over x in [0, 10], y in [-8, 2], z = 1 + 0.2 x + 0.1 (y + 8). Small balls
+// dropped on it roll on its surface wherever they land (a box would slide and tip).
+TEST(Physics, BallsRollOnTheSurfaceOfAHeightmap) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("convoy_heightmap_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  auto surface = [](double x, double y) { return 1 + 0.2 * x + 0.1 * (y + 8); };
+  {
+    std::ofstream pgm(dir / "ramp.pgm", std::ios::binary);
+    pgm << "P5\n11 11\n65535\n";
+    for (int r = 0; r < 11; ++r) {  // the first row is the largest y
+      for (int c = 0; c < 11; ++c) {
+        const double h = surface(c, 2 - r) - 1;  // 0 .. 3 above pos.z
+        const auto v = static_cast<unsigned>(std::lround(h / 3.0 * 65535));
+        pgm.put(static_cast<char>(v >> 8)).put(static_cast<char>(v & 0xff));
+      }
+    }
+  }
+  std::string boxes;
+  const double at[3][2] = {{3, -5}, {8, 0}, {1, 1}};
+  for (int i = 0; i < 3; ++i) {
+    boxes += "<model name='box" + std::to_string(i) + "'><pose>" + std::to_string(at[i][0]) + " " +
+             std::to_string(at[i][1]) + " 6 0 0 0</pose><link name='body'><inertial><mass>1</mass>"
+             "</inertial><collision name='c'><geometry><sphere><radius>0.05</radius></sphere>"
+             "</geometry></collision></link></model>";
+  }
+  {
+    std::ofstream sdf(dir / "world.sdf");
+    sdf << "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
+           "<physics type='ode'><max_step_size>0.001</max_step_size></physics>"
+           "<model name='ground'><static>true</static><link name='link'>"
+           "<collision name='hm'><geometry><heightmap><uri>ramp.pgm</uri><size>10 10 3</size>"
+           "<pos>5 -3 1</pos></heightmap></geometry></collision></link></model>"
+        << boxes << "</world></sdf>";
+  }
+  const WorldDesc desc = load_world(dir / "world.sdf");
+  EXPECT_TRUE(is_ground(desc.models[0]));  // no ground-truth box for it
+  PhysicsWorld p(desc);
+  for (int i = 0; i < 1500; ++i) p.step();  // fallen by 1.1 s, rolling since
+  for (int i = 0; i < 3; ++i) {
+    const LinkState s = p.link_state(p.link_index("box" + std::to_string(i) + "::body"));
+    // the centre of a ball on a slope: its radius along the normal, 1.025 r above the surface
+    EXPECT_NEAR(s.position.z(), surface(s.position.x(), s.position.y()) + 0.0512, 0.01)
+        << "ball " << i << " at " << s.position.transpose();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace convoy::world

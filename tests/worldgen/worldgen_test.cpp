@@ -3,6 +3,7 @@
 // become models, and what cannot be built is a warning naming it.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -10,6 +11,7 @@
 #include <sstream>
 
 #include "opendrive/parser.h"
+#include "worldgen/height_field.h"
 #include "worldgen/scenery.h"
 #include "worldgen/world_gen.h"
 
@@ -218,6 +220,36 @@ TEST_F(WorldGenTest, WhatCannotBeBuiltIsSkippedWithAWarningNamingIt) {
   EXPECT_TRUE(said("road 1 signal 9 (): unknown signal type 'zz99'"));
   EXPECT_TRUE(fs::exists(dir_ / "bad" / "world.sdf"));
   EXPECT_EQ(stats.signals, 1u);  // the stop sign
+}
+
+TEST_F(WorldGenTest, HillyMapsCollideAsAHeightFieldOfTheirRoads) {
+  const odr::Network crest = odr::load(std::string(CONVOY_ESMINI_MAPS) + "/crest-curve.xodr");
+  const wg::HeightField f = wg::road_height_field(crest, -0.04);
+  const odr::Road& road = crest.roads.front();
+  double worst = 0;
+  for (double s = 5; s < road.length - 5; s += 7.3) {
+    for (double t : {-3.0, -1.0, 1.0, 3.0}) {
+      const auto p = road.offset_point(s, t);
+      // between the samples the field is linear (as Bullet's triangles are): bilinear here
+      const double u = (p.x - f.x0) / f.cell, v = (p.y - f.y0) / f.cell;
+      const int c = static_cast<int>(std::floor(u)), r = static_cast<int>(std::floor(v));
+      auto h = [&](int rr, int cc) { return f.heights[static_cast<size_t>(rr) * f.columns + cc]; };
+      const double a = u - c, b = v - r;
+      const double z = (1 - a) * (1 - b) * h(r, c) + a * (1 - b) * h(r, c + 1) +
+                       (1 - a) * b * h(r + 1, c) + a * b * h(r + 1, c + 1);
+      worst = std::max(worst, std::abs(z - road.surface_z(s, t)));
+    }
+  }
+  EXPECT_LT(worst, 0.03);
+  EXPECT_GT(f.max() - f.min(), 5.0);  // the crest
+  make(fs::path(CONVOY_ESMINI_MAPS) / "crest-curve.xodr", "hill", wg::Scenery::kNone);
+  const std::string hill = slurp(dir_ / "hill/world.sdf");
+  EXPECT_NE(hill.find("<heightmap><uri>meshes/road_heights.pgm</uri>"), std::string::npos);
+  EXPECT_EQ(slurp(dir_ / "hill/meshes/road_heights.pgm").rfind("P5\n" + std::to_string(f.columns) + " " +
+                                                                std::to_string(f.rows) + "\n65535\n", 0),
+            0u);
+  make(fs::path(CONVOY_ESMINI_MAPS) / "straight_500m.xodr", "flat", wg::Scenery::kNone);
+  EXPECT_EQ(slurp(dir_ / "flat/world.sdf").find("<heightmap>"), std::string::npos);
 }
 
 TEST(SceneryTest, TheSceneryKindIsCheckedByName) {

@@ -73,7 +73,10 @@ EgoState::Ego EgoState::make_ego(const ModelDesc& m) const {
       Eigen::Vector3d h = 0.5 * c.shape.size;
       if (c.shape.kind == Shape::kCylinder)
         h = {c.shape.size.x(), c.shape.size.x(), 0.5 * c.shape.size.z()};
-      if (c.shape.kind == Shape::kPlane || c.shape.kind == Shape::kMesh) continue;
+      if (c.shape.kind == Shape::kPlane || c.shape.kind == Shape::kMesh ||
+          c.shape.kind == Shape::kHeightmap) {
+        continue;
+      }
       const Eigen::Isometry3d t = ref_inv * l.pose * c.pose;
       for (int k = 0; k < 8; ++k)
         box.extend(t * Eigen::Vector3d((k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(),
