@@ -278,6 +278,7 @@ void CameraSensors::add_visuals(const LinkDesc& link, const Eigen::Isometry3d& p
     std::vector<int>* named = world ? &visual_instances_[{link.name, v.name}] : nullptr;
     for (auto& [mesh_index, mat] : parts) {
       int inst = scene_.add_instance(mesh_index, mat, to_pose(placement * offset), label, label);
+      if (!v.cast_shadows) scene_.set_casts_shadows(inst, false);
       tracked->instances.push_back(inst);
       tracked->offsets.push_back(to_pose(offset));
       if (named) named->push_back(inst);

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '6'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '7'};  // bump on format change
 
 // --- Binary writer and reader -------------------------------------------------------------
 
@@ -142,6 +142,7 @@ void put(Writer& w, const LinkDesc& l) {
     w.iso(v.pose);
     put(w, v.shape);
     put(w, v.material);
+    w.pod<uint8_t>(v.cast_shadows);
   }
   w.size(l.cameras.size());
   for (const auto& c : l.cameras) {
@@ -178,6 +179,7 @@ void get(Reader& r, LinkDesc& l) {
     v.pose = r.iso();
     get(r, v.shape);
     get(r, v.material);
+    v.cast_shadows = r.pod<uint8_t>() != 0;
   }
   l.cameras.resize(r.size());
   for (auto& c : l.cameras) {

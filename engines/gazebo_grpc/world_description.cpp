@@ -393,6 +393,7 @@ class Loader {
         vd.pose = to_eigen(vp);
         vd.shape = shape(vis->Geom(), where + " visual '" + vis->Name() + "'");
         vd.material = material(vis->Material(), where + " visual '" + vis->Name() + "'");
+        vd.cast_shadows = vis->CastShadows();
         ld.visuals.push_back(vd);
       }
       for (uint64_t s = 0; s < l->SensorCount(); ++s) {

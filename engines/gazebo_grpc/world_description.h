@@ -44,6 +44,7 @@ struct VisualDesc {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
   Shape shape;
   Material material;
+  bool cast_shadows = true;  // <cast_shadows>
 };
 
 struct CameraDesc {

@@ -432,7 +432,7 @@ bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dm
   const auto& instances = scene.instances();
   for (size_t i = 0; i < instances.size(); ++i) {
     const Scene::Instance& inst = instances[i];
-    if (!inst.visible) continue;
+    if (!inst.visible || !inst.casts_shadows) continue;
     const Scene::Bounds& b = scene.mesh_bounds()[inst.mesh];
     const glm::dmat4 world = glm::make_mat4(inst.world_from_object.data());
     const double scale =

@@ -144,6 +144,10 @@ void Scene::set_pose(int instance, const Pose& world_from_object) {
   instance_at(instance, "Scene::set_pose").world_from_object = world_from_object;
 }
 
+void Scene::set_casts_shadows(int instance, bool casts) {
+  instance_at(instance, "Scene::set_casts_shadows").casts_shadows = casts;
+}
+
 void Scene::set_visible(int instance, bool visible) {
   instance_at(instance, "Scene::set_visible").visible = visible;
 }

@@ -136,6 +136,7 @@ class Scene {
     uint32_t model_id;  // ground-truth label; 0 = unlabelled (never gets a bounding box)
     uint32_t class_id;
     bool visible = true;
+    bool casts_shadows = true;  // drawn into the sun's shadow map
   };
   struct Texture {
     int width, height;
@@ -177,6 +178,8 @@ class Scene {
                    uint32_t model_id = 0, uint32_t class_id = 0);
   void set_pose(int instance, const Pose& world_from_object);
   void set_visible(int instance, bool visible);
+  // Whether an instance casts shadows (SDF <cast_shadows>; flat ground need not).
+  void set_casts_shadows(int instance, bool casts);
   void set_material(int instance, const Material& material);
 
   void add_light(const Light& light);

@@ -206,6 +206,34 @@ TEST(RenderTest, TheSunCastsShadowsWhereAsked) {
   EXPECT_EQ(dusk_on.rgb, dusk_off.rgb);
 }
 
+TEST(RenderTest, AnInstanceThatCastsNoShadowLeavesNone) {
+  GET_RENDERER(renderer);
+  const CameraSpec spec{320, 240, 1.2, 0.1, 100};
+  Scene scene;
+  scene.set_ambient({0.2f, 0.2f, 0.2f, 1});
+  Light sun;
+  sun.direction = {1, 0, -1};
+  scene.add_light(sun);
+  scene.add_instance(scene.add_mesh(make_plane(80, 80)), plain(0.8f, 0.8f, 0.8f),
+                     make_pose(0, 0, -1.5));
+  const int box = scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(0.8f, 0.2f, 0.2f),
+                                     make_pose(6, 0, 0));
+  Shadows shadows;
+  shadows.enabled = true;
+  scene.set_shadows(shadows);
+  Frame with, without;
+  renderer->render(scene, identity_pose(), spec, &with);
+  scene.set_casts_shadows(box, false);  // SDF <cast_shadows>false</cast_shadows>
+  renderer->render(scene, identity_pose(), spec, &without);
+  const auto uv = project(spec, 7.5, 0, -1.5);  // in the box's shadow
+  const size_t at = 3 * (static_cast<size_t>(uv[1]) * with.width + static_cast<size_t>(uv[0]));
+  EXPECT_LT(with.rgb[at], 0.5 * without.rgb[at]);
+  scene.set_shadows(Shadows{});
+  Frame off;
+  renderer->render(scene, identity_pose(), spec, &off);
+  EXPECT_NEAR(without.rgb[at], off.rgb[at], 2);  // lit as without shadows at all
+}
+
 TEST(RenderTest, PointAndSpotLightsFadeWithDistanceAndCone) {
   GET_RENDERER(renderer);
   const CameraSpec spec{200, 150, 1.2, 0.1, 100};
