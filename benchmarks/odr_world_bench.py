@@ -11,7 +11,8 @@ also loaded, rendered and driven: benchmarks/worlds/<map>.xosc runs to its end (
 generated world (`convoy run --scenario`: the report's smart car with its camera and detector
 follows the lane's waypoints behind a slower car); a map counts as rendered when the run ends
 with exit 0 and the detector got camera frames, and its lane as kept when the car's reference
-point stayed within 0.85 m of the lane's centre (summary.json's score.route_max_offset_m). A
+point stayed within 0.85 m of the lane's centre (summary.json's score.route_max_offset_m) while
+it drove at least 60 m. A
 second run of 1 s gives the start-up with the world cache warm (summary.json's startup_s). With --frames MAP (a name
 like multi_intersections), the smart car is put where that map's scenario starts the ego and
 build/benchmarks/frame_bench measures its camera (physics, rendering with shadows, ground
@@ -65,6 +66,8 @@ def run_scenario(convoy, scenario, cache, run_dir, timeout=None):
 # The smart car keeps its lane when its reference point stays this close to the lane's centre:
 # half a 3.5 m lane less half the car's 1.8 m width.
 LANE_KEEPING_M = 0.85
+# ... over at least this much of its route (20 s behind a car at 6 m/s: about 128 m)
+MIN_PROGRESS_M = 60.0
 
 
 def ego_start(odr, scenario):
@@ -128,7 +131,9 @@ def main():
                 warm = run_scenario(convoy, scenario, cache, os.path.join(tmp, "run2_" + name), timeout=1)
                 score = drive.get("score") or {}
                 offset = score.get("route_max_offset_m")
-                kept = drive["ok"] and offset is not None and offset <= LANE_KEEPING_M
+                progress = score.get("route_progress_m") or 0
+                kept = drive["ok"] and offset is not None and offset <= LANE_KEEPING_M and \
+                    progress >= MIN_PROGRESS_M
                 row.update(rendered=drive["ok"] and warm["ok"] and drive.get("detector_frames", 0) > 0,
                            startup_cold_s=drive.get("startup_s"), startup_warm_s=warm.get("startup_s"),
                            max_offset_m=offset, lane_kept=kept,

@@ -71,7 +71,7 @@ TEMPLATE = """<?xml version="1.0" encoding="UTF-8"?>
 
 
 def pick(path):
-    """(road id, lane id, length) of the longest non-junction road's innermost driving lane on
+    """(road id, lane id, length, left-hand traffic) of the longest non-junction road's innermost driving lane on
     the side traffic keeps to."""
     root = ET.parse(path).getroot()
     best = None
@@ -89,7 +89,7 @@ def pick(path):
             continue
         length = float(road.get("length"))
         if best is None or length > best[2]:
-            best = (road.get("id"), lanes[0], length)
+            best = (road.get("id"), lanes[0], length, lht)
     return best
 
 
@@ -100,9 +100,9 @@ START_S = {"crest-curve": 160.0}
 def main():
     for path in sorted(glob.glob(os.path.join(MAPS, "*.xodr"))):
         name = os.path.splitext(os.path.basename(path))[0]
-        road, lane, length = pick(path)
-        # the ego travels with s on right lanes (RHT) and against it on left ones (LHT)
-        forward = lane < 0
+        road, lane, length, lht = pick(path)
+        # right lanes travel with s under RHT, left lanes under LHT
+        forward = (lane < 0) != lht
         s = START_S.get(name, 10.0 if forward else max(10.0, length - 10.0))
         lead_s = min(length - 1, s + 25) if forward else max(1.0, s - 25)
         route = max(40.0, min(150.0, length - 20))

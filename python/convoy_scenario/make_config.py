@@ -220,10 +220,19 @@ def route_length(scenario):
     return max(40.0, min(300.0, 0.5 * CRUISE * duration))
 
 
-def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0):
+def surface_pose(odr, pose, start):
+    """(z, pitch) of a car at `pose` on the road's surface: the height under it and the slope
+    from there to 1 m ahead (0, 0 on a flat map)."""
+    z = start.get("z", 0.0)
+    ahead = odr.locate(pose[0] + math.cos(pose[2]), pose[1] + math.sin(pose[2]), pose[2])
+    dz = (ahead or {}).get("z", z) - z
+    return z, (0.0 if dz == 0 else -math.atan2(dz, 1.0))
+
+
+def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0.0):
     x, y, yaw = pose
     out_engines[0]["GazeboSDFModels"] = [{"Name": "smart_car", "File": EGO_MODEL,
-                                          "InitPose": [x, y, z, 0.0, 0.0, yaw]}]
+                                          "InitPose": [x, y, z, 0.0, pitch, yaw]}]
     # the smart car's meshes (model://smart_car/...) are found next to its model
     out_engines[0]["EngineEnvParams"] = ["CONVOY_MODEL_PATH=" + os.path.dirname(os.path.dirname(EGO_MODEL))]
     out_engines += [
@@ -273,6 +282,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         if ego_pose is None:
             raise ScenarioError("%s: the ego %r has no Init TeleportAction (where does it start?)" % (base, ego))
         start = lane_of(odr, *ego_pose, "the ego's Init position")
+        ego_surface = surface_pose(odr, ego_pose, start)
         length = route_length(scenario)
         spec = ego_route_action(scenario, ego)
         if spec is not None:
@@ -356,7 +366,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         if "GazeboSDFModels" in frag:
             engines[0]["GazeboSDFModels"] = frag["GazeboSDFModels"]
     else:
-        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs, start.get("z", 0.0))
+        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs, *ego_surface)
     if has_lights:
         engines.append({"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
                         "Map": xodr, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0})
