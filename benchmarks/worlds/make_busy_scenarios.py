@@ -8,6 +8,8 @@ Deterministic; stdlib only.
   /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py"""
 import os
 
+from make_map_scenarios import story_end
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ESMINI = "../../tests/opendrive/data/esmini/"
 # map -> (LogicFile relative to this folder, road, ego lane, oncoming lane, sidewalks (right,
@@ -53,26 +55,7 @@ DOC = """<?xml version="1.0" encoding="UTF-8"?>
       <Actions>
 {inits}      </Actions>
     </Init>
-    <Story name="Story">
-      <Act name="Act">
-        <ManeuverGroup name="LeadGroup" maximumExecutionCount="1">
-          <Actors selectTriggeringEntities="false"><EntityRef entityRef="Lead"/></Actors>
-          <Maneuver name="LeadManeuver">
-            <Event name="Cruise" priority="parallel"><Action name="CruiseAction"><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" dynamicsDimension="time" value="0"/><SpeedActionTarget><AbsoluteTargetSpeed value="5"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction></Action></Event>
-          </Maneuver>
-        </ManeuverGroup>
-      </Act>
-    </Story>
-    <StopTrigger>
-      <ConditionGroup>
-        <Condition name="Timeout" delay="0" conditionEdge="rising">
-          <ByValueCondition><SimulationTimeCondition value="25" rule="greaterOrEqual"/></ByValueCondition>
-        </Condition>
-      </ConditionGroup>
-    </StopTrigger>
-  </Storyboard>
-</OpenSCENARIO>
-"""
+{end}"""
 
 
 def main():
@@ -90,7 +73,8 @@ def main():
             entities.append(PEDESTRIAN.format(name=n))
             inits.append(INIT.format(name=n, road=road, lane=walks[k % 2], s=s + 15 + 18 * k, v=1.3))
         with open(os.path.join(HERE, "busy_%s.xosc" % name), "w") as f:
-            f.write(DOC.format(name=name, xodr=xodr, entities="".join(entities), inits="".join(inits)))
+            f.write(DOC.format(name=name, xodr=xodr, entities="".join(entities), inits="".join(inits),
+                               end=story_end(5, 25)))
         print("busy_%s.xosc" % name)
 
 

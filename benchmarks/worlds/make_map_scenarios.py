@@ -48,12 +48,16 @@ TEMPLATE = """<?xml version="1.0" encoding="UTF-8"?>
         </Private>
       </Actions>
     </Init>
-    <Story name="Story">
+{end}"""
+
+# The end of both scenario kinds (make_busy_scenarios.py too): the Lead cruises at {speed} m/s,
+# the run stops at {duration} s.
+END = """    <Story name="Story">
       <Act name="Act">
         <ManeuverGroup name="LeadGroup" maximumExecutionCount="1">
           <Actors selectTriggeringEntities="false"><EntityRef entityRef="Lead"/></Actors>
           <Maneuver name="LeadManeuver">
-            <Event name="Cruise" priority="parallel"><Action name="CruiseAction"><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" dynamicsDimension="time" value="0"/><SpeedActionTarget><AbsoluteTargetSpeed value="6"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction></Action></Event>
+            <Event name="Cruise" priority="parallel"><Action name="CruiseAction"><PrivateAction><LongitudinalAction><SpeedAction><SpeedActionDynamics dynamicsShape="step" dynamicsDimension="time" value="0"/><SpeedActionTarget><AbsoluteTargetSpeed value="{speed}"/></SpeedActionTarget></SpeedAction></LongitudinalAction></PrivateAction></Action></Event>
           </Maneuver>
         </ManeuverGroup>
       </Act>
@@ -61,13 +65,17 @@ TEMPLATE = """<?xml version="1.0" encoding="UTF-8"?>
     <StopTrigger>
       <ConditionGroup>
         <Condition name="Timeout" delay="0" conditionEdge="rising">
-          <ByValueCondition><SimulationTimeCondition value="20" rule="greaterOrEqual"/></ByValueCondition>
+          <ByValueCondition><SimulationTimeCondition value="{duration}" rule="greaterOrEqual"/></ByValueCondition>
         </Condition>
       </ConditionGroup>
     </StopTrigger>
   </Storyboard>
 </OpenSCENARIO>
 """
+
+
+def story_end(speed, duration):
+    return END.format(speed=speed, duration=duration)
 
 
 def pick(path):
@@ -107,7 +115,8 @@ def main():
         lead_s = min(length - 1, s + 25) if forward else max(1.0, s - 25)
         route = max(40.0, min(150.0, length - 20))
         with open(os.path.join(HERE, name + ".xosc"), "w") as f:
-            f.write(TEMPLATE.format(name=name, road=road, lane=lane, s=s, lead_s=lead_s, route=route))
+            f.write(TEMPLATE.format(name=name, road=road, lane=lane, s=s, lead_s=lead_s, route=route,
+                                    end=story_end(6, 20)))
         print("%s: road %s lane %d (%.0f m)" % (name, road, lane, length))
 
 
