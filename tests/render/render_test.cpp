@@ -165,18 +165,24 @@ TEST(RenderTest, SphereIsBrighterOnTheLitSide) {
 
 // Sun shadows (Scene::set_shadows): a box floating 1 m above the ground, the sun at 45 degrees
 // from behind the camera, shades the ground 1-2 m beyond it; off, the ground is lit alike.
-TEST(RenderTest, TheSunCastsShadowsWhereAsked) {
-  GET_RENDERER(renderer);
-  const CameraSpec spec{320, 240, 1.2, 0.1, 100};
-  Scene scene;
+// A sun from the -x side, a grey ground 1.5 m below the camera and a red box 6 m ahead;
+// returns the box's instance.
+int sun_ground_and_box(Scene& scene) {
   scene.set_ambient({0.2f, 0.2f, 0.2f, 1});
   Light sun;
   sun.direction = {1, 0, -1};
   scene.add_light(sun);
   scene.add_instance(scene.add_mesh(make_plane(80, 80)), plain(0.8f, 0.8f, 0.8f),
                      make_pose(0, 0, -1.5));
-  scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(0.8f, 0.2f, 0.2f),
-                     make_pose(6, 0, 0));
+  return scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(0.8f, 0.2f, 0.2f),
+                            make_pose(6, 0, 0));
+}
+
+TEST(RenderTest, TheSunCastsShadowsWhereAsked) {
+  GET_RENDERER(renderer);
+  const CameraSpec spec{320, 240, 1.2, 0.1, 100};
+  Scene scene;
+  sun_ground_and_box(scene);
   auto grey = [&](const Frame& f, double x, double y, double z) {
     const auto uv = project(spec, x, y, z);
     const uint8_t* p = &f.rgb[3 * (static_cast<int>(uv[1]) * f.width + static_cast<int>(uv[0]))];
@@ -210,14 +216,7 @@ TEST(RenderTest, AnInstanceThatCastsNoShadowLeavesNone) {
   GET_RENDERER(renderer);
   const CameraSpec spec{320, 240, 1.2, 0.1, 100};
   Scene scene;
-  scene.set_ambient({0.2f, 0.2f, 0.2f, 1});
-  Light sun;
-  sun.direction = {1, 0, -1};
-  scene.add_light(sun);
-  scene.add_instance(scene.add_mesh(make_plane(80, 80)), plain(0.8f, 0.8f, 0.8f),
-                     make_pose(0, 0, -1.5));
-  const int box = scene.add_instance(scene.add_mesh(make_box(1, 1, 1)), plain(0.8f, 0.2f, 0.2f),
-                                     make_pose(6, 0, 0));
+  const int box = sun_ground_and_box(scene);
   Shadows shadows;
   shadows.enabled = true;
   scene.set_shadows(shadows);
