@@ -12,7 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kRoadTile = 64;  // m
+constexpr double kRoadTile = 128;  // m
 
 std::string num(double v) {
   char buf[32];
