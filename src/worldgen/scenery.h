@@ -21,7 +21,7 @@ enum class Scenery { kNone, kRoadside, kUrban };
 // "none", "roadside" or "urban"; throws std::invalid_argument naming the value otherwise.
 Scenery parse_scenery(const std::string& name);
 
-// A grid of 1 m cells over the map: marked cells are taken.
+// A grid of `cell`-metre cells over the map: marked cells are taken.
 class Occupancy {
  public:
   Occupancy(const opendrive::Bounds& bounds, double margin, double cell = 1.0);

@@ -75,7 +75,10 @@ WorldStats generate_world(const odr::Network& net, const Catalog& catalog,
   place_objects(net, catalog, plan);
   build_spans(net, plan);
   if (options.scenery != Scenery::kNone) {
-    Occupancy occ(plan.bounds, 60);
+    // 1 m cells, coarser on a map so large that they would take more than 50 MB
+    const double area = (plan.bounds.max[0] - plan.bounds.min[0] + 120) *
+                        (plan.bounds.max[1] - plan.bounds.min[1] + 120);
+    Occupancy occ(plan.bounds, 60, std::max(1.0, std::sqrt(area / 5e7)));
     occ.mark_roads(net, 0.3);
     mark_placed(plan, occ);
     scatter_scenery(net, catalog, options.scenery, options.seed, occ, plan);
@@ -85,7 +88,10 @@ WorldStats generate_world(const odr::Network& net, const Catalog& catalog,
   plan.ground_z = build_ground(plan.bounds, ground, options.seed, plan.ground);
   if (!is_flat(net)) add_embankments(net, plan.ground_z, plan.road);
   if (!is_flat(net) && options.height_field) {
-    plan.height_field = road_height_field(net, plan.ground_z);
+    // 1 m cells, coarser on a map so large that they would be more than 10 M (40 MB)
+    const double area = (plan.bounds.max[0] - plan.bounds.min[0] + 20) *
+                        (plan.bounds.max[1] - plan.bounds.min[1] + 20);
+    plan.height_field = road_height_field(net, plan.ground_z, std::max(1.0, std::sqrt(area / 1e7)));
     plan.plane_z = std::min(plan.ground_z, plan.height_field->min()) - 0.5;
   }
 

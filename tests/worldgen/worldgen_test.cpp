@@ -252,6 +252,14 @@ TEST_F(WorldGenTest, HillyMapsCollideAsAHeightFieldOfTheirRoads) {
   EXPECT_EQ(slurp(dir_ / "flat/world.sdf").find("<heightmap>"), std::string::npos);
 }
 
+TEST_F(WorldGenTest, AMapFarApartGetsCoarserGridsNotAllTheMemory) {
+  const fs::path map = fs::path(CONVOY_WORLDGEN_TEST_DATA) / "far_apart.xodr";
+  const auto stats = make(map, "far", wg::Scenery::kRoadside);
+  EXPECT_GT(stats.placements, 4u);
+  const std::string pgm = slurp(dir_ / "far/meshes/road_heights.pgm");
+  EXPECT_LT(pgm.size(), 25u * 1000 * 1000);  // at most 10 M samples of 2 bytes, and a header
+}
+
 TEST(SceneryTest, TheSceneryKindIsCheckedByName) {
   EXPECT_EQ(wg::parse_scenery("urban"), wg::Scenery::kUrban);
   EXPECT_THROW(wg::parse_scenery("forest"), std::invalid_argument);
