@@ -1,7 +1,5 @@
 #include "physics_world.h"
 
-#include "height_map.h"
-
 #include <algorithm>
 #include <dart/collision/bullet/BulletCollisionDetector.hpp>
 #include <set>
@@ -10,6 +8,8 @@
 #include <unordered_map>
 #include <utility>
 #include <vector>
+
+#include "height_map.h"
 
 namespace convoy::world {
 
@@ -41,8 +41,8 @@ dd::ShapePtr make_shape(const Shape& s, Eigen::Isometry3d* offset) {
       return std::make_shared<dd::BoxShape>(box.computeFullExtents().cwiseMax(1e-3));
     }
     case Shape::kHeightmap: {
-      const HeightMapShape hm = make_height_map(read_height_map(s.mesh, s.size.z()), s.size,
-                                                s.position);
+      const HeightMapShape hm =
+          make_height_map(read_height_map(s.mesh, s.size.z()), s.size, s.position);
       *offset = *offset * hm.offset;
       return hm.shape;
     }

@@ -24,7 +24,8 @@ void usage(const char* prog) {
   std::printf(
       "usage: %s run -c simulation_config.json [-o Key=Value]... [--run-dir DIR] [--quiet]\n"
       "                  [--record] [--record-blobs]\n"
-      "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--scenery KIND] [--ego FRAGMENT.json]\n"
+      "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--scenery KIND] [--ego "
+      "FRAGMENT.json]\n"
       "                [-o Key=Value]... [--run-dir DIR] [--quiet] [--record]\n"
       "       %s replay RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"

@@ -755,7 +755,8 @@ WorldPose LaneGraph::world_pose(const std::string& road_id, int lane_id, double 
   const Road& road = *n.road;
   const LaneCentre c = centre(road, n.section, s, lane_id);
   const Pose2 p = offset_pose(road, s, c.t + t, c.slope);
-  return {p.x, p.y, road.surface_z(s, c.t + t), wrap(p.heading + (n.forward ? 0 : std::numbers::pi))};
+  return {p.x, p.y, road.surface_z(s, c.t + t),
+          wrap(p.heading + (n.forward ? 0 : std::numbers::pi))};
 }
 
 std::optional<LanePosition> LaneGraph::locate(double x, double y, std::optional<double> heading,

@@ -1,12 +1,12 @@
 #include "opendrive/mesh_io.h"
 
-#include "opendrive/text_file.h"
-
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
+
+#include "opendrive/text_file.h"
 
 namespace convoy::opendrive {
 

@@ -181,9 +181,9 @@ struct Signal {
   double value = 0;  // NaN when not given
   std::string unit;
   std::vector<std::pair<int, int>> validity;  // <validity fromLane toLane>; empty = all lanes
-  double width = 0;   // of the sign's face, m; 0 when not given
-  double height = 0;  // m; 0 when not given
-  int line = 0;       // in the file, for messages
+  double width = 0;                           // of the sign's face, m; 0 when not given
+  double height = 0;                          // m; 0 when not given
+  int line = 0;                               // in the file, for messages
 };
 
 class Road {

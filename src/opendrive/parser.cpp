@@ -1,7 +1,5 @@
 #include "opendrive/parser.h"
 
-#include "opendrive/parser_fields.h"
-
 #include <tinyxml2.h>
 
 #include <algorithm>
@@ -14,6 +12,8 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+
+#include "opendrive/parser_fields.h"
 
 namespace convoy::opendrive {
 namespace {
@@ -185,13 +185,15 @@ Road Reader::read_road(const XMLElement* e, size_t index) {
   if (const XMLElement* objects = e->FirstChildElement("objects")) {
     int o = 0;
     for_each_child(objects, "object", [&](const XMLElement* oe) {
-      road.objects.push_back(detail::read_object(*this, oe, where + " object " + std::to_string(o++)));
+      road.objects.push_back(
+          detail::read_object(*this, oe, where + " object " + std::to_string(o++)));
     });
   }
   if (const XMLElement* signals = e->FirstChildElement("signals")) {
     int g = 0;
     for_each_child(signals, "signal", [&](const XMLElement* se) {
-      road.signals.push_back(detail::read_signal(*this, se, where + " signal " + std::to_string(g++)));
+      road.signals.push_back(
+          detail::read_signal(*this, se, where + " signal " + std::to_string(g++)));
     });
   }
   if (const XMLElement* objects = e->FirstChildElement("objects")) {

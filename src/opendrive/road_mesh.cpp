@@ -16,7 +16,7 @@ struct Station {
   double s = 0;
   Pose2 ref;
   double z = 0;
-  double tilt = 0;  // dz/dt from the superelevation
+  double tilt = 0;            // dz/dt from the superelevation
   std::vector<double> outer;  // outer border t per lane index; the centre lane: lane offset
 };
 

@@ -10,8 +10,9 @@
 // their lane: solid lines continuous, broken lines dash_length on / dash_gap off unless the
 // file gives explicit <type><line> definitions, double types ("solid broken" ...) as two
 // lines, the first on the left (+t). Types without paint (none, grass, curb) are skipped,
-// and botts dots unless MeshOptions::lane_materials. Superelevation tilts every surface. Normals are per vertex (averaged over each strip's faces); triangles wind
-// counter-clockwise seen from the side the normal points to.
+// and botts dots unless MeshOptions::lane_materials. Superelevation tilts every surface. Normals
+// are per vertex (averaged over each strip's faces); triangles wind counter-clockwise seen from the
+// side the normal points to.
 #pragma once
 
 #include <array>

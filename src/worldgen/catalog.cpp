@@ -52,7 +52,8 @@ CatalogModel read_model(const std::string& name, const json& j, const std::strin
     m.sign_value = j["sign"].value("value", 0.0);
   }
   if (j.contains("lamps")) {
-    for (const auto& [colour, visual] : j["lamps"].items()) m.lamps[colour] = visual.get<std::string>();
+    for (const auto& [colour, visual] : j["lamps"].items())
+      m.lamps[colour] = visual.get<std::string>();
   }
   return m;
 }

@@ -14,8 +14,8 @@ namespace convoy::worldgen {
 
 struct CatalogVisual {
   std::string name;
-  std::string mesh;                 // relative to the catalog's folder
-  std::array<double, 6> pose{};     // x y z roll pitch yaw in the model's frame
+  std::string mesh;                             // relative to the catalog's folder
+  std::array<double, 6> pose{};                 // x y z roll pitch yaw in the model's frame
   std::optional<std::array<double, 3>> colour;  // overrides the mesh's diffuse colour
 };
 
@@ -26,8 +26,8 @@ struct CatalogCollision {
 
 struct CatalogModel {
   std::string name;
-  std::string kind;   // building, tree, shrub, street_light, bench, bin, bus_stop, ...
-  std::string cls;    // ground-truth class
+  std::string kind;              // building, tree, shrub, street_light, bench, bin, bus_stop, ...
+  std::string cls;               // ground-truth class
   std::array<double, 3> size{};  // length (x), width (y), height (z) of its bounding box
   std::vector<CatalogVisual> visuals;
   std::vector<CatalogCollision> collisions;

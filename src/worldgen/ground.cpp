@@ -29,9 +29,9 @@ double build_ground(const opendrive::Bounds& b, const GroundOptions& options, ui
   std::vector<Vec3> inner, outer;
   for (int i = 0; i <= kSegments; ++i) {
     const double a = 2 * std::numbers::pi * i / kSegments;
-    const double h = std::min(80.0, r * (0.04 + 0.012 * std::sin(3 * a + phase[0]) +
-                                         0.01 * std::sin(7 * a + phase[1]) +
-                                         0.006 * std::sin(13 * a + phase[2])));
+    const double h = std::min(
+        80.0, r * (0.04 + 0.012 * std::sin(3 * a + phase[0]) + 0.01 * std::sin(7 * a + phase[1]) +
+                   0.006 * std::sin(13 * a + phase[2])));
     inner.push_back({cx + r * std::cos(a), cy + r * std::sin(a), z});
     outer.push_back({cx + 1.15 * r * std::cos(a), cy + 1.15 * r * std::sin(a), z + h});
   }

@@ -53,8 +53,8 @@ void dilate(HeightField& f, int passes) {
 
 }  // namespace
 
-HeightField road_height_field(const odr::Network& net, double ground_z, double cell,
-                              double margin, double reach) {
+HeightField road_height_field(const odr::Network& net, double ground_z, double cell, double margin,
+                              double reach) {
   const odr::Bounds b = odr::network_bounds(net);
   HeightField f;
   f.cell = cell;
@@ -64,7 +64,8 @@ HeightField road_height_field(const odr::Network& net, double ground_z, double c
   f.rows = static_cast<int>(std::ceil((b.max[1] - b.min[1] + 2 * margin) / cell));
   if (static_cast<double>(f.columns) * f.rows > 3e7) {
     throw std::runtime_error("the map is too large for a height field (" +
-                             std::to_string(f.columns) + " x " + std::to_string(f.rows) + " cells)");
+                             std::to_string(f.columns) + " x " + std::to_string(f.rows) +
+                             " cells)");
   }
   f.heights.assign(static_cast<size_t>(f.columns) * f.rows, std::nanf(""));
   odr::SamplingOptions fine;

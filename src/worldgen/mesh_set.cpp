@@ -1,13 +1,13 @@
 #include "worldgen/mesh_set.h"
 
-#include "opendrive/text_file.h"
-
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
+
+#include "opendrive/text_file.h"
 
 namespace convoy::worldgen {
 namespace {
@@ -41,7 +41,8 @@ void MeshSet::add_road_mesh(const opendrive::RoadMesh& road) {
     const auto base = static_cast<uint32_t>(p.positions.size());
     p.positions.insert(p.positions.end(), mesh.positions.begin(), mesh.positions.end());
     p.normals.insert(p.normals.end(), mesh.normals.begin(), mesh.normals.end());
-    for (const auto& t : mesh.triangles) p.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    for (const auto& t : mesh.triangles)
+      p.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   }
 }
 
@@ -54,7 +55,8 @@ void MeshSet::add_convex(Part& p, const std::vector<Vec3>& corners) {
     p.normals.push_back(n);
   }
   if (!p.uvs.empty()) p.uvs.resize(p.positions.size(), {0, 0});  // uvs stay one per position
-  for (uint32_t i = 1; i + 1 < corners.size(); ++i) p.triangles.push_back({base, base + i, base + i + 1});
+  for (uint32_t i = 1; i + 1 < corners.size(); ++i)
+    p.triangles.push_back({base, base + i, base + i + 1});
 }
 
 void MeshSet::add_quad(Part& p, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
@@ -66,8 +68,10 @@ void MeshSet::add_quad(Part& p, const Vec3& a, const Vec3& b, const Vec3& c, con
   for (const Vec3* v : {&a, &b, &c, &d}) {
     p.positions.push_back(*v);
     p.normals.push_back(n);
-    if (uv) p.uvs.push_back((*uv)[k]);
-    else if (!p.uvs.empty()) p.uvs.push_back({0, 0});
+    if (uv)
+      p.uvs.push_back((*uv)[k]);
+    else if (!p.uvs.empty())
+      p.uvs.push_back({0, 0});
     ++k;
   }
   p.triangles.push_back({base, base + 1, base + 2});
@@ -144,8 +148,8 @@ void MeshSet::write(const std::filesystem::path& obj, const std::filesystem::pat
       const size_t a = t[0] + offset, b = t[1] + offset, c = t[2] + offset;
       if (uv) {
         const size_t ta = t[0] + uv_offset, tb = t[1] + uv_offset, tc = t[2] + uv_offset;
-        std::fprintf(f.get(), "f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu\n", a, ta, a, b, tb, b, c,
-                     tc, c);
+        std::fprintf(f.get(), "f %zu/%zu/%zu %zu/%zu/%zu %zu/%zu/%zu\n", a, ta, a, b, tb, b, c, tc,
+                     c);
       } else {
         std::fprintf(f.get(), "f %zu//%zu %zu//%zu %zu//%zu\n", a, a, b, b, c, c);
       }
@@ -164,7 +168,8 @@ void MeshSet::write(const std::filesystem::path& obj, const std::filesystem::pat
     std::fprintf(m.get(), "\nnewmtl %s\nKa %.3f %.3f %.3f\nKd %.3f %.3f %.3f\n", name.c_str(), c[0],
                  c[1], c[2], c[0], c[1], c[2]);
     std::fprintf(m.get(), "Ks %.3f %.3f %.3f\nNs %d\nd 1\nillum 2\n", k, k, k, k > 0.1 ? 30 : 10);
-    if (!p.material.texture.empty()) std::fprintf(m.get(), "map_Kd %s\n", p.material.texture.c_str());
+    if (!p.material.texture.empty())
+      std::fprintf(m.get(), "map_Kd %s\n", p.material.texture.c_str());
   }
   close_checked(std::move(m), mtl);
 }

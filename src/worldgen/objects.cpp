@@ -44,7 +44,11 @@ class ObjectBuilder {
  public:
   ObjectBuilder(const odr::Road& road, const odr::RoadObject& o, const Catalog& catalog,
                 WorldPlan& plan)
-      : road_(road), o_(o), catalog_(catalog), plan_(plan), type_(lower(o.type)),
+      : road_(road),
+        o_(o),
+        catalog_(catalog),
+        plan_(plan),
+        type_(lower(o.type)),
         where_("road " + road.id + " object " + o.id + " (" + o.type + ")") {}
 
   void build() {
@@ -71,7 +75,8 @@ class ObjectBuilder {
     const double h0 = or_object(r.height_start, o_.height), h1 = or_object(r.height_end, h0);
     if (r.distance <= 0) return sweep(r, w0, w1, h0, h1);
     const int n = static_cast<int>(std::floor(r.length / r.distance + 1e-9)) + 1;
-    if (n > 5000) return plan_.warn(where_ + ": repeat makes " + std::to_string(n) + " objects; skipped");
+    if (n > 5000)
+      return plan_.warn(where_ + ": repeat makes " + std::to_string(n) + " objects; skipped");
     if (n > 12 && is_post()) return posts(r, n, h0, h1);
     for (int k = 0; k < n; ++k) {
       const double u = r.length > 0 ? k * r.distance / r.length : 0;
@@ -113,7 +118,8 @@ class ObjectBuilder {
       const double u = r.length > 0 ? k * r.distance / r.length : 0;
       const double s = std::clamp(r.s + k * r.distance, 0.0, road_.length);
       const double h = std::max(0.3, lerp(h0, h1, u) > 0 ? lerp(h0, h1, u) : 1.0);
-      const Vec3 base = road_point(road_, s, lerp(r.t_start, r.t_end, u), lerp(r.z_start, r.z_end, u));
+      const Vec3 base =
+          road_point(road_, s, lerp(r.t_start, r.t_end, u), lerp(r.z_start, r.z_end, u));
       MeshSet::add_box(part, {base[0], base[1], base[2] + 0.5 * h}, {0.12, 0.12, h}, yaw_at(s));
     }
     plan_.models.push_back(std::move(m));
@@ -136,7 +142,9 @@ class ObjectBuilder {
     return m;
   }
 
-  double yaw_at(double s) const { return road_.reference(std::clamp(s, 0.0, road_.length)).heading + o_.hdg; }
+  double yaw_at(double s) const {
+    return road_.reference(std::clamp(s, 0.0, road_.length)).heading + o_.hdg;
+  }
 
   void single(const Instance& in);
   void outline(const Instance& in, const odr::Outline& ol, size_t k);
@@ -159,9 +167,9 @@ void ObjectBuilder::single(const Instance& in) {
   const double tall = in.height;
   if (type_ == "crosswalk") {
     const double half = 0.5 * std::max(in.width, 3.0);
-    const auto [t0, t1] = lane_span(road_, std::clamp(in.s, 0.0, road_.length),
-                                    road_.sections.front().min_lane_id(),
-                                    road_.sections.front().max_lane_id());
+    const auto [t0, t1] =
+        lane_span(road_, std::clamp(in.s, 0.0, road_.length), road_.sections.front().min_lane_id(),
+                  road_.sections.front().max_lane_id());
     paint_zebra(white_paint(plan_), road_, in.s - half, in.s + half, t0, t1);
   } else if (type_ == "tree") {
     catalog_model(in, "tree", tall);
@@ -197,7 +205,8 @@ void ObjectBuilder::single(const Instance& in) {
 void ObjectBuilder::catalog_model(const Instance& in, const std::string& kind,
                                   double natural_height) {
   const auto models = catalog_.of_kind(kind);
-  if (models.empty()) return plan_.warn(where_ + ": no " + kind + " model in the scenery catalog; skipped");
+  if (models.empty())
+    return plan_.warn(where_ + ": no " + kind + " model in the scenery catalog; skipped");
   const CatalogModel* m = models[stable_hash(road_.id + "/" + o_.id) % models.size()];
   Placement p;
   p.name = "object_" + road_.id + "_" + o_.id + in.suffix;
@@ -223,12 +232,14 @@ void ObjectBuilder::box(const Instance& in, const std::string& cls) {
     const double c = std::cos(yaw), sn = std::sin(yaw);
     std::vector<Vec3> corners;
     for (auto [u, v] : {std::pair{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}}) {
-      corners.push_back({base[0] + c * u * l - sn * v * w, base[1] + sn * u * l + c * v * w, base[2]});
+      corners.push_back(
+          {base[0] + c * u * l - sn * v * w, base[1] + sn * u * l + c * v * w, base[2]});
     }
     add_prism(m.mesh.part("wall", kWall), m.mesh.part("roof", kRoof), corners,
               std::vector<double>(4, h));
   } else {
-    MeshSet::add_box(m.mesh.part("solid", material()), {base[0], base[1], base[2] + 0.5 * h}, {l, w, h}, yaw);
+    MeshSet::add_box(m.mesh.part("solid", material()), {base[0], base[1], base[2] + 0.5 * h},
+                     {l, w, h}, yaw);
   }
   m.collisions.push_back({{base[0], base[1], base[2] + 0.5 * h}, {l, w, h}, yaw});
   plan_.models.push_back(std::move(m));
@@ -256,7 +267,8 @@ void ObjectBuilder::outline(const Instance& in, const odr::Outline& ol, size_t k
     } else {
       st.push_back({in.s + q.a * std::cos(rel) - q.b * std::sin(rel),
                     in.t + q.a * std::sin(rel) + q.b * std::cos(rel)});
-      world.push_back({origin[0] + c * q.a - sn * q.b, origin[1] + sn * q.a + c * q.b, origin[2] + q.z});
+      world.push_back(
+          {origin[0] + c * q.a - sn * q.b, origin[1] + sn * q.a + c * q.b, origin[2] + q.z});
     }
     flat.push_back({world.back()[0], world.back()[1]});
     heights.push_back(q.height > 0 ? q.height : in.height);
@@ -267,7 +279,8 @@ void ObjectBuilder::outline(const Instance& in, const odr::Outline& ol, size_t k
   if (type_ == "crosswalk") {
     double s0 = 1e300, s1 = -1e300, t0 = 1e300, t1 = -1e300;
     for (const Vec2& p : st) {
-      s0 = std::min(s0, p[0]), s1 = std::max(s1, p[0]), t0 = std::min(t0, p[1]), t1 = std::max(t1, p[1]);
+      s0 = std::min(s0, p[0]), s1 = std::max(s1, p[0]), t0 = std::min(t0, p[1]),
+      t1 = std::max(t1, p[1]);
     }
     paint_zebra(white_paint(plan_), road_, s0, s1, t0, t1);
   } else if (type_ == "parkingspace") {

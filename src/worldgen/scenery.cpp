@@ -22,7 +22,9 @@ class Rng {
   double uniform(double a, double b) { return a + (b - a) * (next() >> 11) * 0x1.0p-53; }
   bool chance(double p) { return uniform(0, 1) < p; }
   template <typename T>
-  const T& pick(const std::vector<T>& v) { return v[next() % v.size()]; }
+  const T& pick(const std::vector<T>& v) {
+    return v[next() % v.size()];
+  }
 
  private:
   uint64_t state_;
@@ -45,7 +47,8 @@ class Scatterer {
  public:
   Scatterer(const Catalog& catalog, Scenery kind, uint64_t seed, Occupancy& occ, WorldPlan& plan)
       : catalog_(catalog), kind_(kind), rng_(seed), occ_(occ), plan_(plan) {
-    for (const char* k : {"building", "tree", "shrub", "street_light", "bench", "bin", "bus_stop"}) {
+    for (const char* k :
+         {"building", "tree", "shrub", "street_light", "bench", "bin", "bus_stop"}) {
       models_[k] = catalog.of_kind(k);
     }
   }
@@ -91,7 +94,8 @@ class Scatterer {
 
   void rows(const odr::Road& road, int side, double t_min, double t_max, double gap_min,
             double gap_max, double bush) {
-    for (double s = rng_.uniform(0, gap_max); s < road.length; s += rng_.uniform(gap_min, gap_max)) {
+    for (double s = rng_.uniform(0, gap_max); s < road.length;
+         s += rng_.uniform(gap_min, gap_max)) {
       const double offset = rng_.uniform(t_min, t_max);
       place(road, s, side, offset, rng_.chance(bush) ? any("shrub") : any("tree"));
     }
@@ -102,11 +106,15 @@ class Scatterer {
     double next_light = rng_.uniform(5, 20), next_stop = rng_.uniform(60, 160);
     for (double s = 2; s < road.length - 2; s += 1) {
       if (s >= next_light) {
-        if (place(road, s, side, 0.4, any("street_light"), 0.1) > 0) next_light = s + rng_.uniform(24, 34);
-        else next_light = s + 2;
+        if (place(road, s, side, 0.4, any("street_light"), 0.1) > 0)
+          next_light = s + rng_.uniform(24, 34);
+        else
+          next_light = s + 2;
       } else if (s >= next_stop && side < 0) {
-        if (place(road, s, side, 0.5, any("bus_stop"), 0.2) > 0) next_stop = s + rng_.uniform(200, 320);
-        else next_stop = s + 3;
+        if (place(road, s, side, 0.5, any("bus_stop"), 0.2) > 0)
+          next_stop = s + rng_.uniform(200, 320);
+        else
+          next_stop = s + 3;
       } else if (rng_.chance(0.03)) {
         place(road, s, side, 0.4, any(rng_.chance(0.5) ? "bench" : "bin"), 0.1);
       }

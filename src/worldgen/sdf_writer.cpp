@@ -79,7 +79,8 @@ void write_placement(std::ostream& out, const Placement& p, const std::string& n
     if (v.colour) {
       const auto& c = *v.colour;
       const std::string rgb = num(c[0]) + " " + num(c[1]) + " " + num(c[2]) + " 1";
-      out << "<material><ambient>" << rgb << "</ambient><diffuse>" << rgb << "</diffuse></material>";
+      out << "<material><ambient>" << rgb << "</ambient><diffuse>" << rgb
+          << "</diffuse></material>";
     }
     out << "</visual>\n";
   }
@@ -134,8 +135,8 @@ void write_world(const WorldPlan& plan, const fs::path& dir, const WriteOptions&
       << "      <direction>-0.3 0.4 -0.85</direction>\n    </light>\n"
       << "    <model name='road'>\n      <static>true</static>\n      <link name='link'>\n"
       << "        <collision name='ground'><pose>" << num(cx) << " " << num(cy) << " "
-      << num(plan.plane_z) << " 0 0 0</pose><geometry><plane><normal>0 0 1</normal><size>" << num(sx) << " "
-      << num(sy) << "</size></plane></geometry></collision>\n"
+      << num(plan.plane_z) << " 0 0 0</pose><geometry><plane><normal>0 0 1</normal><size>"
+      << num(sx) << " " << num(sy) << "</size></plane></geometry></collision>\n"
       << "        <visual name='ground'><cast_shadows>false</cast_shadows><geometry><mesh><uri>"
          "meshes/ground.obj</uri></mesh></geometry></visual>\n";
   if (plan.height_field) {
@@ -144,7 +145,8 @@ void write_world(const WorldPlan& plan, const fs::path& dir, const WriteOptions&
     const HeightField& f = *plan.height_field;
     write_pgm(f, dir / "meshes/road_heights.pgm");
     const double sx = (f.columns - 1) * f.cell, sy = (f.rows - 1) * f.cell;
-    out << "        <collision name='surface'><geometry><heightmap><uri>meshes/road_heights.pgm</uri>"
+    out << "        <collision "
+           "name='surface'><geometry><heightmap><uri>meshes/road_heights.pgm</uri>"
         << "<size>" << num(sx) << " " << num(sy) << " " << num(std::max(1e-6, f.max() - f.min()))
         << "</size><pos>" << num(f.x0 + 0.5 * sx) << " " << num(f.y0 + 0.5 * sy) << " "
         << num(f.min()) << "</pos></heightmap></geometry></collision>\n";

@@ -57,7 +57,8 @@ std::vector<std::array<size_t, 3>> triangulate(const std::vector<Vec2>& polygon)
       if (cross(polygon[a], polygon[b], polygon[c]) <= 0) continue;  // reflex
       bool ear = true;
       for (size_t m : idx) {
-        if (m != a && m != b && m != c && inside_triangle(polygon[m], polygon[a], polygon[b], polygon[c])) {
+        if (m != a && m != b && m != c &&
+            inside_triangle(polygon[m], polygon[a], polygon[b], polygon[c])) {
           ear = false;
           break;
         }
@@ -92,8 +93,10 @@ void add_prism(Part& walls, Part& roof, const std::vector<Vec3>& base,
     const Vec3 pt = {p[0], p[1], top}, qt = {q[0], q[1], top};
     if (uv_metres > 0) {
       const double u0 = along / uv_metres, u1 = (along + len) / uv_metres;
-      const std::array<std::array<double, 2>, 4> uv = {
-          {{u0, p[2] / uv_metres}, {u1, q[2] / uv_metres}, {u1, top / uv_metres}, {u0, top / uv_metres}}};
+      const std::array<std::array<double, 2>, 4> uv = {{{u0, p[2] / uv_metres},
+                                                        {u1, q[2] / uv_metres},
+                                                        {u1, top / uv_metres},
+                                                        {u0, top / uv_metres}}};
       MeshSet::add_quad(walls, p, q, qt, pt, &uv);
     } else {
       MeshSet::add_quad(walls, p, q, qt, pt);

@@ -28,8 +28,8 @@ void add_prism(Part& walls, Part& roof, const std::vector<Vec3>& base,
 // A ribbon: a box-like solid swept along a path; at each station a centre point (its base),
 // a width across and a height. Sides, top and the two end caps.
 struct RibbonStation {
-  Vec3 base;        // centre of the ribbon's foot
-  Vec2 across;      // unit vector across the path (left)
+  Vec3 base;    // centre of the ribbon's foot
+  Vec2 across;  // unit vector across the path (left)
   double width = 0;
   double height = 0;
 };

@@ -29,9 +29,7 @@ double speed_kmh(const odr::Signal& sig, double scale = 1) {
   return v;
 }
 
-SignalClass sign(const char* type, double value = 0) {
-  return {SignalKind::kSign, type, value};
-}
+SignalClass sign(const char* type, double value = 0) { return {SignalKind::kSign, type, value}; }
 
 // Germany's StVO numbers, which the OpenDRIVE catalogue and VIRES maps use under country
 // "DE" or "OpenDRIVE".
@@ -153,8 +151,8 @@ void place_signals(const odr::Network& net, const Catalog& catalog, WorldPlan& p
         }
         case SignalKind::kTrafficLight:
         case SignalKind::kPedestrianLight: {
-          const auto lights = catalog.of_kind(c.kind == SignalKind::kTrafficLight ? "traffic_light"
-                                                                                  : "pedestrian_light");
+          const auto lights = catalog.of_kind(
+              c.kind == SignalKind::kTrafficLight ? "traffic_light" : "pedestrian_light");
           if (lights.empty()) {
             plan.warn(where + ": no traffic light model in the scenery catalog; skipped");
             break;

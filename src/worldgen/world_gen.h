@@ -32,10 +32,10 @@ struct WorldOptions {
 };
 
 struct WorldStats {
-  size_t triangles = 0;      // generated geometry (road, ground, solids), without catalog models
-  size_t models = 0;         // models in the world, the road included
-  size_t placements = 0;     // catalog models placed
-  size_t signals = 0;        // traffic lights and signs placed
+  size_t triangles = 0;   // generated geometry (road, ground, solids), without catalog models
+  size_t models = 0;      // models in the world, the road included
+  size_t placements = 0;  // catalog models placed
+  size_t signals = 0;     // traffic lights and signs placed
   std::vector<std::string> warnings;
 };
 

@@ -8,8 +8,8 @@
 
 #include "opendrive/network.h"
 #include "worldgen/catalog.h"
-#include "worldgen/mesh_set.h"
 #include "worldgen/height_field.h"
+#include "worldgen/mesh_set.h"
 
 namespace convoy::worldgen {
 
@@ -42,9 +42,9 @@ struct WorldPlan {
   MeshSet road;    // surfaces, marks, stop lines, crosswalks, parking bays, embankments
   MeshSet ground;  // the ground plane and the horizon
   double ground_z = 0;
-  double plane_z = 0;                     // the collision plane under everything
+  double plane_z = 0;                       // the collision plane under everything
   std::optional<HeightField> height_field;  // the roads' surface where it is not flat
-  opendrive::Bounds bounds;  // of the roads
+  opendrive::Bounds bounds;                 // of the roads
   std::vector<MeshModel> models;
   std::vector<Placement> placements;
   std::vector<std::string> warnings;  // "road 3 signal 12: ..." each skipped element

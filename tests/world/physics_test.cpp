@@ -304,7 +304,8 @@ TEST(Physics, BallsRollOnTheSurfaceOfAHeightmap) {
   const double at[3][2] = {{3, -5}, {8, 0}, {1, 1}};
   for (int i = 0; i < 3; ++i) {
     boxes += "<model name='box" + std::to_string(i) + "'><pose>" + std::to_string(at[i][0]) + " " +
-             std::to_string(at[i][1]) + " 6 0 0 0</pose><link name='body'><inertial><mass>1</mass>"
+             std::to_string(at[i][1]) +
+             " 6 0 0 0</pose><link name='body'><inertial><mass>1</mass>"
              "</inertial><collision name='c'><geometry><sphere><radius>0.05</radius></sphere>"
              "</geometry></collision></link></model>";
   }

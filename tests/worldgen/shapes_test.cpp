@@ -1,9 +1,10 @@
 // The world generator's polygon helpers and signal classification.
+#include "worldgen/shapes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "worldgen/shapes.h"
 #include "worldgen/signals.h"
 
 namespace wg = convoy::worldgen;
@@ -56,8 +57,9 @@ TEST(SignalClassTest, KnowsTheCataloguesTheMapsUse) {
             wg::SignalKind::kPedestrianLight);
   EXPECT_EQ(wg::classify_signal(signal("OpenDRIVE", "294", "-1", NAN)).kind,
             wg::SignalKind::kStopLine);
-  EXPECT_EQ(wg::classify_signal(signal("OpenDRIVE", "1000003", "-1", 4, "SgRMCrosswalk-2Lanes")).kind,
-            wg::SignalKind::kCrosswalk);
+  EXPECT_EQ(
+      wg::classify_signal(signal("OpenDRIVE", "1000003", "-1", 4, "SgRMCrosswalk-2Lanes")).kind,
+      wg::SignalKind::kCrosswalk);
   const auto de = wg::classify_signal(signal("DE", "274", "", 70));
   EXPECT_EQ(de.sign_type, "speed_limit");
   EXPECT_EQ(de.value, 70);

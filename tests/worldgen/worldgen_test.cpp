@@ -85,26 +85,31 @@ TEST_F(WorldGenTest, EveryEsminiMapBecomesAWorldWithItsMeshes) {
     const std::string text = slurp(world);
     const std::regex uri("<uri>(meshes/[^<]+)</uri>");
     int own = 0;
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), uri); it != std::sregex_iterator(); ++it) {
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), uri);
+         it != std::sregex_iterator(); ++it) {
       EXPECT_TRUE(fs::exists(dir_ / map.stem() / (*it)[1].str())) << (*it)[1].str();
       ++own;
     }
     EXPECT_GE(own, 2);  // the road and the ground
-    EXPECT_FALSE(fs::exists(dir_ / (map.stem().string() + ".partial-" + std::to_string(::getpid()))));
+    EXPECT_FALSE(
+        fs::exists(dir_ / (map.stem().string() + ".partial-" + std::to_string(::getpid()))));
   }
 }
 
 TEST_F(WorldGenTest, SceneryNeverStandsOnALane) {
-  for (const char* name : {"fabriksgatan.xodr", "e6mini.xodr", "multi_intersections.xodr", "curves.xodr"}) {
+  for (const char* name :
+       {"fabriksgatan.xodr", "e6mini.xodr", "multi_intersections.xodr", "curves.xodr"}) {
     SCOPED_TRACE(name);
     const odr::Network net = odr::load(std::string(CONVOY_ESMINI_MAPS) + "/" + name);
     const auto stats = wg::generate_world(net, catalog_, {wg::Scenery::kUrban, 7}, dir_ / "w");
     wg::Occupancy lanes(odr::network_bounds(net), 60);
     lanes.mark_roads(net, 0.0);
     const std::string text = slurp(dir_ / "w" / "world.sdf");
-    const std::regex pose("<model name='scenery_[0-9]+'>\\s*<static>true</static>\\s*<pose>([-0-9.]+) ([-0-9.]+)");
+    const std::regex pose(
+        "<model name='scenery_[0-9]+'>\\s*<static>true</static>\\s*<pose>([-0-9.]+) ([-0-9.]+)");
     int n = 0;
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), pose); it != std::sregex_iterator(); ++it) {
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), pose);
+         it != std::sregex_iterator(); ++it) {
       const double x = std::stod((*it)[1].str()), y = std::stod((*it)[2].str());
       EXPECT_FALSE(lanes.taken(x, y)) << "scenery at " << x << ", " << y;
       ++n;
@@ -125,32 +130,41 @@ TEST_F(WorldGenTest, TheSameSeedGivesTheSameWorldAndAnotherSeedAnother) {
 }
 
 TEST_F(WorldGenTest, SignalsBecomeLightsSignsAndPaint) {
-  const auto stats = make(fs::path(CONVOY_ESMINI_MAPS) / "multi_intersections.xodr", "m", wg::Scenery::kNone);
+  const auto stats =
+      make(fs::path(CONVOY_ESMINI_MAPS) / "multi_intersections.xodr", "m", wg::Scenery::kNone);
   const std::string text = slurp(dir_ / "m/world.sdf");
-  EXPECT_NE(text.find("<plugin name='convoy_signal' filename='convoy_signal'><signal>"), std::string::npos);
+  EXPECT_NE(text.find("<plugin name='convoy_signal' filename='convoy_signal'><signal>"),
+            std::string::npos);
   EXPECT_NE(text.find("<class>traffic_light</class>"), std::string::npos);
   EXPECT_NE(text.find("<class>sign</class>"), std::string::npos);
   EXPECT_GT(stats.signals, 50u);
   // stop lines and crosswalks are paint: more white triangles than the lane marks alone
   odr::MeshOptions plain;
   plain.lane_materials = true;
-  const auto marks = odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/multi_intersections.xodr"), plain)
-                         .parts.at(odr::SurfaceKind::kMarkWhite).triangles.size();
+  const auto marks =
+      odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/multi_intersections.xodr"),
+                           plain)
+          .parts.at(odr::SurfaceKind::kMarkWhite)
+          .triangles.size();
   size_t faces = 0;
   for (const std::string& obj : road_tiles(dir_ / "m")) {
     const size_t at = obj.find("o mark_white");
     if (at == std::string::npos) continue;
     const size_t end = obj.find("\no ", at + 1);
-    const std::string part = obj.substr(at, end == std::string::npos ? std::string::npos : end - at);
-    for (size_t p = part.find("\nf "); p != std::string::npos; p = part.find("\nf ", p + 1)) ++faces;
+    const std::string part =
+        obj.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    for (size_t p = part.find("\nf "); p != std::string::npos; p = part.find("\nf ", p + 1))
+      ++faces;
   }
   EXPECT_GT(faces, marks + 100);
 }
 
 TEST_F(WorldGenTest, UnknownSignalsAreWarningsNamingTheRoadAndSignal) {
-  const auto stats = make(fs::path(CONVOY_ESMINI_MAPS) / "straight_500m_signs.xodr", "s", wg::Scenery::kNone);
+  const auto stats =
+      make(fs::path(CONVOY_ESMINI_MAPS) / "straight_500m_signs.xodr", "s", wg::Scenery::kNone);
   bool named = false;
-  for (const auto& w : stats.warnings) named |= w.find("road 1 signal 14 (overtaking_ban_begin)") == 0;
+  for (const auto& w : stats.warnings)
+    named |= w.find("road 1 signal 14 (overtaking_ban_begin)") == 0;
   EXPECT_TRUE(named);
   EXPECT_GE(stats.signals, 10u);
 }
@@ -161,8 +175,10 @@ TEST_F(WorldGenTest, ObjectsTunnelsAndRepeatsBecomeModels) {
   EXPECT_NE(tunnels.find("<model name='tunnel_1_1'>"), std::string::npos);
   make(fs::path(CONVOY_ESMINI_MAPS) / "e6mini.xodr", "e", wg::Scenery::kNone);
   const std::string e6 = slurp(dir_ / "e/world.sdf");
-  EXPECT_NE(e6.find("<model name='object_0_4_sweep'>"), std::string::npos);  // a railing along the road
-  EXPECT_NE(e6.find("<model name='object_0_2_posts'>"), std::string::npos);    // rail poles every 4 m, one model
+  EXPECT_NE(e6.find("<model name='object_0_4_sweep'>"),
+            std::string::npos);  // a railing along the road
+  EXPECT_NE(e6.find("<model name='object_0_2_posts'>"),
+            std::string::npos);  // rail poles every 4 m, one model
   make(fs::path(CONVOY_ESMINI_MAPS) / "crest-curve.xodr", "c", wg::Scenery::kNone);
   const std::string crest = slurp(dir_ / "c/world.sdf");
   EXPECT_NE(crest.find("<class>building</class>"), std::string::npos);  // from an outline
@@ -171,15 +187,18 @@ TEST_F(WorldGenTest, ObjectsTunnelsAndRepeatsBecomeModels) {
 TEST_F(WorldGenTest, LaneTypesHaveTheirOwnMaterialsAndSuperelevationTilts) {
   odr::MeshOptions look;
   look.lane_materials = true;
-  const auto parking = odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/parking_demo.xodr"), look);
+  const auto parking =
+      odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/parking_demo.xodr"), look);
   EXPECT_TRUE(parking.parts.count(odr::SurfaceKind::kBiking));
   EXPECT_TRUE(parking.parts.count(odr::SurfaceKind::kShoulder));
-  const auto plain = odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/parking_demo.xodr"));
+  const auto plain =
+      odr::build_road_mesh(odr::load(std::string(CONVOY_ESMINI_MAPS) + "/parking_demo.xodr"));
   EXPECT_FALSE(plain.parts.count(odr::SurfaceKind::kBiking));  // the shipped maps' look is kept
   const odr::Network velodrome = odr::load(std::string(CONVOY_ESMINI_MAPS) + "/velodrome.xodr");
   const odr::Road& road = velodrome.roads.front();
   double tilt = 0;
-  for (double s = 0; s < road.length; s += 10) tilt = std::max(tilt, std::abs(road.superelevation_at(s)));
+  for (double s = 0; s < road.length; s += 10)
+    tilt = std::max(tilt, std::abs(road.superelevation_at(s)));
   EXPECT_GT(tilt, 0.1);
   const auto mesh = odr::build_road_mesh(velodrome, look);
   double zmin = 1e9, zmax = -1e9;
@@ -206,7 +225,8 @@ TEST_F(WorldGenTest, WhatCannotBeBuiltIsSkippedWithAWarningNamingIt) {
   const odr::Network net = odr::load(map.string(), lenient);
   ASSERT_EQ(net.roads.size(), 1u);
   bool road2 = false;
-  for (const auto& w : net.warnings) road2 |= w.find("road 2") != std::string::npos && w.find("skipped") != std::string::npos;
+  for (const auto& w : net.warnings)
+    road2 |= w.find("road 2") != std::string::npos && w.find("skipped") != std::string::npos;
   EXPECT_TRUE(road2);
   const auto stats = wg::generate_world(net, catalog_, {wg::Scenery::kRoadside, 1}, dir_ / "bad");
   auto said = [&](const std::string& what) {
@@ -245,9 +265,11 @@ TEST_F(WorldGenTest, HillyMapsCollideAsAHeightFieldOfTheirRoads) {
   make(fs::path(CONVOY_ESMINI_MAPS) / "crest-curve.xodr", "hill", wg::Scenery::kNone);
   const std::string hill = slurp(dir_ / "hill/world.sdf");
   EXPECT_NE(hill.find("<heightmap><uri>meshes/road_heights.pgm</uri>"), std::string::npos);
-  EXPECT_EQ(slurp(dir_ / "hill/meshes/road_heights.pgm").rfind("P5\n" + std::to_string(f.columns) + " " +
-                                                                std::to_string(f.rows) + "\n65535\n", 0),
-            0u);
+  EXPECT_EQ(
+      slurp(dir_ / "hill/meshes/road_heights.pgm")
+          .rfind("P5\n" + std::to_string(f.columns) + " " + std::to_string(f.rows) + "\n65535\n",
+                 0),
+      0u);
   make(fs::path(CONVOY_ESMINI_MAPS) / "straight_500m.xodr", "flat", wg::Scenery::kNone);
   EXPECT_EQ(slurp(dir_ / "flat/world.sdf").find("<heightmap>"), std::string::npos);
 }

@@ -46,7 +46,7 @@ namespace fs = std::filesystem;
 
 int world_command(const std::vector<std::string>& positional,
                   const std::map<std::string, std::string>& options);  // world_command.cpp
-nlohmann::json stop_lines_json(const odr::LaneGraph& g);              // query_signals.cpp
+nlohmann::json stop_lines_json(const odr::LaneGraph& g);               // query_signals.cpp
 
 namespace {
 
@@ -522,7 +522,8 @@ nlohmann::json query_one(const odr::LaneGraph& g, const nlohmann::json& q) {
     return {{"roads", roads}, {"signals", signals}};
   }
   if (op == "stop_lines") return {{"stop_lines", stop_lines_json(g)}};
-  throw std::runtime_error("unknown op '" + op + "' (pose, locate, follow, route, info, stop_lines)");
+  throw std::runtime_error("unknown op '" + op +
+                           "' (pose, locate, follow, route, info, stop_lines)");
 }
 
 int cmd_query(const Args& args) {

@@ -5,8 +5,8 @@
 // its road that traffic drives into (the junction's edge).
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "opendrive/lane_graph.h"
 #include "worldgen/markings.h"

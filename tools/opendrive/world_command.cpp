@@ -31,8 +31,9 @@ int world_command(const std::vector<std::string>& positional,
     wo.seed = v;
   } catch (const std::invalid_argument& e) {
     const std::string what = e.what();
-    std::fprintf(stderr, "convoy-odr world: %s\n",
-                 what == "x" || what == "stoull" ? "--seed must be a whole number >= 0" : what.c_str());
+    std::fprintf(
+        stderr, "convoy-odr world: %s\n",
+        what == "x" || what == "stoull" ? "--seed must be a whole number >= 0" : what.c_str());
     return 2;
   }
   catalog_file = option("catalog", wg::Catalog::default_path().string());
@@ -59,9 +60,10 @@ int world_command(const std::vector<std::string>& positional,
     std::fprintf(stderr, "warning: %s: %s\n", positional[0].c_str(), w.c_str());
   }
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("%s/world.sdf: %zu models (%zu placed, %zu signals), %zu triangles generated, "
-              "%zu warnings, in %.3f s\n",
-              positional[1].c_str(), stats.models, stats.placements, stats.signals, stats.triangles,
-              stats.warnings.size(), s);
+  std::printf(
+      "%s/world.sdf: %zu models (%zu placed, %zu signals), %zu triangles generated, "
+      "%zu warnings, in %.3f s\n",
+      positional[1].c_str(), stats.models, stats.placements, stats.signals, stats.triangles,
+      stats.warnings.size(), s);
   return 0;
 }
