@@ -516,7 +516,8 @@ void CameraSensors::draw_noise(Camera& cam) {
 
 void CameraSensors::convert(const Camera& cam, std::span<uint8_t> dst) const {
   // The one copy of a frame in this process: the read-back RGBA, with the noise, into the
-  // datapack (in the outgoing shared memory for a large frame).
+  // datapack (in the outgoing shared memory for a large frame). Split in two halves of
+  // pixels over two threads: the renderer's wait on the second core.
   const size_t pixels = static_cast<size_t>(cam.frame.width) * cam.frame.height;
   const uint8_t* src = cam.frame.rgba.data();
   const int16_t* noise = cam.noise_at;
@@ -526,22 +527,28 @@ void CameraSensors::convert(const Camera& cam, std::span<uint8_t> dst) const {
     return static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
   };
   if (cam.depth_channels == 1) {
-    for (size_t p = 0; p < pixels; ++p) {
-      int r = src[4 * p], g = src[4 * p + 1], b = src[4 * p + 2];
-      if (noise) r = noisy(p, 0), g = noisy(p, 1), b = noisy(p, 2);
-      dst[p] = static_cast<uint8_t>((299 * r + 587 * g + 114 * b + 500) / 1000);
-    }
-  } else {
-    // Two passes over the destination (RGBA to RGB, then the noise), each a vectorised loop.
-    render::rgba_to_rgb(src, dst.data(), pixels);
-    if (!noise) return;
-    uint8_t* px = dst.data();
-    const size_t n = dst.size();
-    for (size_t i = 0; i < n; ++i) {
-      const int v = px[i] + noise[i];
-      px[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
-    }
+    split_.run(pixels, [&](size_t begin, size_t end) {
+      for (size_t p = begin; p < end; ++p) {
+        int r = src[4 * p], g = src[4 * p + 1], b = src[4 * p + 2];
+        if (noise) r = noisy(p, 0), g = noisy(p, 1), b = noisy(p, 2);
+        dst[p] = static_cast<uint8_t>((299 * r + 587 * g + 114 * b + 500) / 1000);
+      }
+    });
+    return;
   }
+  // Two passes over each half (RGBA to RGB, then the noise), each a vectorised loop.
+  split_.run(
+      pixels,
+      [&](size_t begin, size_t end) {
+        render::rgba_to_rgb(src + 4 * begin, dst.data() + 3 * begin, end - begin);
+        if (!noise) return;
+        uint8_t* px = dst.data();
+        for (size_t i = 3 * begin; i < 3 * end; ++i) {
+          const int v = px[i] + noise[i];
+          px[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
+        }
+      },
+      64);
 }
 
 void CameraSensors::image_datapack(size_t i, datapack::Builder& out) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/two_way.h"
 #include "datapack/datapack.h"
 #include "physics_world.h"
 #include "render/renderer.h"
@@ -163,6 +164,7 @@ class CameraSensors {
       visual_instances_;                                  // (link, visual) -> scene instances
   std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
   std::mt19937_64 rng_;
+  mutable TwoWay split_;  // the frame conversion's second thread
   double now_ = 0;
   std::vector<render::Light> base_lights_;
   std::vector<bool> street_light_;  // by base light

@@ -46,10 +46,21 @@ float attenuation(int i, float dist) {
 // looked up a little along the normal (u_shadow_bias.x metres) and closer to the light
 // (u_shadow_bias.y, depth units) against self-shadowing. Outside the map: lit.
 uniform highp sampler2DShadow u_shadow_map;
-uniform highp mat4 u_shadow_matrix;  // eye space -> the map's [0, 1] cube
 uniform vec2 u_shadow_bias;
+#ifdef SHADOW_VARYINGS
+// Per pixel, the map's coordinates come interpolated from the vertices' (exact: the map's
+// projection is affine), the normal's offset with them; g_shadow_side is -1 on the back of a
+// double-sided face.
+in vec3 v_shadow;
+in vec3 v_shadow_normal;
+float g_shadow_side = 1.0;
 float shadow_gain(vec3 p, vec3 n) {
-  vec4 s = u_shadow_matrix * vec4(p + n * u_shadow_bias.x, 1.0);
+  vec3 s = v_shadow + (g_shadow_side * u_shadow_bias.x) * v_shadow_normal;
+#else
+uniform highp mat4 u_shadow_matrix;  // eye space -> the map's [0, 1] cube
+float shadow_gain(vec3 p, vec3 n) {
+  vec3 s = (u_shadow_matrix * vec4(p + n * u_shadow_bias.x, 1.0)).xyz;
+#endif
   if (s.x <= 0.0 || s.x >= 1.0 || s.y <= 0.0 || s.y >= 1.0 || s.z >= 1.0) return 1.0;
   return texture(u_shadow_map, vec3(s.xy, s.z - u_shadow_bias.y));
 }
@@ -107,6 +118,11 @@ out vec3 v_added;  // plus this
 #endif
 #else
 out vec3 v_normal;
+#ifdef SHADOW_LIGHT
+uniform highp mat4 u_shadow_matrix;  // eye space -> the map's [0, 1] cube (affine)
+out vec3 v_shadow;                   // the vertex in the map
+out vec3 v_shadow_normal;            // its unit normal in the map
+#endif
 #endif
 #if defined(DEPTH) || !defined(PER_VERTEX) || defined(FOG)
 out vec3 v_position;  // eye space
@@ -131,6 +147,10 @@ void main() {
 #endif
 #else
   v_normal = normal;
+#ifdef SHADOW_LIGHT
+  v_shadow = (u_shadow_matrix * p).xyz;
+  v_shadow_normal = mat3(u_shadow_matrix) * normalize(normal);
+#endif
 #endif
 #ifdef TEXTURED
   v_uv = a_uv;
@@ -203,6 +223,9 @@ void main() {
   vec3 color = u_emissive.rgb + u_scene_ambient * u_ambient.rgb * tex;
   vec3 n = normalize(v_normal);
   if (u_double_sided && !gl_FrontFacing) n = -n;
+#ifdef SHADOW_VARYINGS
+  if (u_double_sided && !gl_FrontFacing) g_shadow_side = -1.0;
+#endif
   vec3 p = v_position;
   LIGHT_CALLS
   color += g_diffuse * u_diffuse.rgb * tex + g_specular * u_specular.rgb;
@@ -312,12 +335,16 @@ SurfaceProgram build_surface_program(const ProgramKey& key) {
     calls += std::string(f) + "(" + std::to_string(i) + ", p.xyz, n);\n  ";
   }
   // The lighting code goes into the stage that lights.
-  auto stage = [&](const char* source, bool lights_here) {
+  auto stage = [&](const char* source, bool lights_here, const std::string& more = "") {
     std::string s = replace_all(source, "LIGHTING_CODE", lights_here ? kLighting : "");
-    return header + replace_all(s, "LIGHT_CALLS", lights_here ? calls : "");
+    return header + more + replace_all(s, "LIGHT_CALLS", lights_here ? calls : "");
   };
+  // Lit per pixel, the shadow map's coordinates come from the vertex shader.
+  const bool shadow_varyings = key.shadow_light >= 0 && !key.per_vertex;
   SurfaceProgram p;
-  p.id = link(stage(kVertexShader, key.per_vertex), stage(kFragmentShader, !key.per_vertex));
+  p.id = link(
+      stage(kVertexShader, key.per_vertex),
+      stage(kFragmentShader, !key.per_vertex, shadow_varyings ? "#define SHADOW_VARYINGS\n" : ""));
   auto at = [&](const char* name) { return glGetUniformLocation(p.id, name); };
   p.model_view = at("u_model_view");
   p.normal_matrix = at("u_normal_matrix");

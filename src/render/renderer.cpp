@@ -16,6 +16,7 @@
 
 #include "core/memory.h"
 #include "render/egl_context.h"
+#include "render/frustum.h"
 #include "render/gl_program.h"
 #include "render/gpu_resources.h"
 #include "render/precipitation.h"
@@ -99,7 +100,22 @@ void full_extents(const Scene& scene, const glm::dmat4& view, const CameraSpec& 
 constexpr size_t kFlushEveryTriangles = 16384;
 
 // Bits of Draw::variant: which program draws it.
-constexpr unsigned kTextured = 1, kPerVertex = 2, kSpecular = 4;
+constexpr unsigned kTextured = 1, kPerVertex = 2, kSpecular = 4, kShadowed = 8;
+
+// Where this frame's shadow map lies: a square of 2 x half_size around `centre` in the light's
+// view (x, y), `depth` either side of it along the light (z).
+struct ShadowRegion {
+  bool valid = false;
+  glm::dmat4 light_view{1.0};
+  glm::dvec3 centre{0.0};
+  double half_size = 0, depth = 0;
+  // Whether a sphere (world centre, radius) can take a shadow from the map: any of it inside.
+  bool reaches(const glm::dvec3& world_centre, double r) const {
+    const glm::dvec3 lc(light_view * glm::dvec4(world_centre, 1));
+    return valid && std::abs(lc.x - centre.x) <= half_size + r &&
+           std::abs(lc.y - centre.y) <= half_size + r && std::abs(lc.z - centre.z) <= depth + r;
+  }
+};
 
 struct Draw {
   // Order: things around the camera (ground, walls) after the rest, so that what stands in
@@ -131,6 +147,7 @@ struct Renderer::Impl {
   int shadow_size = 0;
   glm::mat4 shadow_matrix{1.0f};
   glm::vec2 shadow_bias{0.0f};
+  ShadowRegion shadow_region;
   uint64_t frame_number = 0;
   std::map<GLuint, uint64_t> program_frame;  // frame whose uniforms a program holds
   GLint max_size = 0;
@@ -167,9 +184,11 @@ struct Renderer::Impl {
   void draw_precipitation(const Atmosphere& a, int width, int height);
   // The sky gradient where nothing was drawn (colour only).
   void draw_sky(const Sky& sky, const Pose& camera_world_pose, const CameraSpec& spec);
-  // Renders light `li`'s shadow map around the camera of `view` (world to eye); false when
-  // the light is too low to cast shadows.
-  bool render_shadow_map(const Scene& scene, int li, const glm::dmat4& view, const GpuScene& gpu);
+  // Renders light `li`'s shadow map around the camera of `view` (world to eye) with the
+  // casters whose shadow can fall into the camera's view; false when the light is too low to
+  // cast shadows.
+  bool render_shadow_map(const Scene& scene, int li, const glm::dmat4& view, const CameraSpec& spec,
+                         const GpuScene& gpu);
 
   const SurfaceProgram& program(const ProgramKey& key) {
     auto it = programs.find(key);
@@ -237,13 +256,12 @@ void Renderer::Impl::upload_frame_uniforms(const SurfaceProgram& p, const Scene&
 // Keeps the visible instances whose bounding sphere meets the view frustum, nearest first.
 void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
                                    const CameraSpec& spec) {
-  const double tx = std::tan(spec.hfov / 2), ty = tx * spec.height / spec.width;
-  const double focal_px = spec.width / 2.0 / tx;
+  const double focal_px = spec.width / 2.0 / std::tan(spec.hfov / 2);
   bool lights_have_specular = false;
   for (const Light& l : scene.lights()) {
     lights_have_specular |= l.specular[0] > 0 || l.specular[1] > 0 || l.specular[2] > 0;
   }
-  const double nx = std::sqrt(1 + tx * tx), ny = std::sqrt(1 + ty * ty);
+  const ViewFrustum frustum(spec);
   draws.clear();
   const auto& instances = scene.instances();
   instance_distance.assign(instances.size(), std::numeric_limits<float>::infinity());
@@ -257,9 +275,7 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
                                    glm::length(glm::dvec3(mv[2]))});
     const double r = b.radius * scale;
     instance_distance[i] = static_cast<float>(glm::length(c));
-    // Eye space looks down -z; each side plane passes through the eye.
-    if (c.z - r > -spec.near_clip || -c.z - r > spec.far_clip) continue;
-    if ((std::abs(c.x) + c.z * tx) / nx > r || (std::abs(c.y) + c.z * ty) / ny > r) continue;
+    if (frustum.misses_sphere(c, r)) continue;
     const glm::dmat3 normal = glm::transpose(glm::inverse(glm::dmat3(mv)));
     // Level of detail: the coarsest whose error, seen at the instance's nearest point, stays
     // within lod_pixel_error pixels.
@@ -277,8 +293,13 @@ void Renderer::Impl::collect_draws(const Scene& scene, const glm::dmat4& view,
         -c.z > r && !inst.material.double_sided && px_per_triangle < per_vertex_below;
     const auto& ks = inst.material.specular;
     const bool specular = lights_have_specular && (ks[0] > 0 || ks[1] > 0 || ks[2] > 0);
+    // Shadows are looked up only where the map reaches (outside it, all is lit anyway).
+    const glm::dvec3 world_centre(glm::make_mat4(inst.world_from_object.data()) *
+                                  glm::dvec4(b.centre[0], b.centre[1], b.centre[2], 1));
+    const bool shadowed = shadow_region.reaches(world_centre, r + shadow_bias.x);
     const unsigned variant = (inst.material.texture >= 0 ? kTextured : 0) |
-                             (per_vertex ? kPerVertex : 0) | (specular ? kSpecular : 0);
+                             (per_vertex ? kPerVertex : 0) | (specular ? kSpecular : 0) |
+                             (shadowed ? kShadowed : 0);
     draws.push_back(
         Draw{glm::length(c) < r, variant, -c.z, i, mesh, glm::mat4(mv), glm::mat3(normal)});
   }
@@ -295,6 +316,7 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
   stats.instances_drawn = static_cast<int>(draws.size());
   ++frame_number;
   const SurfaceProgram* program = nullptr;
+  const int shadow_light = key.shadow_light;
   unsigned variant = 0;
   int bound_mesh = -1;
   GLuint bound_texture = 0;
@@ -308,6 +330,7 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
       key.textured = variant & kTextured;
       key.per_vertex = variant & kPerVertex;
       key.specular = variant & kSpecular;
+      key.shadow_light = variant & kShadowed ? shadow_light : -1;
       program = &this->program(key);
       glUseProgram(program->id);
       if (program_frame[program->id] != frame_number) {
@@ -365,7 +388,7 @@ void Renderer::Impl::draw(ProgramKey key, const Scene& scene, const glm::dmat4& 
 }
 
 bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dmat4& view,
-                                       const GpuScene& gpu) {
+                                       const CameraSpec& spec, const GpuScene& gpu) {
   const Light& sun = scene.lights()[li];
   glm::dvec3 d(sun.direction[0], sun.direction[1], sun.direction[2]);
   if (!(glm::length(d) > 0)) return false;
@@ -415,6 +438,9 @@ bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dm
                                            -c.z - depth, -c.z + depth) *
                                 light_view;
 
+  const ViewFrustum frustum(spec);
+  const double lowest_seen = eye.z - spec.far_clip;
+
   glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
   glViewport(0, 0, size, size);
   const float far_depth = 1.0f;
@@ -443,6 +469,13 @@ bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dm
     if (std::abs(lc.x - c.x) > radius + r || std::abs(lc.y - c.y) > radius + r ||
         std::abs(lc.z - c.z) > depth + r)
       continue;
+    // Its shadow: the bounding sphere swept along the light down to the lowest point the
+    // camera can see; skipped when that misses the view.
+    const glm::dvec3 wc(world * glm::dvec4(b.centre[0], b.centre[1], b.centre[2], 1));
+    const double drop = std::clamp((wc.z + r - lowest_seen) / -d.z, 0.0, 2 * depth);
+    if (frustum.misses_capsule(glm::dvec3(view * glm::dvec4(wc, 1)),
+                               glm::dvec3(view * glm::dvec4(wc + drop * d, 1)), r))
+      continue;
     int mesh = inst.mesh;
     for (const Scene::Lod& lod : scene.mesh_lods()[inst.mesh]) {
       if (lod.error * scale > texel) break;
@@ -467,6 +500,7 @@ bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dm
   const glm::dmat4 to_unit = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5)) *
                              glm::scale(glm::dmat4(1.0), glm::dvec3(0.5));
   shadow_matrix = glm::mat4(to_unit * light_clip * camera_world);
+  shadow_region = ShadowRegion{true, light_view, c, radius, depth};
   shadow_bias = glm::vec2(static_cast<float>(1.5 * texel), static_cast<float>(0.05 / (2 * depth)));
   return true;
 }
@@ -584,11 +618,12 @@ void Renderer::render(const Scene& scene, const Pose& camera_world_pose, const C
   key.fog = scene.atmosphere().fog();
   key.surface_weather = scene.atmosphere().surface_weather();
   const glm::dmat4 view = glm::inverse(glm::make_mat4(camera_world_pose.data()) * kSdfFromGlCamera);
+  s.shadow_region.valid = false;
   if (scene.shadows().enabled) {
     const auto& lights = scene.lights();
     for (int i = 0; i < static_cast<int>(lights.size()); ++i) {
       if (lights[i].type != Light::kDirectional) continue;
-      if (s.render_shadow_map(scene, i, view, gpu)) {
+      if (s.render_shadow_map(scene, i, view, spec, gpu)) {
         key.shadow_light = i;
         glActiveTexture(GL_TEXTURE1);
         glBindTexture(GL_TEXTURE_2D, s.shadow_texture);
