@@ -233,6 +233,35 @@ TEST(RenderTest, AnInstanceThatCastsNoShadowLeavesNone) {
   EXPECT_NEAR(without.rgb[at], off.rgb[at], 2);  // lit as without shadows at all
 }
 
+TEST(RenderTest, ACasterOutOfViewShadowsWhatIsInView) {
+  // A tower off to the left, outside the view, with the sun behind it: its shadow falls
+  // across the ground in front of the camera, and must be there although the tower is not.
+  GET_RENDERER(renderer);
+  const CameraSpec spec{320, 240, 1.2, 0.1, 100};
+  Scene scene;
+  scene.set_ambient({0.2f, 0.2f, 0.2f, 1});
+  Light sun;
+  sun.direction = {0, -1, -1};
+  scene.add_light(sun);
+  scene.add_instance(scene.add_mesh(make_plane(80, 80)), plain(0.8f, 0.8f, 0.8f),
+                     make_pose(0, 0, -1.5));
+  scene.add_instance(scene.add_mesh(make_box(2, 2, 12)), plain(0.8f, 0.2f, 0.2f),
+                     make_pose(8, 12, 4.5));
+  const auto tower = project(spec, 8, 11, 4.5);
+  ASSERT_TRUE(tower[0] < 0 || tower[0] >= spec.width || tower[1] < 0 || tower[1] >= spec.height);
+  Shadows shadows;
+  shadows.enabled = true;
+  scene.set_shadows(shadows);
+  Frame on;
+  renderer->render(scene, identity_pose(), spec, &on);
+  auto grey = [&](double x, double y) {
+    const auto uv = project(spec, x, y, -1.5);
+    const uint8_t* p = &on.rgb[3 * (static_cast<int>(uv[1]) * on.width + static_cast<int>(uv[0]))];
+    return (p[0] + p[1] + p[2]) / 3.0;
+  };
+  EXPECT_LT(grey(8, 0), 0.5 * grey(4, 0));  // in the tower's shadow, and lit ground nearer
+}
+
 TEST(RenderTest, PointAndSpotLightsFadeWithDistanceAndCone) {
   GET_RENDERER(renderer);
   const CameraSpec spec{200, 150, 1.2, 0.1, 100};
