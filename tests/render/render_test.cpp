@@ -241,13 +241,13 @@ TEST(RenderTest, ACasterOutOfViewShadowsWhatIsInView) {
   Scene scene;
   scene.set_ambient({0.2f, 0.2f, 0.2f, 1});
   Light sun;
-  sun.direction = {0, -1, -1};
+  sun.direction = {0, -2, -1};  // 27 degrees up: a shadow twice as long as the tower is high
   scene.add_light(sun);
   scene.add_instance(scene.add_mesh(make_plane(80, 80)), plain(0.8f, 0.8f, 0.8f),
                      make_pose(0, 0, -1.5));
-  scene.add_instance(scene.add_mesh(make_box(2, 2, 12)), plain(0.8f, 0.2f, 0.2f),
-                     make_pose(8, 12, 4.5));
-  const auto tower = project(spec, 8, 11, 4.5);
+  scene.add_instance(scene.add_mesh(make_box(2, 2, 10)), plain(0.8f, 0.2f, 0.2f),
+                     make_pose(8, 20, 3.5));
+  const auto tower = project(spec, 8, 19, 3.5);
   ASSERT_TRUE(tower[0] < 0 || tower[0] >= spec.width || tower[1] < 0 || tower[1] >= spec.height);
   Shadows shadows;
   shadows.enabled = true;
