@@ -1,7 +1,10 @@
 #include "worldgen/markings.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <string>
+#include <vector>
 
 namespace convoy::worldgen {
 
@@ -68,6 +71,60 @@ void paint_zebra(Part& paint, const odr::Road& road, double s0, double s1, doubl
   for (int k = 0; k < bars; ++k) {
     const double a = t0 + margin + k * (bar + gap);
     paint_band(paint, road, s0, s1, a, a + bar);
+  }
+}
+
+namespace {
+
+// Convex pieces of an arrow in its own frame: u forward from its tail (0..5 m), v to its left.
+using Piece = std::vector<std::array<double, 2>>;
+
+void add_shaft(std::vector<Piece>& out, double u0, double u1, double half_width) {
+  out.push_back({{u0, -half_width}, {u1, -half_width}, {u1, half_width}, {u0, half_width}});
+}
+
+// A side arm leaving the shaft at u, its head pointing to side (+1 left, -1 right).
+void add_turn(std::vector<Piece>& out, double u, int side) {
+  const double w = 0.12, reach = 0.5;
+  Piece arm = {{u - w, 0}, {u + w, 0}, {u + w, side * reach}, {u - w, side * reach}};
+  Piece head = {{u - 0.4, side * reach}, {u + 0.4, side * reach}, {u, side * (reach + 0.6)}};
+  if (side < 0) {  // keep them counter-clockwise
+    std::reverse(arm.begin(), arm.end());
+    std::reverse(head.begin(), head.end());
+  }
+  out.push_back(arm);
+  out.push_back(head);
+}
+
+std::vector<Piece> arrow_pieces(const std::string& directions) {
+  const bool straight = directions.find("straight") != std::string::npos;
+  const bool left = directions.find("left") != std::string::npos;
+  const bool right = directions.find("right") != std::string::npos;
+  std::vector<Piece> out;
+  if (straight) {
+    add_shaft(out, 0, 3.6, 0.12);
+    out.push_back({{3.6, -0.4}, {5.0, 0}, {3.6, 0.4}});
+  } else {
+    add_shaft(out, 0, 3.2, 0.12);
+  }
+  // Turns leave the shaft near its end, or halfway when the arrow also goes straight on.
+  const double at = straight ? 2.0 : 3.0;
+  if (left) add_turn(out, at, +1);
+  if (right) add_turn(out, at, -1);
+  return out;
+}
+
+}  // namespace
+
+void paint_arrow(Part& paint, const odr::Road& road, double s, double t, int dir,
+                 const std::string& directions) {
+  for (const Piece& piece : arrow_pieces(directions)) {
+    std::vector<Vec3> corners;
+    for (const auto& [u, v] : piece) {
+      const double ps = std::clamp(s + dir * (u - 2.5), 0.0, road.length);
+      corners.push_back(road_point(road, ps, t + dir * v, kPaintHeight));
+    }
+    MeshSet::add_convex(paint, corners);
   }
 }
 

@@ -2,6 +2,7 @@
 // from the map's signals and objects. Drawn into the road's white-mark part.
 #pragma once
 
+#include <string>
 #include <utility>
 
 #include "opendrive/network.h"
@@ -27,6 +28,10 @@ void paint_band(Part& paint, const opendrive::Road& road, double s0, double s1, 
 // Zebra stripes over [s0, s1] x [t0, t1]: bars along s, `bar` wide with `gap` between them.
 void paint_zebra(Part& paint, const opendrive::Road& road, double s0, double s1, double t0,
                  double t1, double bar = 0.5, double gap = 0.5);
+// A lane arrow centred at (s, t), 5 m long, pointing along s (dir +1) or against it (-1):
+// `directions` names its heads ("straight", "left", "right", or several joined by '_').
+void paint_arrow(Part& paint, const opendrive::Road& road, double s, double t, int dir,
+                 const std::string& directions);
 // The outline of a rectangle in world coordinates (corners counter-clockwise), lines `width`.
 void paint_outline(Part& paint, const std::vector<Vec3>& corners, double width);
 

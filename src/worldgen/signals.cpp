@@ -59,6 +59,18 @@ SignalClass classify_se(const odr::Signal& sig) {
   return {};
 }
 
+// An arrow's directions from its name: straight, left and right in that order, joined by
+// '_'; straight when the name says none.
+std::string arrow_directions(const std::string& name) {
+  std::string out;
+  for (const char* d : {"straight", "left", "right"}) {
+    if (!contains(name, d)) continue;
+    if (!out.empty()) out += '_';
+    out += d;
+  }
+  return out.empty() ? "straight" : out;
+}
+
 }  // namespace
 
 SignalClass classify_signal(const odr::Signal& sig) {
@@ -69,6 +81,10 @@ SignalClass classify_signal(const odr::Signal& sig) {
   if (sig.type == "1000003") return {SignalKind::kTrafficLight, "", 0};
   if (contains(sig.name, "holdingline") || contains(sig.name, "stopline")) {
     return {SignalKind::kStopLine, "", 0};
+  }
+  if (contains(sig.name, "arrow") ||
+      ((country == "de" || country == "opendrive") && sig.type == "297")) {
+    return {SignalKind::kArrow, arrow_directions(sig.name), 0};
   }
   if (country == "de" || country == "opendrive" || country.empty()) {
     if (SignalClass c = classify_de(sig); c.kind != SignalKind::kUnknown) return c;
@@ -149,6 +165,10 @@ void place_signals(const odr::Network& net, const Catalog& catalog, WorldPlan& p
           paint_zebra(white_paint(plan), road, s - 0.5 * len, s + 0.5 * len, t0, t1);
           break;
         }
+        case SignalKind::kArrow:
+          paint_arrow(white_paint(plan), road, s, sig.t, sig.orientation == "-" ? -1 : 1,
+                      c.sign_type);
+          break;
         case SignalKind::kTrafficLight:
         case SignalKind::kPedestrianLight: {
           const auto lights = catalog.of_kind(

@@ -17,12 +17,13 @@ enum class SignalKind {
   kSign,             // stop, yield, no_entry, speed_limit, priority, warning
   kStopLine,         // 294 (DE) / a holding line
   kCrosswalk,        // a crosswalk marking given as a signal
+  kArrow,            // an arrow painted on a lane (297 (DE), VIRES' SgRMArrow*)
   kUnknown,
 };
 
 struct SignalClass {
   SignalKind kind = SignalKind::kUnknown;
-  std::string sign_type;  // for kSign
+  std::string sign_type;  // for kSign; for kArrow its directions ("straight_right", "left")
   double value = 0;       // speed limits: km/h
 };
 

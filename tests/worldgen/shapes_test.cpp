@@ -72,4 +72,12 @@ TEST(SignalClassTest, KnowsTheCataloguesTheMapsUse) {
   EXPECT_EQ(wg::classify_signal(signal("se", "c", "27", 1)).kind, wg::SignalKind::kUnknown);
   EXPECT_EQ(wg::classify_signal(signal("OpenDRIVE", "-1", "-1", NAN)).kind,
             wg::SignalKind::kUnknown);
+  const auto arrow =
+      wg::classify_signal(signal("OpenDRIVE", "-1", "-1", NAN, "SgRMArrowStraightRight.flt"));
+  EXPECT_EQ(arrow.kind, wg::SignalKind::kArrow);
+  EXPECT_EQ(arrow.sign_type, "straight_right");
+  EXPECT_EQ(
+      wg::classify_signal(signal("OpenDRIVE", "-1", "-1", NAN, "SgRMArrowLeft.flt")).sign_type,
+      "left");
+  EXPECT_EQ(wg::classify_signal(signal("DE", "297", "", NAN)).sign_type, "straight");
 }

@@ -12,6 +12,7 @@
 
 #include "opendrive/parser.h"
 #include "worldgen/height_field.h"
+#include "worldgen/markings.h"
 #include "worldgen/scenery.h"
 #include "worldgen/world_gen.h"
 
@@ -157,6 +158,8 @@ TEST_F(WorldGenTest, SignalsBecomeLightsSignsAndPaint) {
       ++faces;
   }
   EXPECT_GT(faces, marks + 100);
+  // its lane arrows (VIRES' SgRMArrow*) are paint too, not warnings
+  for (const auto& w : stats.warnings) EXPECT_EQ(w.find("Arrow"), std::string::npos) << w;
 }
 
 TEST_F(WorldGenTest, UnknownSignalsAreWarningsNamingTheRoadAndSignal) {
@@ -285,4 +288,31 @@ TEST_F(WorldGenTest, AMapFarApartGetsCoarserGridsNotAllTheMemory) {
 TEST(SceneryTest, TheSceneryKindIsCheckedByName) {
   EXPECT_EQ(wg::parse_scenery("urban"), wg::Scenery::kUrban);
   EXPECT_THROW(wg::parse_scenery("forest"), std::invalid_argument);
+}
+
+TEST(MarkingsTest, ArrowsPointAlongTheirTrafficWithTheirHeadsOnTheirSide) {
+  // straight_500m: road 1 runs along +x from the origin.
+  const odr::Network net = odr::load(std::string(CONVOY_ESMINI_MAPS) + "/straight_500m.xodr");
+  const odr::Road& road = net.roads.front();
+  auto extent = [&](int dir, const char* kind) {
+    wg::Part p;
+    wg::paint_arrow(p, road, 100, -1.75, dir, kind);
+    std::array<double, 4> box{1e9, -1e9, 1e9, -1e9};  // x min, max; y min, max
+    for (const auto& v : p.positions) {
+      box = {std::min(box[0], v[0]), std::max(box[1], v[0]), std::min(box[2], v[1]),
+             std::max(box[3], v[1])};
+    }
+    return std::make_pair(box, p.triangles.size());
+  };
+  const auto [straight, n] = extent(+1, "straight");
+  EXPECT_GT(n, 2u);
+  EXPECT_NEAR(straight[0], 97.5, 1e-6);  // 5 m long, centred on s = 100
+  EXPECT_NEAR(straight[1], 102.5, 1e-6);
+  EXPECT_NEAR(0.5 * (straight[2] + straight[3]), -1.75, 1e-6);  // symmetric about its lane
+  const auto [left, nl] = extent(+1, "left");
+  EXPECT_GT(left[3], -1.75 + 0.8);                  // its head reaches out to the left (+y)...
+  EXPECT_NEAR(left[2], -1.75 - 0.12, 1e-6);         // ...and nothing to the right of the shaft
+  const auto [back_left, nb] = extent(-1, "left");  // traffic against s: its left is -y
+  EXPECT_LT(back_left[2], -1.75 - 0.8);
+  EXPECT_NEAR(back_left[3], -1.75 + 0.12, 1e-6);
 }
