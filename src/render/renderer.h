@@ -5,7 +5,8 @@
 // CPU machine): Blinn-Phong lighting per pixel (per vertex on meshes whose triangles cover
 // under kPerVertexLightingBelow pixels), textures multiplying the diffuse and ambient colours.
 // Weather (Scene::set_atmosphere): fog, wet and snowy surfaces, rain and snow over the image.
-// Not drawn: shadows, transparency (alpha is ignored), anti-aliasing, sky boxes. The output is
+// Sun shadows through a shadow map (Scene::set_shadows), a sky gradient (Scene::set_sky).
+// Not drawn: transparency (alpha is ignored), anti-aliasing, sky boxes. The output is
 // deterministic: the same scene, pose and spec give the same bytes on the same machine.
 //
 // Cost (llvmpipe, 2 cores, 736x480): about 1 ms per frame for clearing and reading back, and
