@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cmath>
 #include <cstdlib>
 #include <map>
 #include <sdf/sdf.hh>
 #include <sstream>
 #include <stdexcept>
+
+#include "world_plugins.h"
 
 namespace convoy::world {
 
@@ -200,290 +201,168 @@ class Loader {
     return out;
   }
 
-  static std::string attr(const sdf::ElementPtr& e, const char* name) {
-    auto a = e->GetAttribute(name);
-    return a ? a->GetAsString() : "";
+  // A link of the model `model_name`, its pose in the world (the model at `model_world`).
+  LinkDesc link(const sdf::Link* l, const Eigen::Isometry3d& model_world,
+                const std::string& model_name) {
+    LinkDesc ld;
+    ld.short_name = l->Name();
+    ld.name = model_name + "::" + l->Name();
+    std::string where = "link '" + ld.name + "'";
+    ignition::math::Pose3d pose;
+    auto errors = l->SemanticPose().Resolve(pose);
+    if (!errors.empty()) throw std::runtime_error(format_errors(errors, file_));
+    ld.pose = model_world * to_eigen(pose);
+    const auto& inertial = l->Inertial();
+    ld.mass = inertial.MassMatrix().Mass();
+    if (!(ld.mass > 0)) {
+      throw std::runtime_error(file_.string() + ": " + where + ": mass must be > 0");
+    }
+    Eigen::Isometry3d inertial_pose = to_eigen(inertial.Pose());
+    ld.com = inertial_pose.translation();
+    const auto& moi = inertial.MassMatrix().Moi();
+    Eigen::Matrix3d I;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) I(r, c) = moi(r, c);
+    ld.inertia = inertial_pose.linear() * I * inertial_pose.linear().transpose();
+    if (auto e = l->Element(); e && e->HasElement("gravity")) ld.gravity = e->Get<bool>("gravity");
+    for (uint64_t c = 0; c < l->CollisionCount(); ++c)
+      ld.collisions.push_back(collision(l->CollisionByIndex(c), where));
+    for (uint64_t v = 0; v < l->VisualCount(); ++v)
+      ld.visuals.push_back(visual(l->VisualByIndex(v), where));
+    for (uint64_t s = 0; s < l->SensorCount(); ++s) {
+      const sdf::Sensor* sensor = l->SensorByIndex(s);
+      if (sensor->Type() != sdf::SensorType::CAMERA) continue;
+      ld.cameras.push_back(camera(sensor, ld.name));
+    }
+    return ld;
   }
 
-  // A convoy_signal plugin: its signal id and lamps, each a visual of the model.
-  SignalDesc signal(const sdf::ElementPtr& p, const std::string& where, const ModelDesc& model) {
-    auto fail = [&](const std::string& what) {
-      throw std::runtime_error(file_.string() + ": " + where + ": " + what);
+  // A collision of the link `where` ("link '<model>::<link>'").
+  CollisionDesc collision(const sdf::Collision* col, const std::string& where) {
+    CollisionDesc cd;
+    cd.name = col->Name();
+    ignition::math::Pose3d cp;
+    col->SemanticPose().Resolve(cp);
+    cd.pose = to_eigen(cp);
+    cd.shape = shape(col->Geom(), where + " collision '" + col->Name() + "'");
+    if (auto e = col->Element()) {
+      auto s = e->FindElement("surface");
+      auto f = s ? s->FindElement("friction") : nullptr;
+      auto o = f ? f->FindElement("ode") : nullptr;
+      if (o && o->HasElement("mu")) cd.mu = o->Get<double>("mu");
+    }
+    return cd;
+  }
+
+  // A visual of the link `where`.
+  VisualDesc visual(const sdf::Visual* vis, const std::string& where) {
+    VisualDesc vd;
+    vd.name = vis->Name();
+    ignition::math::Pose3d vp;
+    vis->SemanticPose().Resolve(vp);
+    vd.pose = to_eigen(vp);
+    vd.shape = shape(vis->Geom(), where + " visual '" + vis->Name() + "'");
+    vd.material = material(vis->Material(), where + " visual '" + vis->Name() + "'");
+    vd.cast_shadows = vis->CastShadows();
+    return vd;
+  }
+
+  // A camera sensor of the link named `link_name` (scoped).
+  static CameraDesc camera(const sdf::Sensor* sensor, const std::string& link_name) {
+    const sdf::Camera* cam = sensor->CameraSensor();
+    CameraDesc cd;
+    cd.name = sensor->Name();
+    cd.scoped_name = link_name + "::" + sensor->Name();
+    ignition::math::Pose3d sp;
+    sensor->SemanticPose().Resolve(sp);
+    cd.pose = to_eigen(sp);
+    if (cam) {
+      cd.width = static_cast<int>(cam->ImageWidth());
+      cd.height = static_cast<int>(cam->ImageHeight());
+      cd.format = cam->PixelFormatStr();
+      cd.hfov = cam->HorizontalFov().Radian();
+      cd.near_clip = cam->NearClip();
+      cd.far_clip = cam->FarClip();
+      const sdf::Noise& n = cam->ImageNoise();
+      cd.noise = n.Type() == sdf::NoiseType::GAUSSIAN;
+      cd.noise_mean = n.Mean();
+      cd.noise_stddev = n.StdDev();
+    }
+    cd.update_rate = sensor->UpdateRate();
+    if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
+      cd.plugin_name = attribute(e->GetElement("plugin"), "name");
+    }
+    return cd;
+  }
+
+  JointDesc::Type joint_type(const sdf::Joint* j, const std::string& where) {
+    switch (j->Type()) {
+      case sdf::JointType::REVOLUTE:
+        return JointDesc::kRevolute;
+      case sdf::JointType::CONTINUOUS:
+        return JointDesc::kContinuous;
+      case sdf::JointType::PRISMATIC:
+        return JointDesc::kPrismatic;
+      case sdf::JointType::FIXED:
+        return JointDesc::kFixed;
+      case sdf::JointType::BALL:
+        return JointDesc::kBall;
+      case sdf::JointType::UNIVERSAL:
+        return JointDesc::kUniversal;
+      default:
+        throw std::runtime_error(file_.string() + ": " + where + ": unsupported joint type");
+    }
+  }
+
+  // A joint of the model `model_name` (at `model_world`), its pose in the world.
+  JointDesc joint(const sdf::Joint* j, const Eigen::Isometry3d& model_world,
+                  const std::string& model_name) {
+    JointDesc jd;
+    jd.short_name = j->Name();
+    jd.name = model_name + "::" + j->Name();
+    jd.type = joint_type(j, "joint '" + jd.name + "'");
+    auto scoped = [&](const std::string& link) {
+      return link == "world" ? link : model_name + "::" + link;
     };
-    SignalDesc s;
-    for (auto e = p->GetFirstElement(); e; e = e->GetNextElement()) {
-      const std::string text = e->GetValue() ? e->GetValue()->GetAsString() : "";
-      if (e->GetName() == "signal") {
-        s.id = text;
-      } else if (e->GetName() == "lamp") {
-        LampDesc lamp;
-        lamp.colour = attr(e, "colour");
-        lamp.visual = text;
-        if (lamp.colour != "red" && lamp.colour != "yellow" && lamp.colour != "green")
-          fail("<lamp> '" + text + "': colour '" + lamp.colour +
-               "' is not one of red, yellow, green");
-        for (const auto& other : s.lamps)
-          if (other.colour == lamp.colour) fail("two " + lamp.colour + " lamps");
-        for (const auto& link : model.links)
-          for (const auto& v : link.visuals)
-            if (lamp.link.empty() && v.name == lamp.visual) lamp.link = link.name;
-        if (lamp.link.empty()) fail("<lamp> '" + text + "' is no visual of the model's links");
-        s.lamps.push_back(lamp);
-      }
+    jd.parent = scoped(j->ParentLinkName());
+    jd.child = scoped(j->ChildLinkName());
+    ignition::math::Pose3d jp;
+    auto errors = j->SemanticPose().Resolve(jp, "__model__");
+    if (!errors.empty()) throw std::runtime_error(format_errors(errors, file_));
+    jd.pose = model_world * to_eigen(jp);
+    for (unsigned a = 0; a < 2; ++a) {
+      const sdf::JointAxis* axis = j->Axis(a);
+      if (!axis) continue;
+      AxisDesc ad;
+      ignition::math::Vector3d xyz;
+      auto axis_errors = axis->ResolveXyz(xyz, "__model__");
+      if (!axis_errors.empty()) throw std::runtime_error(format_errors(axis_errors, file_));
+      // model frame -> joint frame
+      Eigen::Matrix3d r_model_joint = to_eigen(jp).linear();
+      ad.xyz = (r_model_joint.transpose() * to_eigen(xyz)).normalized();
+      ad.lower = axis->Lower();
+      ad.upper = axis->Upper();
+      ad.damping = axis->Damping();
+      ad.friction = axis->Friction();
+      ad.effort = axis->Effort();
+      ad.velocity = axis->MaxVelocity();
+      jd.axes.push_back(ad);
     }
-    if (s.id.empty()) fail("no <signal> id");
-    return s;
+    return jd;
   }
 
-  void plugins(const sdf::ElementPtr& elem, const std::string& model_name, ModelDesc* model) {
-    if (!elem->HasElement("plugin")) return;
-    for (auto p = elem->GetElement("plugin"); p; p = p->GetNextElement("plugin")) {
-      std::string name = attr(p, "name"), filename = attr(p, "filename");
-      std::string where = "model '" + model_name + "' plugin '" + name + "'";
-      if (filename.find("JointController") != std::string::npos) {
-        std::vector<PidDesc> pids;
-        for (auto j = p->GetFirstElement(); j; j = j->GetNextElement()) {
-          PidDesc pid;
-          pid.joint = model_name + "::" + j->GetName();
-          bool known = false;
-          for (const auto& jd : model->joints) known |= jd.name == pid.joint;
-          if (!known) {
-            throw std::runtime_error(file_.string() + ": " + where + ": unknown joint '" +
-                                     j->GetName() + "'");
-          }
-          auto num = [&](const char* key, double def) {
-            std::string v = attr(j, key);
-            if (v.empty()) return def;
-            try {
-              return std::stod(v);
-            } catch (const std::exception&) {
-              throw std::runtime_error(file_.string() + ": " + where + ": joint '" + j->GetName() +
-                                       "': " + key + "='" + v + "' is not a number");
-            }
-          };
-          pid.p = num("P", 0);
-          pid.i = num("I", 0);
-          pid.d = num("D", 0);
-          pid.target = num("Target", 0);
-          pid.i_max = num("IMax", 0);
-          pid.i_min = num("IMin", 0);
-          std::string type = attr(j, "Type");
-          if (type != "position" && type != "velocity") {
-            throw std::runtime_error(file_.string() + ": " + where + ": joint '" + j->GetName() +
-                                     "': Type must be position or velocity, got '" + type + "'");
-          }
-          pid.velocity = type == "velocity";
-          pids.push_back(pid);
-        }
-        model->joint_plugins.emplace_back(name, std::move(pids));
-      } else if (filename.find("ConvoyBrakePlugin") != std::string::npos) {
-        BrakePluginDesc bp;
-        bp.name = name;
-        for (auto j = p->GetFirstElement(); j; j = j->GetNextElement()) {
-          const std::string tag = j->GetName();
-          auto number = [&](const std::string& text, const std::string& what) {
-            try {
-              size_t used = 0;
-              double v = std::stod(text, &used);
-              if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
-              return v;
-            } catch (const std::exception&) {
-              throw std::runtime_error(file_.string() + ": " + where + ": " + what + " '" + text +
-                                       "' is not a number");
-            }
-          };
-          if (tag == "abs") {
-            const std::string v = j->GetValue() ? j->GetValue()->GetAsString() : "";
-            if (v != "true" && v != "false" && v != "1" && v != "0")
-              throw std::runtime_error(file_.string() + ": " + where +
-                                       ": <abs> must be true or false, got '" + v + "'");
-            bp.abs = v == "true" || v == "1";
-          } else if (tag == "slip") {
-            bp.slip = number(j->GetValue() ? j->GetValue()->GetAsString() : "", "<slip>");
-            if (!(bp.slip > 0 && bp.slip < 1))
-              throw std::runtime_error(file_.string() + ": " + where +
-                                       ": <slip> must be in (0, 1)");
-          } else {
-            BrakeDesc b;
-            b.joint = model_name + "::" + tag;
-            bool known = false;
-            for (const auto& jd : model->joints) known |= jd.name == b.joint;
-            if (!known)
-              throw std::runtime_error(file_.string() + ": " + where + ": unknown joint '" + tag +
-                                       "'");
-            const std::string t = attr(j, "MaxTorque");
-            if (!t.empty()) b.max_torque = number(t, "joint '" + tag + "': MaxTorque");
-            if (!(b.max_torque > 0))
-              throw std::runtime_error(file_.string() + ": " + where + ": joint '" + tag +
-                                       "': MaxTorque must be > 0");
-            bp.brakes.push_back(b);
-          }
-        }
-        model->brake_plugins.push_back(std::move(bp));
-      } else if (filename == "convoy_class") {
-        std::string cls = p->HasElement("class") ? p->Get<std::string>("class") : "";
-        if (!is_known_class(cls)) {
-          std::string all;
-          for (const auto& c : known_classes()) all += (all.empty() ? "" : ", ") + c;
-          throw std::runtime_error(file_.string() + ": " + where + ": <class> '" + cls +
-                                   "' is not one of " + all);
-        }
-        model->cls = cls;
-      } else if (filename == "convoy_signal") {
-        model->signals.push_back(signal(p, where, *model));
-      } else if (filename.find("LinkController") != std::string::npos ||
-                 filename.find("LinkPlugin") != std::string::npos) {
-        model->link_plugins.push_back(name);
-      }
-    }
-  }
-
+  // The model `m` as `name` at `model_world`, then its nested models.
   void model(const sdf::Model* m, const Eigen::Isometry3d& model_world, const std::string& name,
              WorldDesc* world) {
     ModelDesc md;
     md.name = name;
     md.is_static = m->Static();
     if (auto e = m->Element(); e && !e->FilePath().empty()) md.source = fs::absolute(e->FilePath());
-    for (uint64_t i = 0; i < m->LinkCount(); ++i) {
-      const sdf::Link* l = m->LinkByIndex(i);
-      LinkDesc ld;
-      ld.short_name = l->Name();
-      ld.name = name + "::" + l->Name();
-      std::string where = "link '" + ld.name + "'";
-      ignition::math::Pose3d pose;
-      auto errors = l->SemanticPose().Resolve(pose);
-      if (!errors.empty()) throw std::runtime_error(format_errors(errors, file_));
-      ld.pose = model_world * to_eigen(pose);
-      const auto& inertial = l->Inertial();
-      ld.mass = inertial.MassMatrix().Mass();
-      if (!(ld.mass > 0)) {
-        throw std::runtime_error(file_.string() + ": " + where + ": mass must be > 0");
-      }
-      Eigen::Isometry3d inertial_pose = to_eigen(inertial.Pose());
-      ld.com = inertial_pose.translation();
-      const auto& moi = inertial.MassMatrix().Moi();
-      Eigen::Matrix3d I;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) I(r, c) = moi(r, c);
-      ld.inertia = inertial_pose.linear() * I * inertial_pose.linear().transpose();
-      if (auto e = l->Element(); e && e->HasElement("gravity"))
-        ld.gravity = e->Get<bool>("gravity");
-      for (uint64_t c = 0; c < l->CollisionCount(); ++c) {
-        const sdf::Collision* col = l->CollisionByIndex(c);
-        CollisionDesc cd;
-        cd.name = col->Name();
-        ignition::math::Pose3d cp;
-        col->SemanticPose().Resolve(cp);
-        cd.pose = to_eigen(cp);
-        cd.shape = shape(col->Geom(), where + " collision '" + col->Name() + "'");
-        if (auto e = col->Element()) {
-          auto s = e->FindElement("surface");
-          auto f = s ? s->FindElement("friction") : nullptr;
-          auto o = f ? f->FindElement("ode") : nullptr;
-          if (o && o->HasElement("mu")) cd.mu = o->Get<double>("mu");
-        }
-        ld.collisions.push_back(cd);
-      }
-      for (uint64_t v = 0; v < l->VisualCount(); ++v) {
-        const sdf::Visual* vis = l->VisualByIndex(v);
-        VisualDesc vd;
-        vd.name = vis->Name();
-        ignition::math::Pose3d vp;
-        vis->SemanticPose().Resolve(vp);
-        vd.pose = to_eigen(vp);
-        vd.shape = shape(vis->Geom(), where + " visual '" + vis->Name() + "'");
-        vd.material = material(vis->Material(), where + " visual '" + vis->Name() + "'");
-        vd.cast_shadows = vis->CastShadows();
-        ld.visuals.push_back(vd);
-      }
-      for (uint64_t s = 0; s < l->SensorCount(); ++s) {
-        const sdf::Sensor* sensor = l->SensorByIndex(s);
-        if (sensor->Type() != sdf::SensorType::CAMERA) continue;
-        const sdf::Camera* cam = sensor->CameraSensor();
-        CameraDesc cd;
-        cd.name = sensor->Name();
-        cd.scoped_name = ld.name + "::" + sensor->Name();
-        ignition::math::Pose3d sp;
-        sensor->SemanticPose().Resolve(sp);
-        cd.pose = to_eigen(sp);
-        if (cam) {
-          cd.width = static_cast<int>(cam->ImageWidth());
-          cd.height = static_cast<int>(cam->ImageHeight());
-          cd.format = cam->PixelFormatStr();
-          cd.hfov = cam->HorizontalFov().Radian();
-          cd.near_clip = cam->NearClip();
-          cd.far_clip = cam->FarClip();
-          const sdf::Noise& n = cam->ImageNoise();
-          cd.noise = n.Type() == sdf::NoiseType::GAUSSIAN;
-          cd.noise_mean = n.Mean();
-          cd.noise_stddev = n.StdDev();
-        }
-        cd.update_rate = sensor->UpdateRate();
-        if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
-          cd.plugin_name = attr(e->GetElement("plugin"), "name");
-        }
-        ld.cameras.push_back(cd);
-      }
-      md.links.push_back(std::move(ld));
-    }
-    for (uint64_t i = 0; i < m->JointCount(); ++i) {
-      const sdf::Joint* j = m->JointByIndex(i);
-      JointDesc jd;
-      jd.short_name = j->Name();
-      jd.name = name + "::" + j->Name();
-      std::string where = "joint '" + jd.name + "'";
-      switch (j->Type()) {
-        case sdf::JointType::REVOLUTE:
-          jd.type = JointDesc::kRevolute;
-          break;
-        case sdf::JointType::CONTINUOUS:
-          jd.type = JointDesc::kContinuous;
-          break;
-        case sdf::JointType::PRISMATIC:
-          jd.type = JointDesc::kPrismatic;
-          break;
-        case sdf::JointType::FIXED:
-          jd.type = JointDesc::kFixed;
-          break;
-        case sdf::JointType::BALL:
-          jd.type = JointDesc::kBall;
-          break;
-        case sdf::JointType::UNIVERSAL:
-          jd.type = JointDesc::kUniversal;
-          break;
-        default:
-          throw std::runtime_error(file_.string() + ": " + where + ": unsupported joint type");
-      }
-      auto scoped = [&](const std::string& link) {
-        return link == "world" ? link : name + "::" + link;
-      };
-      jd.parent = scoped(j->ParentLinkName());
-      jd.child = scoped(j->ChildLinkName());
-      ignition::math::Pose3d jp;
-      auto errors = j->SemanticPose().Resolve(jp, "__model__");
-      if (!errors.empty()) throw std::runtime_error(format_errors(errors, file_));
-      jd.pose = model_world * to_eigen(jp);
-      for (unsigned a = 0; a < 2; ++a) {
-        const sdf::JointAxis* axis = j->Axis(a);
-        if (!axis) continue;
-        AxisDesc ad;
-        ignition::math::Vector3d xyz;
-        auto axis_errors = axis->ResolveXyz(xyz, "__model__");
-        if (!axis_errors.empty()) throw std::runtime_error(format_errors(axis_errors, file_));
-        // model frame -> joint frame
-        Eigen::Matrix3d r_model_joint = to_eigen(jp).linear();
-        ad.xyz = (r_model_joint.transpose() * to_eigen(xyz)).normalized();
-        ad.lower = axis->Lower();
-        ad.upper = axis->Upper();
-        ad.damping = axis->Damping();
-        ad.friction = axis->Friction();
-        ad.effort = axis->Effort();
-        ad.velocity = axis->MaxVelocity();
-        jd.axes.push_back(ad);
-      }
-      md.joints.push_back(jd);
-    }
-    plugins(m->Element(), name, &md);
+    for (uint64_t i = 0; i < m->LinkCount(); ++i)
+      md.links.push_back(link(m->LinkByIndex(i), model_world, name));
+    for (uint64_t i = 0; i < m->JointCount(); ++i)
+      md.joints.push_back(joint(m->JointByIndex(i), model_world, name));
+    read_plugins(m->Element(), name, file_, &md);
     world->models.push_back(std::move(md));
     for (uint64_t i = 0; i < m->ModelCount(); ++i) {
       const sdf::Model* nested = m->ModelByIndex(i);
