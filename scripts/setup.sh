@@ -18,7 +18,7 @@ PACKAGES=(
   sumo sumo-tools
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
-  zlib1g-dev
+  zlib1g-dev libboost-dev
   ffmpeg
 )
 
@@ -41,10 +41,13 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/pyth
 cmake --build build -j"$(nproc)"
 echo "== built: build/bin/convoy, build/bin/NRPCoreSim"
 
-# A test instrument: the official MCAP library reads Convoy's recordings
+# Test instruments: the official MCAP library reads Convoy's recordings
 # (tests/e2e/test_recording.py; skipped when it is not installed). With the machine's own
 # Node.js and npm (Debian's npm package conflicts with a Node.js that bundles npm).
 if command -v npm >/dev/null; then
   (cd tools/mcap_check && npm ci --no-audit --no-fund --loglevel=error) ||
     echo "warning: npm ci in tools/mcap_check failed; the @mcap/core test will be skipped"
+  # Foxglove's own protocol client watches a live run (tests/e2e/test_live.py).
+  (cd tools/live_check && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "warning: npm ci in tools/live_check failed; the @foxglove/ws-protocol test will be skipped"
 fi

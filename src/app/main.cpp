@@ -14,6 +14,7 @@
 
 #include "app/simulation.h"
 #include "core/memory.h"
+#include "live/address.h"
 #include "python/interpreter.h"
 
 extern char** environ;
@@ -23,7 +24,7 @@ namespace {
 void usage(const char* prog) {
   std::printf(
       "usage: %s run -c simulation_config.json [-o Key=Value]... [--run-dir DIR] [--quiet]\n"
-      "                  [--record] [--record-blobs]\n"
+      "                  [--record] [--record-blobs] [--live [HOST:]PORT [--insecure]]\n"
       "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--scenery KIND] [--ego "
       "FRAGMENT.json]\n"
       "                [-o Key=Value]... [--run-dir DIR] [--quiet] [--record]\n"
@@ -36,6 +37,13 @@ void usage(const char* prog) {
       "  --record            record every datapack that crosses the coordinator into\n"
       "                      RUN_DIR/recording.mcap (MCAP; docs/recording.md)\n"
       "  --record-blobs      --record, with the blobs (camera frames) too\n"
+      "  --live [HOST:]PORT  serve the run live to Foxglove or Lichtblick (Foxglove WebSocket\n"
+      "                      protocol at ws://HOST:PORT; HOST 127.0.0.1 by default; loopback\n"
+      "                      addresses only, unless --insecure); every datapack a channel,\n"
+      "                      the camera as JPEG, the log (docs/architecture.md, \"Live server\")\n"
+      "  --live-camera-hz HZ with --live: JPEG camera frames per simulated second (default 10)\n"
+      "  --insecure          with --live or --server_address: listen beyond the loopback too\n"
+      "                      (there is no TLS or token: anyone who reaches it sees the run)\n"
       "  replay RUN_DIR      re-run the functions on the recording (no engines); exit 0 when\n"
       "                      they send what they sent live, 5 when not (RUN_DIR/replay/)\n"
       "  score RUN_DIR       replay into RUN_DIR/rescore/ and compare the fields the functions\n"
@@ -291,7 +299,18 @@ int main(int argc, char** argv) {
       options.slave = true;
     else if (a == "--insecure")
       options.insecure = true;
-    else if (a == "--logoutput")
+    else if (a == "--live")
+      options.live = value();
+    else if (a == "--live-camera-hz") {
+      const std::string v = value();
+      char* end = nullptr;
+      options.live_camera_hz = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end || !(options.live_camera_hz >= 0) || options.live_camera_hz > 1e6) {
+        std::fprintf(stderr, "error: --live-camera-hz must be a number >= 0, got '%s'\n",
+                     v.c_str());
+        return 2;
+      }
+    } else if (a == "--logoutput")
       log_output = value();
     else if (a == "--logfilename")
       log_filename = value();
@@ -330,6 +349,19 @@ int main(int argc, char** argv) {
   } else if (mode != "standalone") {
     std::fprintf(stderr, "error: -m must be standalone or server, got '%s'\n", mode.c_str());
     return 2;
+  }
+  if (!options.live.empty()) {
+    if (options.server) {
+      std::fprintf(stderr, "error: --live runs standalone only (not with -m server)\n");
+      return 2;
+    }
+    try {  // the port itself is taken when the run starts (app/live_run.h)
+      convoy::live::check_listen_policy(convoy::live::parse_listen_address(options.live),
+                                        options.insecure);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
   }
   if (!scenario.empty()) {
     if (!options.config_file.empty()) {

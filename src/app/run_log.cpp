@@ -12,6 +12,7 @@ RunLog::~RunLog() {
 void RunLog::open(const std::filesystem::path& file) { file_ = std::fopen(file.c_str(), "a"); }
 
 void RunLog::write(const char* level, const std::string& text) {
+  if (sink) sink(level[0] == 'e', text);
   if (!file_) return;
   auto now = std::chrono::system_clock::now();
   std::time_t t = std::chrono::system_clock::to_time_t(now);

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace convoy::app {
@@ -15,6 +16,8 @@ class RunLog {
   void info(const std::string& line);   // stderr unless quiet
   void error(const std::string& text);  // always on stderr
   bool quiet = false;
+  // Also gets every line (`error`: an error line), e.g. the live server's /convoy/log.
+  std::function<void(bool error, const std::string& line)> sink;
 
  private:
   void write(const char* level, const std::string& text);

@@ -130,8 +130,10 @@ void Session::initialize(bool keep_observations) {
   loop_ = std::make_unique<loop::FtiLoop>(engines_.handles(), runtime_, functions_,
                                           status_ ? &*status_ : nullptr);
   loop_->keep_observations(keep_observations);
-  if (recorder_) loop_->set_tap(recorder_.get());
-  if (replay_tap_) loop_->set_tap(replay_tap_);
+  taps_.add(recorder_.get());
+  taps_.add(replay_tap_);
+  for (auto* tap : extra_taps_) taps_.add(tap);
+  if (!taps_.empty()) loop_->set_tap(taps_.single_or_this());
   csv_.reset(std::fopen((run_dir_ / "steps.csv").c_str(), "w"));
   if (csv_) std::setvbuf(csv_.get(), nullptr, _IOFBF, 1 << 20);
   loop_->set_step_log(csv_.get());

@@ -17,6 +17,7 @@
 #include "app/run_log.h"
 #include "config/simulation_config.h"
 #include "loop/fti_loop.h"
+#include "loop/tap_fanout.h"
 #include "python/function_runtime.h"
 #include "record/recorder.h"
 
@@ -74,6 +75,9 @@ class Session {
   using ChannelFactory =
       std::function<std::unique_ptr<transport::EngineChannel>(const config::EngineConfig&)>;
   void replay_with(ChannelFactory channel, loop::DataPackTap* tap);
+  // Another tap on the loop (the live server's), after the recorder. Before initialize();
+  // it must outlive the session's loop.
+  void add_tap(loop::DataPackTap* tap) { extra_taps_.push_back(tap); }
 
   // Loads the functions (a broken file costs no start-up), launches and initializes the
   // engines, and fetches the functions' first inputs. `keep_observations`: collect what the
@@ -119,6 +123,8 @@ class Session {
   std::unique_ptr<record::Recorder> recorder_;
   ChannelFactory replay_channel_;
   loop::DataPackTap* replay_tap_ = nullptr;
+  std::vector<loop::DataPackTap*> extra_taps_;
+  loop::TapFanout taps_;
 };
 
 }  // namespace convoy::app

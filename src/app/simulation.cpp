@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "app/engine_set.h"
+#include "app/live_run.h"
 #include "app/nrp_server.h"
 #include "app/run_log.h"
 #include "app/session.h"
@@ -127,7 +128,7 @@ nlohmann::json startup_json(const StartupFigures& s) {
 // experiment's own figures), with the coordinator's fields on top.
 void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
                    const LoopFigures& loop, double wall_s, const Outcome& outcome,
-                   const StartupFigures* startup) {
+                   const StartupFigures* startup, const nlohmann::json* extra) {
   nlohmann::json j = nlohmann::json::object();
   if (std::ifstream in(file); in) {
     j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
@@ -151,6 +152,8 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
     j["startup"] = startup_json(*startup);
   }
   j["frame_copies"] = frame_copies(cfg, file.parent_path());
+  if (extra)
+    for (const auto& [key, value] : extra->items()) j[key] = value;
   std::ofstream(file) << j.dump(2) << "\n";
 }
 
@@ -232,11 +235,13 @@ namespace {
 // The run proper, with the interpreter up: load the functions, launch and initialize the
 // engines, run the loop; then shut the engines down, whatever happened before.
 Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet,
-                    RunLog& log, LoopFigures* figures, StartupFigures* startup) {
+                    RunLog& log, LoopFigures* figures, StartupFigures* startup,
+                    loop::DataPackTap* live_tap) {
   export_run_environment(run_dir);
   python::Interpreter interpreter;
   Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
+  if (live_tap) session.add_tap(live_tap);
   try {
     if (cfg.record) {
       try {
@@ -272,8 +277,8 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
 // summary.json and the last lines of the log.
 void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog& log,
             const LoopFigures& figures, double wall_s, const Outcome& outcome,
-            const StartupFigures* startup = nullptr) {
-  write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome, startup);
+            const StartupFigures* startup = nullptr, const nlohmann::json* extra = nullptr) {
+  write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome, startup, extra);
   if (startup && startup->total_s >= 0) {
     std::ostringstream s;
     s.precision(3);
@@ -308,9 +313,24 @@ int run_simulation(const RunOptions& options) {
   const auto t0 = SteadyClock::now();
   LoopFigures figures;
   StartupFigures startup;
-  Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup);
+  // The live server first: a port in use or a refused address ends the run before any engine.
+  std::unique_ptr<LiveRun> live;
+  if (!options.live.empty()) {
+    try {
+      live = std::make_unique<LiveRun>(options, cfg, log);
+    } catch (const UserError& e) {
+      const Outcome refused{kExitUserError, e.what()};
+      log.error(refused.error);
+      report(cfg, run_dir, log, figures, 0, refused);
+      return refused.code;
+    }
+  }
+  Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup,
+                                live ? live->tap() : nullptr);
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
-  report(cfg, run_dir, log, figures, wall_s, outcome, &startup);
+  nlohmann::json live_fields;
+  if (live) live_fields = {{"live", live->finish()}};
+  report(cfg, run_dir, log, figures, wall_s, outcome, &startup, live ? &live_fields : nullptr);
   return outcome.code;
 }
 

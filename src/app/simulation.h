@@ -21,6 +21,9 @@ struct RunOptions {
   std::string server_address;  // --server_address HOST:PORT
   bool slave = false;          // --slave: started by a client; ignore Ctrl-C, end with it
   bool insecure = false;       // --insecure: listen beyond the loopback too
+  // --live [HOST:]PORT: serve the run to Foxglove WebSocket clients (app/live_run.h).
+  std::string live;
+  double live_camera_hz = 10;  // --live-camera-hz: JPEG frames per simulated second
 };
 
 // Exit codes of `convoy run`.
@@ -56,10 +59,11 @@ void install_signal_handlers(bool ignore_sigint = false);
 // $CONVOY_RUN_DIR and $CONVOY_SHARE_DIR for the functions, before the interpreter starts.
 void export_run_environment(const std::filesystem::path& run_dir);
 // summary.json: what the run's engines and functions wrote there, with the coordinator's
-// fields on top (and the start-up figures, when given: a live run's).
+// fields on top (and the start-up figures, when given: a live run's; and `extra`'s fields,
+// e.g. the live server's "live").
 void write_summary(const std::filesystem::path& file, const config::SimulationConfig& cfg,
                    const LoopFigures& loop, double wall_s, const Outcome& outcome,
-                   const StartupFigures* startup = nullptr);
+                   const StartupFigures* startup = nullptr, const nlohmann::json* extra = nullptr);
 // The `convoy` metadata of a recording: the effective config (tokens redacted), version.
 record::StringMap recording_metadata(const config::SimulationConfig& cfg);
 

@@ -238,6 +238,19 @@ Kind kind_from_name(std::string_view name) {
   throw std::invalid_argument("unknown datapack kind '" + std::string(name) + "'");
 }
 
+Kind kind_of(const engine::DataPack& dp, bool with_blobs) {
+  switch (dp.payload_case()) {
+    case engine::DataPack::kJsonMsgpack:
+      return Kind::kJson;
+    case engine::DataPack::kProto: {
+      const bool known = datapack::Registry::global().find(dp.proto().type_name()) != nullptr;
+      return !known || (dp.blobs_size() > 0 && !with_blobs) ? Kind::kStub : Kind::kProtobuf;
+    }
+    default:
+      return Kind::kEmpty;
+  }
+}
+
 Encoded encode(const engine::DataPack& dp, const datapack::BlobReader& blobs, bool with_blobs) {
   Encoded out;
   out.type = dp.id().type();

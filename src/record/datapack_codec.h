@@ -41,6 +41,9 @@ struct Encoded {
   bool has_blobs = false;
 };
 
+// The kind encode() gives `dp`, without encoding it.
+Kind kind_of(const engine::DataPack& dp, bool with_blobs);
+
 // Encodes a datapack whose blobs `blobs` reads; `with_blobs`: put the blobs' bytes in.
 // Throws std::runtime_error naming the datapack when its payload is malformed.
 Encoded encode(const engine::DataPack& dp, const datapack::BlobReader& blobs, bool with_blobs);
