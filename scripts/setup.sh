@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake ccache pkg-config
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev libprotoc-dev protobuf-compiler python3-protobuf
-  pybind11-dev nlohmann-json3-dev libvalijson-dev python3-dev python3-numpy
+  pybind11-dev nlohmann-json3-dev libvalijson-dev python3-dev python3-numpy python3-zstandard
   libgtest-dev
   libdart-dev libdart-external-ikfast-dev libdart-collision-bullet-dev libsdformat-dev
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libassimp-dev libglm-dev libpng-dev libjpeg-dev
@@ -18,7 +18,7 @@ PACKAGES=(
   sumo sumo-tools
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
-  zlib1g-dev libboost-dev
+  zlib1g-dev libzstd-dev libboost-dev
   ffmpeg
 )
 

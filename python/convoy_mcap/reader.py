@@ -66,6 +66,18 @@ class _Fields:
         return bytes(self.buf[self.p:])
 
 
+def _zstd_decompress(data, size, fail):
+    """A zstd chunk's records (Convoy writes them so; Debian's python3-zstandard reads them)."""
+    try:
+        import zstandard
+    except ImportError:
+        fail("zstd chunk: install python3-zstandard to read it")
+    try:
+        return zstandard.ZstdDecompressor().decompress(bytes(data), max_output_size=size)
+    except zstandard.ZstdError as e:
+        fail("zstd chunk does not decompress: %s" % e)
+
+
 def _records(buf, start, end, where):
     p = start
     while p < end:
@@ -152,7 +164,9 @@ class Recording:
                 start, end, usize, crc = f.u64(), f.u64(), f.u64(), f.u32()
                 comp = f.string()
                 recs = f.bytes64()
-                if comp:
+                if comp == "zstd":
+                    recs = _zstd_decompress(recs, usize, lambda what: self._fail(what, off))
+                elif comp:
                     self._fail("compressed chunk (%s) not supported" % comp, off)
                 if len(recs) != usize:
                     self._fail("chunk sizes disagree", off)

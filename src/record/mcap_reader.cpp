@@ -1,5 +1,7 @@
 #include "record/mcap_reader.h"
 
+#include <zstd.h>
+
 #include <cerrno>
 #include <cstring>
 
@@ -144,12 +146,26 @@ void McapReader::parse_record(uint8_t op, std::string_view body, uint64_t offset
       const std::string compression = c.string();
       const std::string_view records = c.bytes(c.uint(8));
       if (!c.ok) fail("malformed Chunk record", offset);
-      if (!compression.empty())
-        fail("Chunk compressed with '" + compression + "' (only uncompressed chunks are read)",
-             offset);
-      if (records.size() != uncompressed_size) fail("Chunk sizes disagree", offset);
-      if (crc != 0 && mcap_io::crc32(records) != crc) fail("Chunk CRC does not match", offset);
-      chunk_.assign(records);
+      if (compression.empty()) {
+        if (records.size() != uncompressed_size) fail("Chunk sizes disagree", offset);
+        chunk_.assign(records);
+      } else if (compression == "zstd") {
+        // Bounded: a corrupt size must not make the reader ask for terabytes.
+        if (uncompressed_size > (uint64_t{1} << 34))
+          fail("Chunk says it holds " + std::to_string(uncompressed_size) + " bytes", offset);
+        chunk_.resize(uncompressed_size);
+        const size_t n =
+            ZSTD_decompress(chunk_.data(), chunk_.size(), records.data(), records.size());
+        if (ZSTD_isError(n))
+          fail(std::string("zstd chunk does not decompress: ") + ZSTD_getErrorName(n), offset);
+        if (n != uncompressed_size)
+          fail("zstd chunk decompresses to " + std::to_string(n) + " bytes, not " +
+                   std::to_string(uncompressed_size),
+               offset);
+      } else {
+        fail("Chunk compressed with '" + compression + "' (only zstd and none are read)", offset);
+      }
+      if (crc != 0 && mcap_io::crc32(chunk_) != crc) fail("Chunk CRC does not match", offset);
       chunk_pos_ = 0;
       chunk_offset_ = offset;
       return;

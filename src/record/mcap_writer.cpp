@@ -1,6 +1,7 @@
 #include "record/mcap_writer.h"
 
 #include <zlib.h>
+#include <zstd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -59,17 +60,31 @@ uint32_t crc32(std::string_view bytes, uint32_t crc) {
 
 using namespace mcap_io;
 
+// ZSTD_CCtx, opaque in the header so that it does not include zstd.h.
+struct McapWriter::ZstdContext {
+  ZSTD_CCtx* cctx = nullptr;
+};
+void McapWriter::ZstdContextDeleter::operator()(ZstdContext* c) const {
+  ZSTD_freeCCtx(c->cctx);
+  delete c;
+}
+
 McapWriter::~McapWriter() { close(); }
 
 void McapWriter::open(const std::filesystem::path& path, const std::string& library,
-                      size_t chunk_bytes) {
+                      const McapWriterOptions& options) {
   if (file_) throw std::logic_error("McapWriter: already open");
   path_ = path;
+  options_ = options;
+  if (options_.compression == McapCompression::kZstd && !zstd_) {
+    zstd_.reset(new ZstdContext);
+    zstd_->cctx = ZSTD_createCCtx();
+    if (!zstd_->cctx) throw std::runtime_error(path.string() + ": cannot create a zstd context");
+  }
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) {
     throw std::runtime_error("cannot create " + path.string() + ": " + std::strerror(errno));
   }
-  chunk_bytes_ = chunk_bytes;
   std::string header;
   put_string(&header, "");  // profile
   put_string(&header, library);
@@ -141,25 +156,42 @@ void McapWriter::write_message(uint16_t channel, uint32_t sequence, uint64_t log
   chunk_has_messages_ = true;
   ++message_count_;
   ++channel_counts_[channel];
-  if (chunk_.size() >= chunk_bytes_) flush_chunk();
+  if (chunk_.size() >= options_.chunk_bytes) flush_chunk();
+}
+
+std::string_view McapWriter::compressed_chunk(const char** compression) {
+  *compression = "";
+  if (options_.compression != McapCompression::kZstd) return chunk_;
+  compressed_.resize(ZSTD_compressBound(chunk_.size()));
+  const size_t n = ZSTD_compressCCtx(zstd_->cctx, compressed_.data(), compressed_.size(),
+                                     chunk_.data(), chunk_.size(), options_.zstd_level);
+  // Should zstd fail, or not help (JPEG frames), the chunk goes uncompressed: the
+  // specification lets each chunk say how it is compressed.
+  if (ZSTD_isError(n) || n >= chunk_.size()) return chunk_;
+  compressed_.resize(n);
+  *compression = "zstd";
+  return compressed_;
 }
 
 void McapWriter::flush_chunk() {
   if (!file_ || chunk_.empty()) return;
   const uint64_t chunk_offset = pos_;
+  const char* compression = "";
+  const std::string_view records = compressed_chunk(&compression);
   std::string head;
   put_u64(&head, chunk_has_messages_ ? chunk_start_ : 0);
   put_u64(&head, chunk_has_messages_ ? chunk_end_ : 0);
-  put_u64(&head, chunk_.size());  // uncompressed_size
-  put_u32(&head, crc32(chunk_));  // uncompressed_crc
-  put_string(&head, "");          // compression
-  put_u64(&head, chunk_.size());  // records length
+  put_u64(&head, chunk_.size());   // uncompressed_size
+  put_u32(&head, crc32(chunk_));   // uncompressed_crc
+  put_string(&head, compression);  // compression
+  put_u64(&head, records.size());  // records length
   std::string prefix;
   put_u8(&prefix, kOpChunk);
-  put_u64(&prefix, head.size() + chunk_.size());
+  put_u64(&prefix, head.size() + records.size());
   write_raw(prefix);
   write_raw(head);
-  write_raw(chunk_);
+  write_raw(records);
+  uncompressed_bytes_ += chunk_.size();
   const uint64_t chunk_length = pos_ - chunk_offset;
 
   // Message indexes, one per channel with messages in the chunk.
@@ -189,9 +221,9 @@ void McapWriter::flush_chunk() {
   }
   put_string(&ci, offsets);
   put_u64(&ci, pos_ - index_start);
-  put_string(&ci, "");
-  put_u64(&ci, chunk_.size());  // compressed_size
-  put_u64(&ci, chunk_.size());  // uncompressed_size
+  put_string(&ci, compression);
+  put_u64(&ci, records.size());  // compressed_size
+  put_u64(&ci, chunk_.size());   // uncompressed_size
   chunk_index_records_.push_back(record(kOpChunkIndex, ci));
 
   ++chunk_count_;

@@ -1,7 +1,9 @@
 #include "record/recorder.h"
 
+#include "datapack/camera.h"
 #include "datapack/registry.h"
 #include "record/datapack_codec.h"
+#include "record/jpeg.h"
 
 namespace convoy::record {
 
@@ -10,11 +12,13 @@ namespace {
 // panels) have it; the spec allows none for json.
 constexpr const char* kJsonSchema =
     R"js({"type":"object","description":"a Convoy JSON datapack (docs/recording.md)"})js";
+constexpr const char* kCameraType = "convoy.data.Camera";
 }  // namespace
 
-Recorder::Recorder(const std::filesystem::path& path, bool record_blobs, const StringMap& metadata)
-    : record_blobs_(record_blobs) {
-  writer_.open(path, std::string("convoy ") + metadata.at("convoy_version"));
+Recorder::Recorder(const std::filesystem::path& path, bool record_blobs, const StringMap& metadata,
+                   const RecorderOptions& options)
+    : record_blobs_(record_blobs), options_(options) {
+  writer_.open(path, std::string("convoy ") + metadata.at("convoy_version"), options.mcap);
   writer_.write_metadata("convoy", metadata);
 }
 
@@ -73,6 +77,52 @@ void Recorder::write(const std::string& engine, const engine::DataPack& dp,
   const uint16_t ch = channel(engine, dp.id().name(), to_engine, enc);
   const auto t = static_cast<uint64_t>(time_ns);
   writer_.write_message(ch, static_cast<uint32_t>(cycle), t, t, enc.data);
+  if (!to_engine && dp.payload_case() == engine::DataPack::kProto &&
+      dp.proto().type_name() == kCameraType) {
+    try {
+      camera(engine + "/" + dp.id().name(), dp, blobs, cycle, time_ns);
+    } catch (const std::exception& e) {
+      if (skipped_++ == 0) first_skip_ = e.what();
+    }
+  }
+}
+
+uint16_t Recorder::foxglove_schema(const FoxgloveSchema& schema) {
+  const std::string key = std::string("foxglove") + '\0' + schema.name;
+  if (auto it = schemas_.find(key); it != schemas_.end()) return it->second;
+  const uint16_t id = writer_.add_schema(schema.name, schema.encoding, schema.data);
+  schemas_[key] = id;
+  return id;
+}
+
+void Recorder::camera(const std::string& topic, const engine::DataPack& dp,
+                      const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns) {
+  if (!record_blobs_ && options_.camera_hz <= 0) return;
+  auto [it, added] = cameras_.try_emplace(topic);
+  Camera& cam = it->second;
+  if (!record_blobs_) {
+    const auto period = static_cast<int64_t>(1e9 / options_.camera_hz);
+    if (cam.last_ns >= 0 && time_ns - cam.last_ns < period) return;
+  }
+  const datapack::CameraImage img = datapack::read_camera(datapack::View(dp, blobs));
+  if (img.width == 0 || img.height == 0) return;
+  if (added) {
+    const StringMap meta = {{"camera", topic}};
+    cam.image = writer_.add_channel(topic + "/image", "json",
+                                    foxglove_schema(compressed_image_schema()), meta);
+    cam.calibration = writer_.add_channel(topic + "/calibration", "json",
+                                          foxglove_schema(camera_calibration_schema()), meta);
+  }
+  cam.last_ns = time_ns;
+  const auto t = static_cast<uint64_t>(time_ns);
+  const auto seq = static_cast<uint32_t>(cycle);
+  const std::string jpeg =
+      encode_jpeg(img.pixels, img.width, img.height, img.depth, options_.jpeg_quality);
+  writer_.write_message(cam.image, seq, t, t, compressed_image_json(t, topic, jpeg));
+  writer_.write_message(
+      cam.calibration, seq, t, t,
+      camera_calibration_json(t, topic, img.width, img.height, options_.camera_hfov));
+  ++camera_frames_;
 }
 
 void Recorder::from_engine(const std::string& engine, const engine::DataPack& dp,

@@ -8,6 +8,12 @@
 // protobuf with their FileDescriptorSet, blobs (camera frames) as stubs unless
 // `record_blobs`. A Metadata record `convoy` holds what a replay needs (the effective config,
 // Convoy's version); `convoy_end` how the run ended.
+//
+// For viewers (Foxglove, Lichtblick), each camera (`convoy.data.Camera` taken from an engine)
+// also gives `<engine>/<datapack>/image` as `foxglove.CompressedImage` (JPEG) and
+// `<engine>/<datapack>/calibration` as `foxglove.CameraCalibration`, the live server's
+// channels (record/foxglove_schemas.h): every frame when blobs are recorded, else at
+// `camera_hz` per simulated second. Chunks are compressed with zstd.
 #pragma once
 
 #include <filesystem>
@@ -17,6 +23,7 @@
 
 #include "loop/datapack_tap.h"
 #include "record/datapack_codec.h"
+#include "record/foxglove_schemas.h"
 #include "record/mcap_writer.h"
 
 namespace convoy::record {
@@ -24,10 +31,18 @@ namespace convoy::record {
 inline constexpr const char* kRecordingFile = "recording.mcap";
 inline constexpr const char* kRecordingFormat = "convoy-recording-1";
 
+struct RecorderOptions {
+  McapWriterOptions mcap;      // chunk size and compression
+  double camera_hz = 1;        // JPEG frames per simulated second without blobs (0: none)
+  int jpeg_quality = 80;       // as the live server's
+  double camera_hfov = 1.047;  // the calibration's field of view (rad): the datapack has none
+};
+
 class Recorder final : public loop::DataPackTap {
  public:
   // Creates `path` and writes the header and the `convoy` metadata. Throws std::runtime_error.
-  Recorder(const std::filesystem::path& path, bool record_blobs, const StringMap& metadata);
+  Recorder(const std::filesystem::path& path, bool record_blobs, const StringMap& metadata,
+           const RecorderOptions& options = {});
   ~Recorder() override;
 
   void from_engine(const std::string& engine, const engine::DataPack& dp,
@@ -44,6 +59,7 @@ class Recorder final : public loop::DataPackTap {
   // Datapacks that could not be encoded (left out), and why the first one could not.
   uint64_t skipped() const { return skipped_; }
   const std::string& first_skip() const { return first_skip_; }
+  uint64_t camera_frames() const { return camera_frames_; }
 
  private:
   void write(const std::string& engine, const engine::DataPack& dp,
@@ -51,9 +67,21 @@ class Recorder final : public loop::DataPackTap {
              uint64_t cycle, int64_t time_ns);
   uint16_t channel(const std::string& engine, const std::string& name, bool to_engine,
                    const Encoded& enc);
+  // The camera's JPEG and calibration, when its period has passed.
+  void camera(const std::string& topic, const engine::DataPack& dp,
+              const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns);
+  uint16_t foxglove_schema(const FoxgloveSchema& schema);
+
+  struct Camera {
+    uint16_t image = 0, calibration = 0;
+    int64_t last_ns = -1;
+  };
 
   McapWriter writer_;
   bool record_blobs_;
+  RecorderOptions options_;
+  std::map<std::string, Camera> cameras_;  // by topic
+  uint64_t camera_frames_ = 0;
   uint64_t skipped_ = 0;
   std::string first_skip_;
   std::map<std::string, uint16_t> schemas_;  // "kind\0type" -> schema id

@@ -37,11 +37,12 @@ uint64_t u64(const std::string& s, size_t at) {
   return v;
 }
 
-// A file of `n` messages on two channels, in chunks of `chunk` bytes.
+// A file of `n` messages on two channels, in uncompressed chunks of `chunk` bytes (zstd:
+// mcap_zstd_test.cpp).
 fs::path write_file(int n, size_t chunk) {
   fs::path p = temp_file(std::to_string(n) + ".mcap");
   McapWriter w;
-  w.open(p, "test", chunk);
+  w.open(p, "test", {chunk, McapCompression::kNone});
   uint16_t s = w.add_schema("convoy.JsonDataPack", "jsonschema", "{}");
   uint16_t a = w.add_channel("e/a", "json", s, {{"k", "v"}});
   uint16_t b = w.add_channel("e/b/in", "json", 0, {});

@@ -1,19 +1,28 @@
 // Reads an MCAP file with the official MCAP library (@mcap/core), both ways: the streaming
 // reader (every record, CRCs checked) and the indexed reader (summary, chunk indexes, message
 // indexes, metadata). Prints what it found as JSON; exits 1 when either reader refuses the
-// file. A test instrument for Convoy's own writer (tests/e2e/test_recording.py).
+// file. A test instrument for Convoy's own writer (tests/e2e/test_recording.py). Chunks
+// compressed with zstd are decompressed by fzstd (pure JavaScript, from npm).
 //
 //   node tools/mcap_check/check.mjs FILE.mcap
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { readFileSync } from "node:fs";
 import zlib from "node:zlib";
+import { decompress as zstdDecompress } from "fzstd";
 
 const file = process.argv[2];
 const bytes = new Uint8Array(readFileSync(file));
 const out = { file, stream: {}, indexed: {} };
+const decompressHandlers = {
+  zstd: (data, size) => {
+    const raw = zstdDecompress(data, new Uint8Array(Number(size)));
+    if (raw.length !== Number(size)) throw new Error(`zstd chunk: ${raw.length} bytes, not ${size}`);
+    return raw;
+  },
+};
 
 // Streaming: every record, chunk and data-section CRCs validated.
-const stream = new McapStreamReader({ validateCrcs: true });
+const stream = new McapStreamReader({ validateCrcs: true, decompressHandlers });
 stream.append(bytes);
 const ops = {};
 let streamMessages = 0;
@@ -33,7 +42,7 @@ const readable = {
   size: async () => BigInt(bytes.length),
   read: async (offset, length) => bytes.subarray(Number(offset), Number(offset + length)),
 };
-const reader = await McapIndexedReader.Initialize({ readable });
+const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
 const topics = {};
 let indexedMessages = 0;
 let lastTime = -1n;
@@ -63,6 +72,9 @@ out.indexed = {
   messages: indexedMessages,
   statistics_messages: Number(reader.statistics?.messageCount ?? -1),
   chunks: reader.chunkIndexes.length,
+  chunk_compressions: [...new Set(reader.chunkIndexes.map((c) => c.compression))],
+  compressed_bytes: Number(reader.chunkIndexes.reduce((a, c) => a + c.compressedSize, 0n)),
+  uncompressed_bytes: Number(reader.chunkIndexes.reduce((a, c) => a + c.uncompressedSize, 0n)),
   channels: reader.channelsById.size,
   topics,
   schemas,

@@ -1,4 +1,4 @@
-#include "live/jpeg.h"
+#include "record/jpeg.h"
 
 #include <jpeglib.h>
 
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace convoy::live {
+namespace convoy::record {
 
 namespace {
 
@@ -74,4 +74,4 @@ std::string encode_jpeg(std::string_view pixels, uint32_t width, uint32_t height
   return result;
 }
 
-}  // namespace convoy::live
+}  // namespace convoy::record
