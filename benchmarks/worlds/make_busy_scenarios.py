@@ -5,8 +5,20 @@ sidewalks, 25 s. The same scene on the project's city map and on generated world
 maps gives the detector's mAP on both (summary.json's detector_map50; docs/worlds.md).
 Deterministic; stdlib only.
 
-  /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py"""
+  /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py
+  /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py --train
+
+--train writes the detector's training scenes instead (tools/detector/reproduce.sh renders
+them): train/train_<scene>.xosc, busy scenes on esmini maps with sidewalks (fabriksgatan's
+streets in both directions, fabriksgatan_traffic_lights, soderleden, parking_demo) with more
+and varied road users (cars, vans, buses, trucks, adults and children, their places and
+speeds drawn per scene). multi_intersections is never among them: busy_multi_intersections
+measures the detector on a map it was not trained on. No scene starts where
+busy_fabriksgatan does (road 2, s 20, lane -1), but fabriksgatan's world is in training."""
 import os
+import random
+import sys
+import xml.etree.ElementTree as ET
 
 from make_map_scenarios import story_end
 
@@ -78,5 +90,71 @@ def main():
         print("busy_%s.xosc" % name)
 
 
+# The training scenes: name -> (map, road, ego lane, ego's s, lanes of traffic along the ego's
+# direction, oncoming lanes, sidewalks). A positive lane drives against s (right-hand traffic),
+# so "ahead" is s falling there.
+TRAIN = {
+    "fabriksgatan_r2_north": ("fabriksgatan", "2", 1, 285.0, [1], [-1], [-3, 3]),
+    "fabriksgatan_r3": ("fabriksgatan", "3", -1, 5.0, [-1], [1], [-3, 3]),
+    "fabriksgatan_r0_west": ("fabriksgatan", "0", 1, 90.0, [1], [-1], [-3, 3]),
+    "fabriksgatan_lights_r2_mid": ("fabriksgatan_traffic_lights", "2", -1, 110.0, [-1], [1], [-3, 3]),
+    "fabriksgatan_lights_r3_north": ("fabriksgatan_traffic_lights", "3", 1, 110.0, [1], [-1], [-3, 3]),
+    "soderleden_r0": ("soderleden", "0", -1, 120.0, [-1, -2], [], [-4, 2]),  # (past s 100: 2 lanes)
+    "soderleden_r0_far": ("soderleden", "0", -2, 700.0, [-1, -2], [], [-4, 2]),
+    "soderleden_r2": ("soderleden", "2", -1, 10.0, [-1, -2], [], [-4, 2]),
+    "parking_demo_r1": ("parking_demo", "1", -1, 5.0, [-1], [1, 2], [-6]),
+}
+VEHICLE_MODELS = ("sedan", "sedan", "hatchback", "suv", "van", "bus", "truck")
+WALKER_MODELS = ("adult", "adult", "adult", "child")
+TRAIN_PEDESTRIAN = """    <ScenarioObject name="{name}">
+      <CatalogReference catalogName="SuitePedestrians" entryName="{model}"/>
+    </ScenarioObject>
+"""
+
+
+def train():
+    """Writes train/train_<scene>.xosc (the paths in them relative to train/)."""
+    out = os.path.join(HERE, "train")
+    os.makedirs(out, exist_ok=True)
+    for k, (name, (mp, road, lane, s, along, oncoming, walks)) in enumerate(sorted(TRAIN.items())):
+        rng = random.Random(2611 + k)
+        length = float(ET.parse(os.path.join(HERE, ESMINI + mp + ".xodr")).getroot()
+                       .find("road[@id='%s']" % road).get("length"))
+        on_road = lambda ss: 2.0 <= ss <= length - 2.0  # noqa: E731 (road users off the road are left out)
+        ahead = 1 if lane < 0 else -1  # the ego's direction in s
+        entities, inits = [VEHICLE.format(name="Ego", model="smart_car")], []
+        inits.append(INIT.format(name="Ego", road=road, lane=lane, s=s, v=0))
+        cars = [("Lead", rng.choice(VEHICLE_MODELS[:5]), lane, s + ahead * rng.uniform(20, 30), rng.uniform(4, 6))]
+        for j in range(rng.randint(1, 3)):  # more traffic along the ego's direction
+            ln = rng.choice(along)
+            cars.append(("Along%d" % j, rng.choice(VEHICLE_MODELS), ln,
+                         s + ahead * rng.uniform(40, 110) if ln == lane else s + ahead * rng.uniform(-5, 90),
+                         rng.uniform(3, 7)))
+        for j, ln in enumerate(rng.choice(oncoming) for _ in range(rng.randint(3, 4)) if oncoming):
+            cars.append(("Oncoming%d" % j, rng.choice(VEHICLE_MODELS), ln, s + ahead * (40 + 30 * j + rng.uniform(0, 15)),
+                         rng.uniform(5, 8)))
+        placed = []
+        for n, m, ln, ss, v in cars:
+            # off the road, or within 15 m of one placed before on its lane: left out
+            if on_road(ss) and all(l != ln or abs(ss - p) >= 15.0 for l, p in placed):
+                placed.append((ln, ss))
+                entities.append(VEHICLE.format(name=n, model=m))
+                inits.append(INIT.format(name=n, road=road, lane=ln, s="%.1f" % ss, v="%.1f" % v))
+        for j in range(rng.randint(4, 6)):
+            n, model = "Walker%d" % j, rng.choice(WALKER_MODELS)
+            ss, v = s + ahead * (10 + 14 * j + rng.uniform(0, 8)), rng.uniform(0.9, 1.6)
+            if on_road(ss):
+                entities.append(TRAIN_PEDESTRIAN.format(name=n, model=model))
+                inits.append(INIT.format(name=n, road=road, lane=walks[j % len(walks)], s="%.1f" % ss, v="%.1f" % v))
+        with open(os.path.join(out, "train_%s.xosc" % name), "w") as f:
+            f.write(DOC.format(name=name, xodr="../" + ESMINI + mp + ".xodr", entities="".join(entities),
+                               inits="".join(inits), end=story_end(5, 30))
+                    .replace("busy_%s: the ego" % name, "train_%s: a detector training scene, the ego" % name)
+                    .replace("make_busy_scenarios.py. -->", "make_busy_scenarios.py, its training set. -->")
+                    .replace('path="../suite/catalogs"', 'path="../../suite/catalogs"')
+                    .replace('description="busy %s"' % name, 'description="detector training %s"' % name))
+        print("train/train_%s.xosc" % name)
+
+
 if __name__ == "__main__":
-    main()
+    train() if "--train" in sys.argv[1:] else main()

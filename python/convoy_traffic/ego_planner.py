@@ -159,10 +159,13 @@ def objects_from_detections(detections, depth, width, height, hfov, cam_x=0.0, c
     return out
 
 
+MAX_WALKER_SPEED = 4.0  # m/s: a pedestrian track's raw velocity is clamped to it
+
+
 class Tracker:
     """Velocities for detections: each object is matched to the nearest one of its class in
-    the previous frame (within `gate` m); its velocity is a filtered difference. Ids become
-    track ids."""
+    the previous frame (within `gate` m); its velocity is a filtered difference (a
+    pedestrian's raw difference clamped to MAX_WALKER_SPEED). Ids become track ids."""
 
     def __init__(self, gate=2.5, alpha=0.3):
         self.gate, self.alpha = gate, alpha
@@ -194,6 +197,12 @@ class Tracker:
                 # absolute velocity = relative rate + the ego's own speed
                 raw_lon = (o["lon"] - tr["lon"]) / dt + ego_speed
                 raw_lat = (o["lat"] - tr["lat"]) / dt
+                if o["class"] == "pedestrian":
+                    # No one walks faster than MAX_WALKER_SPEED: more is the depth ranging
+                    # jumping (a box taking in more or less background), not motion.
+                    raw = math.hypot(raw_lon, raw_lat)
+                    if raw > MAX_WALKER_SPEED:
+                        raw_lon, raw_lat = raw_lon * MAX_WALKER_SPEED / raw, raw_lat * MAX_WALKER_SPEED / raw
                 v_lon = tr["v_lon"] + self.alpha * (raw_lon - tr["v_lon"])
                 v_lat = tr["v_lat"] + self.alpha * (raw_lat - tr["v_lat"])
             o = dict(o, id=tid, v_lon=v_lon, v_lat=v_lat)

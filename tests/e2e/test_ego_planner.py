@@ -121,6 +121,10 @@ class Logic(unittest.TestCase):
         moved = tr.update([dict(o, lat=o["lat"] + 0.15)], 0.1, 0.0)
         self.assertAlmostEqual(moved[0]["v_lat"], 1.5)
         self.assertEqual(moved[0]["id"], "track0")
+        # a pedestrian's range jumping 2 m in 0.1 s (the depth ranging, not motion) gives at
+        # most a walker's speed
+        jumped = tr.update([dict(o, lat=o["lat"] + 0.15, lon=o["lon"] - 2.0)], 0.2, 0.0)
+        self.assertLessEqual(math.hypot(jumped[0]["v_lon"], jumped[0]["v_lat"]), ep.MAX_WALKER_SPEED + 1e-9)
 
     def test_crossing_prediction(self):
         pl = ep.Planner(self.params())
