@@ -1,8 +1,8 @@
 // Reads MCAP files (https://mcap.dev/spec) written by McapWriter or anyone else, front to
 // back: the records of the data section, with the records inside chunks (uncompressed or
-// compressed with zstd) in their place. Checks the magic, every record's length, the chunks' CRCs, the data
-// section's CRC and the summary's CRC. A file cut short (a killed writer) reads up to its
-// last whole record; whether it ended cleanly is reported, not thrown.
+// compressed with zstd) in their place. Checks the magic, every record's length, the chunks'
+// CRCs, the data section's CRC and the summary's CRC. A file cut short (a killed writer) reads
+// up to its last whole record; whether it ended cleanly is reported, not thrown.
 #pragma once
 
 #include <cstdint>
