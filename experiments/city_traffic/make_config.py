@@ -170,6 +170,7 @@ def config():
             {"Name": "truth_tf", "FileName": "../autonomous_driving/truth_tf.py"},
             {"Name": "traffic_tf", "FileName": "traffic_tf.py"},
             {"Name": "recorder_tf", "FileName": "recorder_tf.py"},
+            {"Name": "score_tf", "FileName": "score_tf.py"},
         ],
     }
 

@@ -232,6 +232,11 @@ class Script(EngineScript):
             "simulated_s": sim,
         }
         path = os.path.join(self.dir, "summary.json")
+        try:  # keep what functions wrote there (score_tf.py's live score)
+            with open(path) as f:
+                summary = {**json.load(f), **summary}
+        except (OSError, ValueError, TypeError):
+            pass
         with open(path, "w") as f:
             json.dump(summary, f, indent=1)
         print("recorder: %d road users, %d collisions, %d red-light violations, min TTC %s, "

@@ -16,6 +16,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -105,6 +106,14 @@ class Outputs(CityCase):
         # the ego's track is drawn in yellow (BGR 0, 255, 255)
         yellow = ((bird[:, :, 0] < 40) & (bird[:, :, 1] > 215) & (bird[:, :, 2] > 215)).sum()
         self.assertGreater(yellow, 200)
+        # the live score (score_tf.py) agrees with the score of the finished run folder
+        sys.path.insert(0, os.path.join(REPO, "python"))
+        from convoy_bench import runs
+        after = runs.score_run(d)
+        self.assertGreater(s["route_completion"], 5.0)
+        self.assertAlmostEqual(s["route_completion"], after["route_completion"], delta=1.0)
+        self.assertAlmostEqual(s["driving_score"], after["driving_score"], delta=1.0)
+        self.assertEqual([i["kind"] for i in s["infractions"]], [i["kind"] for i in after["infractions"]])
         with open(os.path.join(d, "ego_planner.json")) as f:
             planner = json.load(f)
         self.assertTrue(planner["ground_truth"])
