@@ -4,7 +4,10 @@
 channel, reading at full speed. Prints the loop's real-time factor of each run (summary.json's
 `real_time_factor`: start-up and shutdown not counted), `live real-time factor ratio: R` (the
 mean with clients over the mean without) and `dropped messages: N` (summary.json's
-live.dropped_messages, over every client of every run).
+live.dropped_messages, over every client of every run). Then one more run with the web
+dashboard open in headless Chromium (tools/dashboard_check, puppeteer-core) prints
+`frame latency ms: N` (median, a camera frame reaching the coordinator's tap -> drawn in the
+page) and `dashboard first paint ms: N` (opening the URL -> first contentful paint).
 
   /usr/bin/python3 benchmarks/live_bench.py [--seconds 30] [--repeats 2] [--clients 2]
                                             [--build build] [--config CONFIG]
@@ -26,6 +29,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 CONFIG = os.path.join(REPO, "experiments", "autonomous_driving", "simulation_config_both.json")
 LIVE_CHECK = os.path.join(REPO, "tools", "live_check")
+DASHBOARD_CHECK = os.path.join(REPO, "tools", "dashboard_check")
 
 
 def cpu_model():
@@ -72,6 +76,27 @@ def run(args, tmp, name, clients):
     return summary, got
 
 
+def dashboard(args, tmp):
+    """A live run with the dashboard open in headless Chromium: dashboard_check's figures."""
+    port = free_port()
+    run_dir = os.path.join(tmp, "dashboard")
+    cmd = [args.convoy, "run", "-q", "-c", args.config, "-o", "SimulationTimeout=%g" % args.seconds,
+           "--run-dir", run_dir, "--live", str(port)]
+    sim = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        check = subprocess.run(
+            ["node", os.path.join(DASHBOARD_CHECK, "check.mjs"), "--url", "http://127.0.0.1:%d/" % port,
+             "--expect-live", "--seconds", str(max(5, int(args.seconds / 2))), "--timeout", "120"],
+            capture_output=True, text=True, timeout=600)
+    finally:
+        _, err = sim.communicate(timeout=args.seconds * 20 + 120)
+    if sim.returncode != 0:
+        sys.exit("%s failed (%d): %s" % (" ".join(cmd), sim.returncode, err[-2000:]))
+    if check.returncode != 0:
+        sys.exit("dashboard_check failed: %s" % check.stderr[-2000:])
+    return json.loads(check.stdout)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seconds", type=float, default=30, help="simulated seconds per run")
@@ -83,6 +108,8 @@ def main():
     args.convoy = os.path.join(args.build, "bin", "convoy")
     if not os.path.isdir(os.path.join(LIVE_CHECK, "node_modules", "@foxglove", "ws-protocol")):
         sys.exit("tools/live_check is not installed: (cd tools/live_check && npm ci)")
+    if not os.path.isdir(os.path.join(DASHBOARD_CHECK, "node_modules", "puppeteer-core")):
+        sys.exit("tools/dashboard_check is not installed: (cd tools/dashboard_check && npm ci)")
     tmp = tempfile.mkdtemp(prefix="convoy_live_bench_")
     plain, live, dropped = [], [], 0
     try:
@@ -100,6 +127,10 @@ def main():
                   "(camera images %s), dropped %d" %
                   (i + 1, args.clients, live[-1], counts, images,
                    summary["live"]["dropped_messages"]), flush=True)
+        page = dashboard(args, tmp)
+        print("dashboard run: %d camera frames drawn, %d latencies, %d road users" %
+              (page.get("framesDrawn", 0), page.get("latencies", 0), page.get("roadUsers", 0)),
+              flush=True)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print("cpu: %s (%d cores)" % (cpu_model(), os.cpu_count()))
@@ -109,6 +140,8 @@ def main():
     print("real-time factor with %d clients: mean %.3f" % (args.clients, statistics.mean(live)))
     print("live real-time factor ratio: %.3f" % (statistics.mean(live) / statistics.mean(plain)))
     print("dropped messages: %d" % dropped)
+    print("frame latency ms: %.1f" % page["frameLatencyMedianMs"])
+    print("dashboard first paint ms: %.1f" % page["firstPaintMs"])
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ PACKAGES=(
   slurm-wlm slurmctld slurmd slurm-client munge
   zlib1g-dev libzstd-dev libboost-dev
   ffmpeg
+  chromium
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
@@ -50,4 +51,12 @@ if command -v npm >/dev/null; then
   # Foxglove's own protocol client watches a live run (tests/e2e/test_live.py).
   (cd tools/live_check && npm ci --no-audit --no-fund --loglevel=error) ||
     echo "warning: npm ci in tools/live_check failed; the @foxglove/ws-protocol test will be skipped"
+  # puppeteer-core drives Debian's chromium (above), headless, through the web dashboard
+  # (tests/e2e/test_dashboard.py); it downloads no browser.
+  (cd tools/dashboard_check && npm ci --no-audit --no-fund --loglevel=error) ||
+    echo "warning: npm ci in tools/dashboard_check failed; the dashboard test will be skipped"
+  # The web dashboard that `convoy run --live` and `convoy view` serve at / (web/dashboard/dist,
+  # linked as build/share/convoy/dashboard).
+  (cd web/dashboard && npm ci --no-audit --no-fund --loglevel=error && npm run build) ||
+    echo "warning: the web dashboard did not build; convoy run --live and convoy view show a text page at / instead"
 fi

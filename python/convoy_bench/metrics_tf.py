@@ -12,14 +12,19 @@ From the config it takes the names, the map (the scenario engine's Map) and Simu
 
 It writes every WRITE_EVERY samples and at the end: when the scenario engine says done, or at
 the last cycle before SimulationTimeout. At the end a route not finished is a scenario_timeout
-infraction. Replaying the same datapacks gives the same summary fields, bit for bit."""
+infraction. Replaying the same datapacks gives the same summary fields, bit for bit.
+
+In a live run (`convoy run --live`) each new infraction event goes to the viewers on
+/convoy/infractions as it happens ({"time_s", "kind", "other", ...}), as do the infractions
+the score finds when it is computed (min_speed, ...; each once), and the summary fields on
+/convoy/metrics whenever they are written (run_files.update_summary)."""
 
 import os
 
 from nrp_core import *  # noqa: F401,F403
 
 from convoy_bench.live import LiveScore, summary_fields
-from convoy_bench.run_files import load_config, update_summary
+from convoy_bench.run_files import INFRACTIONS_TOPIC, load_config, publish_live, update_summary
 
 WRITE_EVERY = 100   # samples (5 s at 20 Hz): scoring the drive so far costs ~0.1 s
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -43,7 +48,7 @@ if LIGHTS is not None:
     from convoy_scenario.stop_lines import stop_lines  # noqa: E402
     STOP_LINES = stop_lines(LIGHTS["Map"])
 
-_state = {"live": None, "final": False, "n": 0}
+_state = {"live": None, "final": False, "n": 0, "events_sent": 0, "sent": set()}
 
 
 def _user(dp):
@@ -79,14 +84,37 @@ def _metrics(time_ns, route, scenario, ego, collisions, lights=None, **agents):
         signals = {} if lights is None or lights.isEmpty() else dict(lights.data.get("signals") or {})
         live.add(t, e, others, cols, signals)
         _state["n"] += 1
+        _publish_events(live)
     done = not scenario.isEmpty() and bool(scenario.data.get("done"))
     final = done or (TIMEOUT > 0 and t + DT > TIMEOUT + 1e-9)
     if final or (_state["n"] and _state["n"] % WRITE_EVERY == 0):
         r = live.result(final=final, timed_out=final)
         if r is not None:
-            update_summary(summary_fields(r, final))
+            fields = summary_fields(r, final)
+            update_summary(fields)
+            for i in fields["infractions"]:
+                if i.get("time") is not None:
+                    _publish_infraction(i["time"], i)
         _state["final"] = final
     return []
+
+
+def _publish_infraction(t, infraction):
+    """One infraction to the viewers of a live run, unless it was sent already."""
+    key = (infraction.get("kind"), round(float(t), 6), str(infraction.get("other")))
+    if key in _state["sent"]:
+        return
+    _state["sent"].add(key)
+    msg = {"time_s": float(t), "kind": infraction.get("kind")}
+    msg.update({k: v for k, v in infraction.items() if k not in ("t", "time", "kind")})
+    publish_live(INFRACTIONS_TOPIC, msg)
+
+
+def _publish_events(live):
+    """The LiveScore events not sent yet (collisions, red lights), as they happen."""
+    for ev in live.events[_state["events_sent"]:]:
+        _publish_infraction(ev["t"], ev)
+    _state["events_sent"] = len(live.events)
 
 
 metrics = _metrics

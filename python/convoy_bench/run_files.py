@@ -1,8 +1,18 @@
 """The run folder as the live-scoring functions use it (metrics_tf.py, detection_tf.py): the
-run's effective config, and summary.json updated in place with a function's fields."""
+run's effective config, and summary.json updated in place with a function's fields. In a live
+run (`convoy run --live`) the fields also go to the viewers on /convoy/metrics, through the
+coordinator's module convoy_live (absent outside Convoy: then nothing is sent)."""
 
 import json
 import os
+
+try:
+    import convoy_live as _live
+except ImportError:  # not in the coordinator's interpreter
+    _live = None
+
+METRICS_TOPIC = "/convoy/metrics"
+INFRACTIONS_TOPIC = "/convoy/infractions"
 
 
 def run_dir():
@@ -31,3 +41,16 @@ def update_summary(fields):
     with open(tmp, "w") as f:
         json.dump(summary, f, indent=1)
     os.replace(tmp, path)
+    publish_live(METRICS_TOPIC, fields)
+
+
+def publish_live(topic, message):
+    """Sends the dict `message` to the viewers of a live run on `topic` (/convoy/metrics or
+    /convoy/infractions). True when sent; False without --live, outside Convoy, or when it
+    cannot be sent (never raises: a viewer must not change the run)."""
+    if _live is None:
+        return False
+    try:
+        return bool(_live.enabled()) and bool(_live.publish(topic, message))
+    except Exception:  # noqa: BLE001 (a message that is not JSON, say)
+        return False

@@ -46,6 +46,9 @@ def _parser():
     p.add_argument("--out", help="output folder (default campaigns/<suite folder name>)")
     p.add_argument("--seconds", type=float, help="simulated seconds per run (default: the "
                                                  "config's SimulationTimeout)")
+    p.add_argument("--record", action="store_true",
+                   help="record each run (RUN_DIR/recording.mcap); report.html links each to the "
+                        "dashboard: open it with `convoy view OUT_DIR`")
     p.add_argument("--build", help="Convoy's build folder, for bin/convoy (default "
                                    "<repo>/build, or $CONVOY_BIN_DIR/convoy when set)")
     p.add_argument("--poll", type=float, default=1.0, help="seconds between Slurm polls")
@@ -95,7 +98,7 @@ def main(argv=None):
         entries = load_suite(args.suite)
         out = os.path.abspath(args.out or os.path.join(
             "campaigns", os.path.basename(os.path.normpath(os.path.abspath(args.suite)))))
-        plan = make_plan(entries, args.seeds, weathers, out, convoy, args.seconds)
+        plan = make_plan(entries, args.seeds, weathers, out, convoy, args.seconds, args.record)
         os.makedirs(out, exist_ok=True)
         state = CampaignState.open(out, plan, args.backend)
     except (SuiteError, StateError) as e:

@@ -17,11 +17,16 @@ Sections, from results.collect's records:
    attempts, wall s).
 6. Failed tasks: exit code, reason, log path and the last LOG_TAIL_LINES lines of its log.
 Every value from the runs is HTML-escaped.
+
+A run that has a recording (RUN_DIR/recording.mcap) links to it in the web dashboard
+(`/?mcap=/files/<run path relative to the campaign folder>/recording.mcap`): those links work
+when `convoy view CAMPAIGN_DIR` serves this page (the line at the top says so).
 """
 
 import html
 import math
 import os
+import urllib.parse
 
 from .results import INFRACTION_KINDS, infraction_counts
 
@@ -130,6 +135,20 @@ def _count(v):
     return v if isinstance(v, (int, float)) and not isinstance(v, bool) else None
 
 
+def recording_link(record, out_dir):
+    """The dashboard URL of the run's recording as `convoy view OUT_DIR` serves it, or None
+    when the run has no recording.mcap (or lies outside the campaign folder)."""
+    run_dir = record.get("run_dir")
+    if not run_dir or not os.path.isfile(os.path.join(run_dir, "recording.mcap")):
+        return None
+    rel = os.path.relpath(os.path.abspath(run_dir), os.path.abspath(out_dir))
+    if rel == ".." or rel.startswith(".." + os.sep) or os.path.isabs(rel):
+        return None
+    path = "/".join(p for p in rel.split(os.sep) if p not in ("", "."))
+    return "/?mcap=/files/%s" % urllib.parse.quote(
+        (path + "/" if path else "") + "recording.mcap")
+
+
 def render(records, plan, scorer_missing=None):
     by_scenario = {}
     for r in records:
@@ -138,6 +157,12 @@ def render(records, plan, scorer_missing=None):
     out = ['<!DOCTYPE html><html><head><meta charset="utf-8"><title>Convoy campaign</title>'
            '<style>%s</style></head><body>' % CSS]
     out.append("<h1>Convoy campaign</h1>")
+    links = {id(r): recording_link(r, plan["out"]) for r in records}
+    recorded = any(links.values())
+    if recorded:
+        out.append('<p class="note">Recordings: open with <code>convoy view CAMPAIGN_DIR</code> '
+                   '(here <code>convoy view %s</code>) and follow a run\'s '
+                   '&ldquo;view&rdquo; link to watch it in the dashboard.</p>' % _e(plan["out"]))
     out.append("<p>%d tasks (%d scenarios &times; %d seeds &times; %d weathers: %s): "
                "%d done, %d failed. Output: <code>%s</code>.</p>" % (
                    len(records), len(by_scenario), plan["seeds"], len(plan["weathers"]),
@@ -198,7 +223,8 @@ def render(records, plan, scorer_missing=None):
         out.append('<p class="note">%s</p>' % _e(rs[0]["config"]))
         out.append("<table><tr><th>seed</th><th>weather</th><th>DS</th><th>RC</th><th>penalty</th>"
                    "<th>infractions</th><th>collisions</th><th>red lights</th><th>min TTC s</th>"
-                   "<th>mAP@0.5</th><th>sim s</th><th>exit</th><th>attempts</th><th>wall s</th></tr>")
+                   "<th>mAP@0.5</th><th>sim s</th><th>exit</th><th>attempts</th><th>wall s</th>%s"
+                   "</tr>" % ("<th>recording</th>" if recorded else ""))
         for r in rs:
             s, sc = r["summary"], r["score"] or {}
             infr = sum(infraction_counts(sc).values()) if r["score"] else None
@@ -212,6 +238,10 @@ def render(records, plan, scorer_missing=None):
                            _fmt(_count(s.get("red_light_violations"))), _fmt(s.get("min_ttc_s")),
                            _fmt(s.get("detector_map50"), 3), _fmt(s.get("sim_time_s")),
                            _fmt(r["exit_code"]), r["attempts"], _fmt(r["wall_s"], 1)))
+            if recorded:
+                link = links[id(r)]
+                out[-1] = out[-1][:-len("</tr>")] + "<td>%s</td></tr>" % (
+                    '<a href="%s">view</a>' % _e(link) if link else "&mdash;")
         out.append("</table>")
 
     # 6. failed

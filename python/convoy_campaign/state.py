@@ -62,7 +62,7 @@ class CampaignState:
                                  "--out" % (path, e)) from None
             if doc.get("plan_digest") != digest:
                 raise StateError("%s holds another campaign (other entries, seeds, weathers, "
-                                 "--seconds or convoy); use another --out" % path)
+                                 "--seconds, --record or convoy); use another --out" % path)
             if doc.get("backend") != backend:
                 raise StateError("%s was run with --backend %s, not %s; use another --out" % (
                     path, doc.get("backend"), backend))

@@ -236,9 +236,11 @@ def task_name(scenario, seed, weather):
     return "%s__s%d__%s" % (scenario, seed, weather)
 
 
-def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None):
+def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=False):
     """The campaign's plan: {"version", "out", "convoy", "seconds", "seeds", "weathers",
-    "tasks": [{"index", "name", "scenario", "seed", "weather", "config", "run_dir", "argv"}]}."""
+    "record", "tasks": [{"index", "name", "scenario", "seed", "weather", "config", "run_dir",
+    "argv"}]}. With `record` each run also writes RUN_DIR/recording.mcap (`convoy run
+    --record`), which report.html links to the dashboard."""
     out_dir = os.path.abspath(out_dir)
     tasks = []
     for e in entries:
@@ -248,8 +250,10 @@ def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None):
                 run_dir = os.path.join(out_dir, "runs", name)
                 argv = ENTRY_TYPES[e["type"]](e, seed, weather, {
                     "convoy": convoy, "run_dir": run_dir, "seconds": seconds})
+                if record:
+                    argv.insert(2, "--record")  # after `convoy run`
                 tasks.append({"index": len(tasks), "name": name, "scenario": e["name"],
                               "seed": seed, "weather": weather, "config": e["config"],
                               "run_dir": run_dir, "argv": argv})
     return {"version": 1, "out": out_dir, "convoy": convoy, "seconds": seconds, "seeds": seeds,
-            "weathers": list(weathers), "tasks": tasks}
+            "weathers": list(weathers), "record": bool(record), "tasks": tasks}

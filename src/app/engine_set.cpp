@@ -150,6 +150,7 @@ void EngineSet::initialize(RunLog& log, std::vector<EngineStartup>* startup) {
     engine::Reply reply;
     e->finish(&reply);
     const auto& init = reply.initialize();
+    e->registered.assign(init.registered().begin(), init.registered().end());
     for (const auto& w : init.warnings()) log.info("warning: engine '" + e->name() + "': " + w);
     if (startup) {
       EngineStartup s{e->name()};

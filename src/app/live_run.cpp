@@ -5,7 +5,10 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "app/scene_setup.h"
 #include "core/error.h"
+#include "live/static_files.h"
+#include "python/live_module.h"
 
 namespace convoy::app {
 
@@ -25,6 +28,16 @@ live::ServerOptions server_options(const RunOptions& options, const config::Simu
       std::to_string(getpid()) + "-" +
       std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(now).count());
   o.info.metadata = {{"simulation", cfg.name}, {"config", cfg.file.string()}};
+  o.info.capabilities = {"time", "clientPublish"};  // /convoy/control
+  o.info.supported_encodings = {"json"};
+  // The dashboard at / (share/convoy/dashboard, built from web/dashboard).
+  o.http = live::make_http_handler(
+      share_dir() / "dashboard", std::nullopt,
+      live::no_dashboard_page(
+          share_dir() / "dashboard",
+          "Meanwhile, Foxglove or Lichtblick can show this run: open a Foxglove "
+          "WebSocket connection to ws://" +
+              o.address.text() + "\n"));
   return o;
 }
 
@@ -45,7 +58,16 @@ LiveRun::LiveRun(const RunOptions& options, const config::SimulationConfig& cfg,
   }
   live::TapOptions t;
   t.camera_hz = options.live_camera_hz;
+  t.scene_hz = options.live_scene_hz;
+  const SceneSetup scene = scene_setup(cfg, log_);
+  t.map = scene.map;
+  t.scene = scene.options;
   tap_ = std::make_unique<live::LiveTap>(*server_, t);
+  control_ = std::make_unique<live::RunControl>(*server_, gate_);
+  python::set_live_publisher([control = control_.get()](const std::string& topic,
+                                                        const std::string& json, int64_t time_ns) {
+    return control->publish(topic, json, time_ns);
+  });
   if (options.insecure && !live::is_loopback_host(o.address.host))
     log_.info("warning: --insecure: the live server listens at " + o.address.text() +
               " without TLS or token");
@@ -54,6 +76,9 @@ LiveRun::LiveRun(const RunOptions& options, const config::SimulationConfig& cfg,
   };
   log_.info("live: serving at " + server_->url() +
             " (Foxglove or Lichtblick: open a Foxglove WebSocket connection to it)");
+  std::string page = server_->url();
+  page.replace(0, 2, "http");  // ws://HOST:PORT -> http://HOST:PORT
+  log_.info("live: dashboard at " + page + "/");
 }
 
 LiveRun::~LiveRun() {
@@ -65,6 +90,8 @@ nlohmann::json LiveRun::finish() {
   if (finished_) return figures_;
   finished_ = true;
   log_.sink = nullptr;
+  python::set_live_publisher(nullptr);
+  gate_.close();
   server_->stop(1.0);
   uint64_t dropped = 0;
   nlohmann::json clients = nlohmann::json::array();
@@ -87,7 +114,10 @@ nlohmann::json LiveRun::finish() {
               {"datapack_channels", tap_->channels()},
               {"datapacks_encoded", tap_->encoded()},
               {"camera_frames", frames.encoded()},
-              {"camera_frames_skipped", frames.skipped()}};
+              {"camera_frames_skipped", frames.skipped()},
+              {"control_commands", control_->commands()},
+              {"paused_s", gate_.held_ns() * 1e-9},
+              {"metrics_published", control_->published()}};
   if (tap_->skipped() > 0)
     log_.info("warning: live: " + std::to_string(tap_->skipped()) +
               " datapacks could not be shown; the first: " + tap_->first_skip());

@@ -11,7 +11,9 @@
 #include "app/simulation.h"
 #include "config/simulation_config.h"
 #include "live/live_tap.h"
+#include "live/run_control.h"
 #include "live/server.h"
+#include "loop/pause_gate.h"
 
 namespace convoy::app {
 
@@ -22,6 +24,8 @@ class LiveRun {
   LiveRun(const RunOptions& options, const config::SimulationConfig& cfg, RunLog& log);
   ~LiveRun();
   loop::DataPackTap* tap() { return tap_.get(); }
+  // Where the viewers pause the loop (/convoy/control).
+  loop::PauseGate* gate() { return &gate_; }
   // Closes the connections once their queues are sent (at most 1 s), logs what each client
   // got and lost; summary.json's "live".
   nlohmann::json finish();
@@ -30,6 +34,8 @@ class LiveRun {
   RunLog& log_;
   std::unique_ptr<live::LiveServer> server_;
   std::unique_ptr<live::LiveTap> tap_;  // after the server: goes first
+  loop::PauseGate gate_;
+  std::unique_ptr<live::RunControl> control_;
   bool finished_ = false;
   nlohmann::json figures_;
 };

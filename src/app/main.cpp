@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/simulation.h"
+#include "app/view.h"
 #include "core/memory.h"
 #include "live/address.h"
 #include "python/interpreter.h"
@@ -32,6 +33,7 @@ void usage(const char* prog) {
       "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s campaign SUITE_DIR [--seeds N] [--workers N] [--backend local|slurm] [--out DIR]\n"
       "                [...]  (tools/campaign/campaign.py; --help for its options)\n"
+      "       %s view PATH [--port P] [--host H [--insecure]]\n"
       "       NRPCoreSim -c simulation_config.json [-o Key=Value]...\n"
       "\n"
       "  --record            record every datapack that crosses the coordinator into\n"
@@ -42,10 +44,14 @@ void usage(const char* prog) {
       "                      addresses only, unless --insecure); every datapack a channel,\n"
       "                      the camera as JPEG, the log (docs/architecture.md, \"Live server\")\n"
       "  --live-camera-hz HZ with --live: JPEG camera frames per simulated second (default 10)\n"
+      "  --live-scene-hz HZ  with --live: /convoy/scene updates per simulated second (default 10)\n"
       "  --insecure          with --live or --server_address: listen beyond the loopback too\n"
       "                      (there is no TLS or token: anyone who reaches it sees the run)\n"
       "  replay RUN_DIR      re-run the functions on the recording (no engines); exit 0 when\n"
       "                      they send what they sent live, 5 when not (RUN_DIR/replay/)\n"
+      "  view PATH           serve the web dashboard and the files under PATH (a run folder, a\n"
+      "                      campaign folder, a .mcap file) at http://127.0.0.1:8765 (--port,\n"
+      "                      --host) until Ctrl-C; prints the URL to open\n"
       "  score RUN_DIR       replay into RUN_DIR/rescore/ and compare the fields the functions\n"
       "                      wrote (driving_score...) with the live ones; exit 5 if one differs\n"
       "\n"
@@ -74,7 +80,16 @@ void usage(const char* prog) {
       "  --logoutput all|engines|silent   all: this program's output into --logfilename;\n"
       "                      silent: none; engines: (engines log into the run folder anyway)\n"
       "  --logfilename FILE  default .console_output.log\n",
-      prog, prog, prog, prog, prog);
+      prog, prog, prog, prog, prog, prog);
+}
+
+// The value of the option at argv[*i] (the next argument; *i moves to it); none: exit 2.
+std::string next_value(int argc, char** argv, int* i) {
+  if (*i + 1 >= argc) {
+    std::fprintf(stderr, "error: %s needs a value\n", argv[*i]);
+    std::exit(2);
+  }
+  return argv[++*i];
 }
 
 // convoy replay|score RUN_DIR [--out DIR] [-c CONFIG] [-o K=V]... [-q]
@@ -82,13 +97,7 @@ int replay_command(const char* prog, bool score, int argc, char** argv) {
   convoy::app::ReplayOptions options;
   for (int i = 2; i < argc; ++i) {
     std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "error: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
+    auto value = [&] { return next_value(argc, argv, &i); };
     if (a == "--out")
       options.out_dir = value();
     else if (a == "-c" || a == "--config")
@@ -113,6 +122,44 @@ int replay_command(const char* prog, bool score, int argc, char** argv) {
     return 2;
   }
   return score ? convoy::app::score_run(options) : convoy::app::replay_run(options);
+}
+
+// convoy view PATH [--port P] [--host H] [--insecure]
+int view_command(const char* prog, int argc, char** argv) {
+  convoy::app::ViewOptions options;
+  for (int i = 2; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&] { return next_value(argc, argv, &i); };
+    if (a == "--port") {
+      const std::string v = value();
+      char* end = nullptr;
+      const long port = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end || port < 0 || port > 65535) {
+        std::fprintf(stderr, "error: --port must be a number from 0 to 65535, got '%s'\n",
+                     v.c_str());
+        return 2;
+      }
+      options.port = static_cast<uint16_t>(port);
+    } else if (a == "--host") {
+      options.host = value();
+    } else if (a == "--insecure") {
+      options.insecure = true;
+    } else if (a == "-h" || a == "--help") {
+      usage(prog);
+      return 0;
+    } else if (!a.empty() && a[0] != '-' && options.path.empty()) {
+      options.path = a;
+    } else {
+      std::fprintf(stderr, "error: unknown option '%s'\n", a.c_str());
+      usage(prog);
+      return 2;
+    }
+  }
+  if (options.path.empty()) {
+    std::fprintf(stderr, "error: view needs a run folder, campaign folder or .mcap file (PATH)\n");
+    return 2;
+  }
+  return convoy::app::view_files(options);
 }
 
 // NRP-Core's --logoutput: `all` sends this program's stdout and stderr to `file`, `silent` to
@@ -240,6 +287,7 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[1], "replay") || !std::strcmp(argv[1], "score"))
       return replay_command(prog.c_str(), !std::strcmp(argv[1], "score"), argc, argv);
     if (std::strcmp(argv[1], "campaign") == 0) return campaign(argc, argv);
+    if (std::strcmp(argv[1], "view") == 0) return view_command(prog.c_str(), argc, argv);
     if (std::strcmp(argv[1], "run") != 0) {
       std::fprintf(stderr, "error: unknown command '%s'\n", argv[1]);
       usage(prog.c_str());
@@ -262,12 +310,7 @@ int main(int argc, char** argv) {
       }
     }
     auto value = [&]() -> std::string {
-      if (has_inline) return inline_value;
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "error: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
+      return has_inline ? inline_value : next_value(argc, argv, &i);
     };
     if (a == "-c" || a == "--config")
       options.config_file = value();
@@ -308,6 +351,14 @@ int main(int argc, char** argv) {
       if (v.empty() || *end || !(options.live_camera_hz >= 0) || options.live_camera_hz > 1e6) {
         std::fprintf(stderr, "error: --live-camera-hz must be a number >= 0, got '%s'\n",
                      v.c_str());
+        return 2;
+      }
+    } else if (a == "--live-scene-hz") {
+      const std::string v = value();
+      char* end = nullptr;
+      options.live_scene_hz = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end || !(options.live_scene_hz >= 0) || options.live_scene_hz > 1e6) {
+        std::fprintf(stderr, "error: --live-scene-hz must be a number >= 0, got '%s'\n", v.c_str());
         return 2;
       }
     } else if (a == "--logoutput")

@@ -95,6 +95,8 @@ Replay::Replay(const fs::path& recording) : path_(recording) {
     record_blobs_ = metadata_["record_blobs"] == "true";
     if (auto e = check.metadata().find("convoy_end"); e != check.metadata().end()) end_ = e->second;
     for (const auto& [id, ch] : check.channels()) {
+      // Viewers' channels (a camera's JPEG and calibration, the scene) hold no datapack.
+      if (ch.metadata.count("camera") || ch.metadata.count("viewer")) continue;
       auto get = [&](const char* key) -> std::string {
         auto it = ch.metadata.find(key);
         if (it == ch.metadata.end())
@@ -148,7 +150,9 @@ void Replay::advance_to(uint64_t time_ns) {
     }
     if (peeked_.log_time > time_ns) return;
     has_peeked_ = false;
-    const Topic& t = topics_.at(peeked_.channel);
+    const auto topic = topics_.find(peeked_.channel);
+    if (topic == topics_.end()) continue;  // a viewers' channel
+    const Topic& t = topic->second;
     RecordedDataPack r{peeked_.log_time, peeked_.sequence, t.name,
                        t.kind,           t.type,           std::move(peeked_.data)};
     (t.to_engine ? to_ : from_)[t.engine].push_back(std::move(r));

@@ -6,10 +6,12 @@
 #include <set>
 #include <sstream>
 
+#include "app/scene_setup.h"
 #include "app/simulation.h"
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "python/live_module.h"
 
 namespace convoy::app {
 
@@ -130,10 +132,18 @@ void Session::initialize(bool keep_observations) {
   loop_ = std::make_unique<loop::FtiLoop>(engines_.handles(), runtime_, functions_,
                                           status_ ? &*status_ : nullptr);
   loop_->keep_observations(keep_observations);
+  if (show_scene_) {
+    std::string extra;
+    for (const auto& id : scene_datapacks(engines_.handles()))
+      if (loop_->also_want(id.engine_name(), id.name()))
+        extra += (extra.empty() ? "" : ", ") + id.engine_name() + "/" + id.name();
+    if (!extra.empty()) log_.info("scene: also taking " + extra + " (no function reads them)");
+  }
   taps_.add(recorder_.get());
   taps_.add(replay_tap_);
   for (auto* tap : extra_taps_) taps_.add(tap);
   if (!taps_.empty()) loop_->set_tap(taps_.single_or_this());
+  loop_->set_gate(gate_);
   csv_.reset(std::fopen((run_dir_ / "steps.csv").c_str(), "w"));
   if (csv_) std::setvbuf(csv_.get(), nullptr, _IOFBF, 1 << 20);
   loop_->set_step_log(csv_.get());
@@ -158,13 +168,25 @@ void Session::initialize(bool keep_observations) {
 }
 
 void Session::record_to(const fs::path& file, bool blobs, const record::StringMap& metadata) {
-  recorder_ = std::make_unique<record::Recorder>(file, blobs, metadata);
+  record::RecorderOptions options;
+  const SceneSetup scene = scene_setup(cfg_, log_);
+  options.map = scene.map;
+  options.scene = scene.options;
+  recorder_ = std::make_unique<record::Recorder>(file, blobs, metadata, options);
+  python::set_live_publisher(
+      [recorder = recorder_.get()](const std::string& topic, const std::string& json,
+                                   int64_t time_ns) {
+        return recorder->viewer_json(topic, json, time_ns);
+      },
+      python::PublisherSlot::kRecording);
+  show_scene();
   log_.info("recording the datapacks into " + file.string() +
             (blobs ? " (with blobs)" : " (blobs as stubs; --record-blobs records them)"));
 }
 
 void Session::finish_recording(const Outcome& outcome) {
   if (!recorder_) return;
+  python::set_live_publisher(nullptr, python::PublisherSlot::kRecording);
   const std::string error =
       recorder_->finish({{"exit_code", std::to_string(outcome.code)},
                          {"error", outcome.error},
@@ -189,10 +211,12 @@ void Session::replay_with(ChannelFactory channel, loop::DataPackTap* tap) {
 template <typename F>
 void Session::timed(F&& run) {
   const auto start = SteadyClock::now();
+  const int64_t held = gate_ ? gate_->held_ns() : 0;
   auto record = [&] {
     figures_.cycles = loop_->cycles();
     figures_.sim_time_ns = loop_->sim_time_ns();
     figures_.wall_s += std::chrono::duration<double>(SteadyClock::now() - start).count();
+    if (gate_) figures_.wall_s -= (gate_->held_ns() - held) * 1e-9;  // paused by a viewer
     figures_.done = loop_->done();
   };
   try {
@@ -243,6 +267,7 @@ void Session::reset(std::vector<engine::DataPack> inputs) {
 std::string Session::shut_down(bool clean) {
   shut_down_ = true;
   loop_.reset();
+  if (recorder_) python::set_live_publisher(nullptr, python::PublisherSlot::kRecording);
   recorder_.reset();  // finished already, unless the run ended by an exception of its own
   std::string error = engines_.shut_down(clean, log_);
   if (csv_) std::fflush(csv_.get());

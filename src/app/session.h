@@ -78,6 +78,14 @@ class Session {
   // Another tap on the loop (the live server's), after the recorder. Before initialize();
   // it must outlive the session's loop.
   void add_tap(loop::DataPackTap* tap) { extra_taps_.push_back(tap); }
+  // A viewer shows the scene (a live run; a recording, by record_to()): the loop also asks the
+  // engines for the road users the functions do not read (scene_setup.h's scene_datapacks).
+  // Before initialize(); nothing the run computes changes.
+  void show_scene() { show_scene_ = true; }
+  // A gate the loop waits at between cycles (a live run's pause; loop/pause_gate.h). Before
+  // initialize(); it must outlive the session's loop. The time it holds the loop is not in
+  // LoopFigures::wall_s.
+  void pause_with(loop::PauseGate* gate) { gate_ = gate; }
 
   // Loads the functions (a broken file costs no start-up), launches and initializes the
   // engines, and fetches the functions' first inputs. `keep_observations`: collect what the
@@ -124,6 +132,8 @@ class Session {
   ChannelFactory replay_channel_;
   loop::DataPackTap* replay_tap_ = nullptr;
   std::vector<loop::DataPackTap*> extra_taps_;
+  loop::PauseGate* gate_ = nullptr;
+  bool show_scene_ = false;
   loop::TapFanout taps_;
 };
 

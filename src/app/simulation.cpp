@@ -236,12 +236,16 @@ namespace {
 // engines, run the loop; then shut the engines down, whatever happened before.
 Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir, bool quiet,
                     RunLog& log, LoopFigures* figures, StartupFigures* startup,
-                    loop::DataPackTap* live_tap) {
+                    loop::DataPackTap* live_tap, loop::PauseGate* gate) {
   export_run_environment(run_dir);
   python::Interpreter interpreter;
   Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
-  if (live_tap) session.add_tap(live_tap);
+  if (live_tap) {
+    session.add_tap(live_tap);
+    session.show_scene();
+  }
+  session.pause_with(gate);
   try {
     if (cfg.record) {
       try {
@@ -326,7 +330,7 @@ int run_simulation(const RunOptions& options) {
     }
   }
   Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup,
-                                live ? live->tap() : nullptr);
+                                live ? live->tap() : nullptr, live ? live->gate() : nullptr);
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
   nlohmann::json live_fields;
   if (live) live_fields = {{"live", live->finish()}};

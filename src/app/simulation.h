@@ -24,6 +24,7 @@ struct RunOptions {
   // --live [HOST:]PORT: serve the run to Foxglove WebSocket clients (app/live_run.h).
   std::string live;
   double live_camera_hz = 10;  // --live-camera-hz: JPEG frames per simulated second
+  double live_scene_hz = 10;   // --live-scene-hz: /convoy/scene updates per simulated second
 };
 
 // Exit codes of `convoy run`.

@@ -3,7 +3,9 @@
 #include <array>
 #include <boost/asio/post.hpp>
 #include <boost/asio/strand.hpp>
+#include <boost/beast/core/file.hpp>
 #include <boost/beast/core/string.hpp>
+#include <boost/beast/http/basic_file_body.hpp>
 #include <chrono>
 
 #include "live/protocol.h"
@@ -20,6 +22,7 @@ namespace {
 
 constexpr size_t kMaxClientMessage = 1 << 20;  // a subscribe to thousands of channels fits
 constexpr auto kRequestTimeout = std::chrono::seconds(10);
+constexpr auto kWriteTimeout = std::chrono::minutes(30);
 
 // True when the comma-separated header `offered` names `protocol`.
 bool offers(beast::string_view offered, beast::string_view protocol) {
@@ -33,6 +36,42 @@ std::string peer_of(const tcp::socket& socket) {
   const auto ep = socket.remote_endpoint(ec);
   return ec ? "?" : ep.address().to_string() + ":" + std::to_string(ep.port());
 }
+
+// A part of a file, as a Beast File (http::basic_file_body sends all of its file).
+class FileRange {
+ public:
+  bool is_open() const { return file_.is_open(); }
+  void close(beast::error_code& ec) { file_.close(ec); }
+  void open(const char* path, beast::file_mode mode, beast::error_code& ec) {
+    file_.open(path, mode, ec);
+  }
+  // Opens `path` for reading from `offset`, `length` bytes.
+  void open_range(const std::string& path, uint64_t offset, uint64_t length,
+                  beast::error_code& ec) {
+    file_.open(path.c_str(), beast::file_mode::scan, ec);
+    if (!ec) file_.seek(offset, ec);
+    offset_ = offset;
+    length_ = length;
+  }
+  uint64_t size(beast::error_code& ec) const {
+    ec = {};
+    return length_;
+  }
+  uint64_t pos(beast::error_code& ec) const { return file_.pos(ec) - offset_; }
+  void seek(uint64_t offset, beast::error_code& ec) { file_.seek(offset_ + offset, ec); }
+  size_t read(void* buffer, size_t n, beast::error_code& ec) const {
+    return file_.read(buffer, n, ec);
+  }
+  size_t write(const void*, size_t, beast::error_code& ec) {
+    ec = beast::errc::make_error_code(beast::errc::operation_not_permitted);
+    return 0;
+  }
+
+ private:
+  beast::file file_;
+  uint64_t offset_ = 0, length_ = 0;
+};
+using FileRangeBody = http::basic_file_body<FileRange>;
 
 // The first request on a connection: an upgrade becomes a WsConnection; anything else gets
 // the host's HTTP answer and the connection closes.
@@ -57,9 +96,9 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     auto request = parser_->release();
     if (websocket::is_upgrade(request)) {
       if (!offers(request[http::field::sec_websocket_protocol], kSubprotocol)) {
-        answer(request, {400, "text/plain; charset=utf-8",
-                         std::string("this server speaks the WebSocket subprotocol ") +
-                             kSubprotocol + " only\n"});
+        answer(request,
+               HttpAnswer::text(400, std::string("this server speaks the WebSocket subprotocol ") +
+                                         kSubprotocol + " only\n"));
         return;
       }
       stream_.expires_never();
@@ -67,18 +106,54 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
       ws->start(std::move(request));
       return;
     }
-    answer(request,
-           host_.on_http(std::string(request.method_string()), std::string(request.target())));
+    HttpRequest r{std::string(request.method_string()), std::string(request.target()),
+                  std::string(request[http::field::range])};
+    answer(request, host_.on_http(r));
   }
 
   void answer(const http::request<http::string_body>& request, HttpAnswer a) {
+    const bool head = request.method() == http::verb::head;
+    auto header = [&](auto& res) {
+      res.set(http::field::server, "convoy-live");
+      res.set(http::field::content_type, a.content_type);
+      for (const auto& [name, value] : a.headers) res.set(name, value);
+      res.keep_alive(false);
+    };
+    if (!a.file.empty() && !head) {
+      auto res = std::make_shared<http::response<FileRangeBody>>(
+          static_cast<http::status>(a.status), request.version());
+      beast::error_code ec;
+      FileRange range;
+      range.open_range(a.file, a.file_offset, a.file_length, ec);
+      if (!ec) res->body().reset(std::move(range), ec);
+      if (ec) {
+        answer(request, HttpAnswer::text(500, "cannot read the file\n"));
+        return;
+      }
+      header(*res);
+      res->content_length(a.file_length);
+      send(res);
+      return;
+    }
+    if (head) {
+      auto res = std::make_shared<http::response<http::empty_body>>(
+          static_cast<http::status>(a.status), request.version());
+      header(*res);
+      res->content_length(a.file.empty() ? a.body.size() : a.file_length);
+      send(res);
+      return;
+    }
     auto res = std::make_shared<http::response<http::string_body>>(
         static_cast<http::status>(a.status), request.version());
-    res->set(http::field::server, "convoy-live");
-    res->set(http::field::content_type, a.content_type);
-    res->keep_alive(false);
-    if (request.method() != http::verb::head) res->body() = std::move(a.body);
+    header(*res);
+    res->body() = std::move(a.body);
     res->prepare_payload();
+    send(res);
+  }
+
+  template <typename Response>
+  void send(std::shared_ptr<Response> res) {
+    stream_.expires_after(kWriteTimeout);  // a recording of a few GB to a slow viewer
     http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code, size_t) {
       beast::error_code ignored;
       self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
@@ -116,14 +191,15 @@ void WsConnection::start(http::request<http::string_body> request) {
 }
 
 void WsConnection::read() {
-  ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, size_t bytes) {
+  ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, size_t) {
     if (ec) return self->finish(ec.message());
     const auto data = self->in_.cdata();
     if (self->ws_.got_text())
       self->host_.on_text(self->id_,
                           std::string_view(static_cast<const char*>(data.data()), data.size()));
     else
-      self->host_.on_binary(self->id_, bytes);
+      self->host_.on_binary(self->id_,
+                            std::string_view(static_cast<const char*>(data.data()), data.size()));
     self->in_.consume(self->in_.size());
     self->read();
   });

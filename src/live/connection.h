@@ -15,6 +15,9 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include "live/channel_table.h"
 #include "live/send_queue.h"
@@ -23,10 +26,31 @@ namespace convoy::live {
 
 class WsConnection;
 
+// A plain HTTP request, as the host sees it.
+struct HttpRequest {
+  std::string method;  // "GET", "HEAD", ...
+  std::string target;  // "/index.html?x=1" (as sent: percent-encoded, with the query)
+  std::string range;   // the Range header, or ""
+};
+
+// The host's answer: `body`, or `file_length` bytes of the file `file` from `file_offset`
+// (sent from the disk as it goes: a recording may be large).
 struct HttpAnswer {
   unsigned status = 404;
   std::string content_type = "text/plain; charset=utf-8";
   std::string body;
+  std::string file;
+  uint64_t file_offset = 0, file_length = 0;
+  std::vector<std::pair<std::string, std::string>> headers;  // more: Content-Range, ...
+
+  static HttpAnswer text(unsigned status, std::string body,
+                         std::string content_type = "text/plain; charset=utf-8") {
+    HttpAnswer a;
+    a.status = status;
+    a.content_type = std::move(content_type);
+    a.body = std::move(body);
+    return a;
+  }
 };
 
 // What the server does with connections (called on the I/O thread).
@@ -36,10 +60,10 @@ class ConnectionHost {
   // A WebSocket client is connected: its id (its serverInfo and advertise are queued).
   virtual ClientId on_open(std::shared_ptr<WsConnection> connection) = 0;
   virtual void on_text(ClientId client, std::string_view text) = 0;
-  virtual void on_binary(ClientId client, size_t bytes) = 0;
+  virtual void on_binary(ClientId client, std::string_view bytes) = 0;
   virtual void on_close(ClientId client, const std::string& why) = 0;
   // A plain HTTP request (not an upgrade).
-  virtual HttpAnswer on_http(const std::string& method, const std::string& target) = 0;
+  virtual HttpAnswer on_http(const HttpRequest& request) = 0;
 };
 
 class WsConnection : public std::enable_shared_from_this<WsConnection> {

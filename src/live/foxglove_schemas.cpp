@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "record/scene_schemas.h"
+
 namespace convoy::live {
 
 namespace {
@@ -23,6 +25,18 @@ ChannelInfo compressed_image_channel(const std::string& topic) {
 
 ChannelInfo camera_calibration_channel(const std::string& topic) {
   return channel(topic, record::camera_calibration_schema());
+}
+
+ChannelInfo scene_update_channel(const std::string& topic) {
+  return channel(topic, record::scene_update_schema());
+}
+
+ChannelInfo frame_transforms_channel(const std::string& topic) {
+  return channel(topic, record::frame_transforms_schema());
+}
+
+ChannelInfo camera_frame_channel(const std::string& topic) {
+  return channel(topic, record::camera_frame_schema());
 }
 
 json json_schema_of(const json& value, int depth) {

@@ -22,6 +22,10 @@ using record::LogLevel;
 ChannelInfo log_channel(const std::string& topic);
 ChannelInfo compressed_image_channel(const std::string& topic);
 ChannelInfo camera_calibration_channel(const std::string& topic);
+// The scene's channels (scene/scene_json.h; schemas in record/scene_schemas.h).
+ChannelInfo scene_update_channel(const std::string& topic);
+ChannelInfo frame_transforms_channel(const std::string& topic);
+ChannelInfo camera_frame_channel(const std::string& topic);
 
 // A JSON Schema describing `value`: its type and, for objects, each property's (arrays by
 // their first element), at most `depth` levels deep. Informative: nothing is required.

@@ -4,6 +4,7 @@
 
 #include "live/foxglove_schemas.h"
 #include "live/jpeg.h"
+#include "scene/scene_json.h"
 
 namespace convoy::live {
 
@@ -50,6 +51,10 @@ void FrameEncoder::encode(const Frame& f) {
       server_.publish(
           f.image_channel, f.time_ns,
           std::make_shared<const std::string>(compressed_image_json(f.time_ns, f.frame_id, jpeg)));
+      if (f.want_frame_note)
+        server_.publish(f.frame_note_channel, f.time_ns,
+                        std::make_shared<const std::string>(
+                            scene::frame_json(f.frame_id + "/image", f.time_ns, f.wall_ms)));
     }
     server_.publish(f.calibration_channel, f.time_ns,
                     std::make_shared<const std::string>(

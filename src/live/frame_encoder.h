@@ -19,6 +19,10 @@ namespace convoy::live {
 struct Frame {
   uint32_t image_channel = 0, calibration_channel = 0;
   bool want_image = true;
+  // With the image, {"topic", "time_ns", "wall_ms"} on this channel (/convoy/frames).
+  bool want_frame_note = false;
+  uint32_t frame_note_channel = 0;
+  double wall_ms = 0;  // when the datapack reached the tap (Unix ms)
   std::string frame_id;
   uint64_t time_ns = 0;
   uint32_t width = 0, height = 0, channels = 0;

@@ -1,8 +1,11 @@
 #include "live/live_tap.h"
 
+#include <chrono>
+
 #include "datapack/camera.h"
 #include "datapack/registry.h"
 #include "record/datapack_codec.h"
+#include "scene/scene_json.h"
 
 namespace convoy::live {
 
@@ -19,8 +22,19 @@ std::shared_ptr<const std::string> shared(std::string s) {
 LiveTap::LiveTap(LiveServer& server, TapOptions options)
     : server_(server),
       options_(options),
+      scene_(options.scene),
+      scene_pacer_(options.scene_hz),
       encoder_(server, options.jpeg_quality, options.camera_hfov) {
   log_channel_ = server_.add_channel(log_channel(kLogTopic), options_.log_lines_kept);
+  if (options_.map) {
+    const uint32_t map = server_.add_channel(scene_update_channel(scene::kMapTopic), 1);
+    server_.publish(map, 0, shared(scene::map_update_json(*options_.map, 0)));
+  }
+  if (options_.scene_hz > 0) {
+    scene_channel_ = server_.add_channel(scene_update_channel(scene::kSceneTopic));
+    transforms_channel_ = server_.add_channel(frame_transforms_channel(scene::kTransformsTopic));
+  }
+  frames_channel_ = server_.add_channel(camera_frame_channel(scene::kFramesTopic));
 }
 
 void LiveTap::from_engine(const std::string& engine, const engine::DataPack& dp,
@@ -43,6 +57,7 @@ void LiveTap::tap(const std::string& engine, const engine::DataPack& dp,
                   const datapack::BlobReader& blobs, bool to_engine, int64_t time_ns) {
   time_ns_.store(time_ns);
   server_.publish_time(static_cast<uint64_t>(time_ns));
+  if (!to_engine && options_.scene_hz > 0) scene(engine, dp, blobs, time_ns);
   // Nothing to show (a datapack not produced yet); a channel of its own would only double
   // the topic of the real one.
   if (dp.payload_case() == engine::DataPack::PAYLOAD_NOT_SET) return;
@@ -98,6 +113,21 @@ uint32_t LiveTap::channel(const std::string& engine, const engine::DataPack& dp,
   return id;
 }
 
+void LiveTap::scene(const std::string& engine, const engine::DataPack& dp,
+                    const datapack::BlobReader& blobs, int64_t time_ns) {
+  if (const auto due = scene_pacer_.due(time_ns, !scene_.empty())) {
+    const auto t = static_cast<uint64_t>(*due);
+    if (server_.has_subscribers(scene_channel_))
+      server_.publish(scene_channel_, t,
+                      shared(scene::scene_update_json(scene_, options_.map.get(), t)));
+    if (server_.has_subscribers(transforms_channel_))
+      server_.publish(transforms_channel_, t, shared(scene::frame_transforms_json(scene_, t)));
+    // A client that subscribes later never had the entities that left.
+    scene_.clear_deleted();
+  }
+  scene_.ingest(engine, datapack::View(dp, blobs), time_ns);
+}
+
 void LiveTap::camera(const std::string& topic, const engine::DataPack& dp,
                      const datapack::BlobReader& blobs, int64_t time_ns) {
   auto [it, added] = cameras_.try_emplace(topic);
@@ -117,6 +147,11 @@ void LiveTap::camera(const std::string& topic, const engine::DataPack& dp,
   f.image_channel = cam.image;
   f.calibration_channel = cam.calibration;
   f.want_image = want_image;
+  f.frame_note_channel = frames_channel_;
+  f.want_frame_note = want_image && server_.has_subscribers(frames_channel_);
+  f.wall_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch())
+          .count();
   f.frame_id = topic;
   f.time_ns = static_cast<uint64_t>(time_ns);
   f.width = img.width;

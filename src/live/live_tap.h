@@ -11,6 +11,12 @@
 // FrameEncoder's thread) and `<engine>/<datapack>/calibration` (foxglove.CameraCalibration).
 // log() publishes a line of the coordinator's log on `/convoy/log` (foxglove.Log; the last
 // lines are kept for a viewer that connects late). The simulated time goes to every client.
+//
+// The scene (scene/scene_json.h): `/convoy/map` once, kept for every client that subscribes
+// later, when a map is given; `/convoy/scene` and `/convoy/transforms` at most `scene_hz` per
+// simulated second, built only while someone subscribes to them (the road users are taken in
+// all the time, for the ego's trail); `/convoy/frames` notes each camera frame published with
+// the wall-clock time its datapack reached the tap (for latency measurements).
 #pragma once
 
 #include <atomic>
@@ -24,6 +30,8 @@
 #include "live/frame_encoder.h"
 #include "live/server.h"
 #include "loop/datapack_tap.h"
+#include "scene/scene_map.h"
+#include "scene/scene_state.h"
 
 namespace convoy::live {
 
@@ -32,6 +40,9 @@ struct TapOptions {
   int jpeg_quality = 80;
   double camera_hfov = 1.047;  // the calibration's field of view (rad): the datapack has none
   size_t log_lines_kept = 500;
+  double scene_hz = 10;  // /convoy/scene and /convoy/transforms per simulated second (0: none)
+  std::shared_ptr<const scene::SceneMap> map;  // null: no /convoy/map
+  scene::SceneOptions scene;
 };
 
 inline constexpr const char* kLogTopic = "/convoy/log";
@@ -59,6 +70,10 @@ class LiveTap final : public loop::DataPackTap {
            bool to_engine, int64_t time_ns);
   uint32_t channel(const std::string& engine, const engine::DataPack& dp,
                    const datapack::BlobReader& blobs, bool to_engine);
+  // The scene before a datapack of `time_ns` from an engine is taken in (when an update is
+  // due and wanted), then the datapack.
+  void scene(const std::string& engine, const engine::DataPack& dp,
+             const datapack::BlobReader& blobs, int64_t time_ns);
   void camera(const std::string& topic, const engine::DataPack& dp,
               const datapack::BlobReader& blobs, int64_t time_ns);
 
@@ -69,6 +84,9 @@ class LiveTap final : public loop::DataPackTap {
   LiveServer& server_;
   TapOptions options_;
   uint32_t log_channel_ = 0;
+  uint32_t scene_channel_ = 0, transforms_channel_ = 0, frames_channel_ = 0;
+  scene::SceneState scene_;
+  scene::ScenePacer scene_pacer_;
   std::atomic<int64_t> time_ns_{0};
   std::map<std::tuple<std::string, std::string, bool, int, std::string>, uint32_t> channels_;
   std::map<std::string, Camera> cameras_;

@@ -67,13 +67,67 @@ ClientRequest parse_unsubscribe(const json& msg) {
   return r;
 }
 
+// An array of integer ids in [0, 2^32) under `key`.
+bool read_ids(const json& msg, const char* key, std::vector<uint32_t>* out, std::string* error) {
+  auto it = msg.find(key);
+  if (it == msg.end() || !it->is_array()) {
+    *error = std::string("\"") + key + "\" must be an array";
+    return false;
+  }
+  for (const auto& id : *it) {
+    if (!id.is_number_integer() || id.get<int64_t>() < 0 || id.get<int64_t>() > 0xffffffffLL) {
+      *error = std::string("\"") + key + "\" must hold integers from 0 to 4294967295, got " +
+               id.dump(-1, ' ', false, json::error_handler_t::replace);
+      return false;
+    }
+    out->push_back(static_cast<uint32_t>(id.get<int64_t>()));
+  }
+  return true;
+}
+
+// A string field of `obj` (optional: "" when absent).
+bool read_string(const json& obj, const char* key, bool required, std::string* out,
+                 std::string* error) {
+  auto it = obj.find(key);
+  if (it == obj.end()) {
+    if (!required) return true;
+    *error = std::string("missing \"") + key + "\"";
+    return false;
+  }
+  if (!it->is_string()) {
+    *error = std::string("\"") + key + "\" must be a string";
+    return false;
+  }
+  *out = it->get<std::string>();
+  return true;
+}
+
+ClientRequest parse_advertise(const json& msg) {
+  auto it = msg.find("channels");
+  if (it == msg.end() || !it->is_array())
+    return invalid("advertise: \"channels\" must be an array");
+  ClientRequest r;
+  r.op = ClientRequest::Op::kAdvertise;
+  for (const auto& c : *it) {
+    if (!c.is_object()) return invalid("advertise: each channel must be an object");
+    ClientChannel ch;
+    std::string error;
+    if (!read_id(c, "id", &ch.id, &error) || !read_string(c, "topic", true, &ch.topic, &error) ||
+        !read_string(c, "encoding", true, &ch.encoding, &error) ||
+        !read_string(c, "schemaName", false, &ch.schema_name, &error))
+      return invalid("advertise: " + error);
+    r.advertise.push_back(std::move(ch));
+  }
+  return r;
+}
+
 }  // namespace
 
 std::string server_info_json(const ServerInfo& info) {
   json j = {{"op", "serverInfo"},
             {"name", info.name},
-            {"capabilities", json::array({"time"})},
-            {"supportedEncodings", json::array()},
+            {"capabilities", info.capabilities},
+            {"supportedEncodings", info.supported_encodings},
             {"metadata", info.metadata},
             {"sessionId", info.session_id}};
   return j.dump();
@@ -128,10 +182,36 @@ ClientRequest parse_client_message(std::string_view text) {
   const auto name = op->get<std::string>();
   if (name == "subscribe") return parse_subscribe(msg);
   if (name == "unsubscribe") return parse_unsubscribe(msg);
+  if (name == "advertise") return parse_advertise(msg);
+  if (name == "unadvertise") {
+    ClientRequest r;
+    r.op = ClientRequest::Op::kUnadvertise;
+    if (!read_ids(msg, "channelIds", &r.unadvertise, &r.error))
+      return invalid("unadvertise: " + r.error);
+    return r;
+  }
   ClientRequest r;
   r.op = ClientRequest::Op::kUnsupported;
   r.error = name;
   return r;
+}
+
+ClientData parse_client_binary(std::string_view bytes) {
+  ClientData d;
+  if (bytes.empty()) {
+    d.error = "empty binary message";
+  } else if (static_cast<uint8_t>(bytes[0]) != kOpMessageData) {
+    d.error = "binary message with unknown opcode " +
+              std::to_string(static_cast<uint8_t>(bytes[0])) +
+              " (clients may send 1: message data)";
+  } else if (bytes.size() < 5) {
+    d.error = "client message data of " + std::to_string(bytes.size()) +
+              " bytes: needs an opcode and a 4-byte channel id";
+  } else {
+    d.channel_id = read_u32_le(bytes, 1);
+    d.payload = bytes.substr(5);
+  }
+  return d;
 }
 
 uint32_t read_u32_le(std::string_view b, size_t at) {

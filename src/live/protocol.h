@@ -4,8 +4,10 @@
 //
 // Server -> client: serverInfo, advertise, unadvertise and status as JSON text; messageData
 // (opcode 0x01: subscription id, receive time in ns, payload) and time (opcode 0x02) as
-// binary, integers little-endian. Client -> server: subscribe and unsubscribe (JSON). Anything
-// else a client sends is answered with a status error by the server, to that client only.
+// binary, integers little-endian. Client -> server: subscribe and unsubscribe (JSON); with the
+// capability clientPublish, advertise and unadvertise of client channels (JSON) and their
+// messages (binary, opcode 0x01: client channel id, payload). Anything else a client sends is
+// answered with a status error by the server, to that client only.
 #pragma once
 
 #include <cstdint>
@@ -36,6 +38,8 @@ struct ServerInfo {
   std::string name;
   std::string session_id;
   std::map<std::string, std::string> metadata;
+  std::vector<std::string> capabilities = {"time"};  // + "clientPublish"
+  std::vector<std::string> supported_encodings;      // of client channels: "json"
 };
 
 enum class StatusLevel { kInfo = 0, kWarning = 1, kError = 2 };
@@ -53,14 +57,39 @@ struct Subscription {
   uint32_t id = 0;
   uint32_t channel_id = 0;
 };
+// A channel a client publishes on (Client Advertise).
+struct ClientChannel {
+  uint32_t id = 0;
+  std::string topic;
+  std::string encoding;
+  std::string schema_name;
+};
 struct ClientRequest {
-  enum class Op { kSubscribe, kUnsubscribe, kUnsupported, kInvalid } op = Op::kInvalid;
-  std::vector<Subscription> subscribe;  // kSubscribe
-  std::vector<uint32_t> unsubscribe;    // kUnsubscribe: subscription ids
-  std::string error;                    // kInvalid: why; kUnsupported: the op
+  enum class Op {
+    kSubscribe,
+    kUnsubscribe,
+    kAdvertise,
+    kUnadvertise,
+    kUnsupported,
+    kInvalid
+  } op = Op::kInvalid;
+  std::vector<Subscription> subscribe;   // kSubscribe
+  std::vector<uint32_t> unsubscribe;     // kUnsubscribe: subscription ids
+  std::vector<ClientChannel> advertise;  // kAdvertise
+  std::vector<uint32_t> unadvertise;     // kUnadvertise: client channel ids
+  std::string error;                     // kInvalid: why; kUnsupported: the op
 };
 // Never throws: garbage gives kInvalid with a message saying what is wrong.
 ClientRequest parse_client_message(std::string_view text);
+
+// A binary message from a client: Client Message Data (opcode 0x01, u32 client channel id,
+// payload). `error` says what is wrong otherwise (another opcode, too short).
+struct ClientData {
+  uint32_t channel_id = 0;
+  std::string_view payload;
+  std::string error;
+};
+ClientData parse_client_binary(std::string_view bytes);
 
 // Little-endian readers for the tests and for clients in C++.
 uint32_t read_u32_le(std::string_view bytes, size_t at);

@@ -14,13 +14,14 @@ using tcp = net::ip::tcp;
 
 namespace {
 
-tcp::endpoint resolve(net::io_context& io, const ListenAddress& address, bool insecure) {
+tcp::endpoint resolve(net::io_context& io, const ListenAddress& address, bool insecure,
+                      const std::string& option) {
   boost::system::error_code ec;
   tcp::resolver resolver(io);
   auto results = resolver.resolve(address.host, std::to_string(address.port),
                                   tcp::resolver::numeric_service | tcp::resolver::passive, ec);
   if (ec || results.empty())
-    throw std::runtime_error("--live " + address.text() + ": cannot resolve the host '" +
+    throw std::runtime_error(option + " " + address.text() + ": cannot resolve the host '" +
                              address.host + "': " + ec.message());
   const tcp::endpoint endpoint = *results.begin();
   if (!insecure && !endpoint.address().is_loopback()) {
@@ -31,18 +32,23 @@ tcp::endpoint resolve(net::io_context& io, const ListenAddress& address, bool in
   return endpoint;
 }
 
+// A client's text quoted in a status message: at most 100 bytes of it.
+std::string clip(const std::string& text) {
+  return text.size() <= 100 ? text : text.substr(0, 100) + "...";
+}
+
 }  // namespace
 
 LiveServer::LiveServer(ServerOptions options) : options_(std::move(options)) {
   check_listen_policy(options_.address, options_.insecure);
-  const tcp::endpoint endpoint = resolve(io_, options_.address, options_.insecure);
+  const tcp::endpoint endpoint = resolve(io_, options_.address, options_.insecure, options_.option);
   try {
     ConnectionHost& host = *this;
     listener_ = std::make_shared<Listener>(io_, endpoint, host, options_.limits);
   } catch (const boost::system::system_error& e) {
-    throw std::runtime_error("--live " + options_.address.text() + ": cannot listen there (" +
-                             e.code().message() +
-                             "): give another port, e.g. --live 127.0.0.1:8766");
+    throw std::runtime_error(options_.option + " " + options_.address.text() +
+                             ": cannot listen there (" + e.code().message() +
+                             "): give another port, e.g. " + options_.another_port);
   }
   port_ = listener_->local_endpoint().port();
   listener_->start();
@@ -182,10 +188,21 @@ void LiveServer::on_text(ClientId client, std::string_view text) {
         if (!error.empty()) send_status(c, StatusLevel::kError, error);
       }
       break;
+    case ClientRequest::Op::kAdvertise:
+      for (const auto& ch : request.advertise) advertise(c, ch);
+      break;
+    case ClientRequest::Op::kUnadvertise:
+      for (uint32_t id : request.unadvertise) {
+        if (c.channels.erase(id) == 0)
+          send_status(c, StatusLevel::kError,
+                      "unadvertise: no client channel " + std::to_string(id) + " was advertised");
+      }
+      break;
     case ClientRequest::Op::kUnsupported:
       send_status(c, StatusLevel::kError,
-                  "unsupported operation \"" + request.error +
-                      "\" (this server supports subscribe and unsubscribe)");
+                  "unsupported operation \"" + clip(request.error) +
+                      "\" (this server supports subscribe, unsubscribe" +
+                      (accepted_.empty() ? "" : ", advertise and unadvertise") + ")");
       break;
     case ClientRequest::Op::kInvalid:
       send_status(c, StatusLevel::kError, "invalid message: " + request.error);
@@ -193,13 +210,72 @@ void LiveServer::on_text(ClientId client, std::string_view text) {
   }
 }
 
-void LiveServer::on_binary(ClientId client, size_t bytes) {
+void LiveServer::accept_client_topic(const std::string& topic, const std::string& encoding,
+                                     ClientMessageHandler handler) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  accepted_[topic] = {encoding, std::move(handler)};
+}
+
+std::string LiveServer::accepted_topics() const {
+  std::string list;
+  for (const auto& [topic, a] : accepted_)
+    list += (list.empty() ? "" : ", ") + topic + " (" + a.encoding + ")";
+  return list;
+}
+
+void LiveServer::advertise(Client& c, const ClientChannel& ch) {
+  if (accepted_.empty())
+    return send_status(c, StatusLevel::kError,
+                       "advertise: this server does not accept client publishing");
+  auto it = accepted_.find(ch.topic);
+  if (it == accepted_.end())
+    return send_status(c, StatusLevel::kError,
+                       "advertise: clients cannot publish on \"" + clip(ch.topic) +
+                           "\" (this server accepts: " + accepted_topics() + ")");
+  if (ch.encoding != it->second.encoding)
+    return send_status(c, StatusLevel::kError,
+                       "advertise: \"" + ch.topic + "\" takes the encoding \"" +
+                           it->second.encoding + "\", not \"" + clip(ch.encoding) + "\"");
+  if (c.channels.count(ch.id))
+    return send_status(c, StatusLevel::kError,
+                       "advertise: client channel id " + std::to_string(ch.id) +
+                           " is in use (unadvertise it first)");
+  c.channels[ch.id] = ch;
+}
+
+void LiveServer::on_binary(ClientId client, std::string_view bytes) {
+  ClientMessageHandler handler;
+  std::string error;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    Client& c = it->second;
+    const ClientData data = parse_client_binary(bytes);
+    if (!data.error.empty()) return send_status(c, StatusLevel::kError, data.error);
+    if (accepted_.empty())
+      return send_status(c, StatusLevel::kError,
+                         "binary message of " + std::to_string(bytes.size()) +
+                             " bytes ignored: this server does not accept client publishing");
+    auto ch = c.channels.find(data.channel_id);
+    if (ch == c.channels.end())
+      return send_status(c, StatusLevel::kError,
+                         "message on client channel " + std::to_string(data.channel_id) +
+                             ", which was not advertised (advertise it first)");
+    auto topic = accepted_.find(ch->second.topic);
+    if (topic == accepted_.end()) return;
+    handler = topic->second.handler;
+    bytes = data.payload;
+  }
+  try {
+    error = handler ? handler(bytes) : std::string();
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  if (error.empty()) return;
   std::lock_guard<std::mutex> lock(mutex_);
   auto it = clients_.find(client);
-  if (it == clients_.end()) return;
-  send_status(it->second, StatusLevel::kError,
-              "binary message of " + std::to_string(bytes) +
-                  " bytes ignored: this server does not accept client publishing");
+  if (it != clients_.end()) send_status(it->second, StatusLevel::kError, error);
 }
 
 void LiveServer::on_close(ClientId client, const std::string& why) {
@@ -214,15 +290,15 @@ void LiveServer::on_close(ClientId client, const std::string& why) {
   closed_.notify_all();
 }
 
-HttpAnswer LiveServer::on_http(const std::string& method, const std::string& target) {
-  if (options_.http) return options_.http(method, target);
-  if (method != "GET" && method != "HEAD") return {405, "text/plain; charset=utf-8", "GET only\n"};
-  if (target != "/") return {404, "text/plain; charset=utf-8", "not found\n"};
-  return {200, "text/plain; charset=utf-8",
-          options_.info.name + ": a Foxglove WebSocket server (" + kSubprotocol + "). Open " +
-              url() +
-              " in Foxglove or Lichtblick (Open connection -> "
-              "Foxglove WebSocket).\n"};
+HttpAnswer LiveServer::on_http(const HttpRequest& request) {
+  if (options_.http) return options_.http(request);
+  if (request.method != "GET" && request.method != "HEAD")
+    return HttpAnswer::text(405, "GET only\n");
+  if (request.target != "/") return HttpAnswer::text(404, "not found\n");
+  return HttpAnswer::text(200, options_.info.name + ": a Foxglove WebSocket server (" +
+                                   kSubprotocol + "). Open " + url() +
+                                   " in Foxglove or Lichtblick (Open connection -> "
+                                   "Foxglove WebSocket).\n");
 }
 
 }  // namespace convoy::live

@@ -5,9 +5,11 @@
 // oldest messages when full, and counts them). The network runs on the server's own thread.
 //
 // Client errors (garbage, an unknown channel, a subscription id in use) get a status message
-// to that client; other clients and the run go on. A plain HTTP GET on the same port gets
-// the answer of an HttpHandler (a page saying where to connect, until the dashboard serves
-// its files there).
+// to that client; other clients and the run go on. Clients may publish on the topics the
+// owner accepts (accept_client_topic: capability clientPublish): they advertise a channel
+// with such a topic, then send its messages. A plain HTTP request on the same port gets the
+// answer of ServerOptions::http (live/static_files.h: the dashboard), by default a page
+// saying where to connect.
 #pragma once
 
 #include <boost/asio/io_context.hpp>
@@ -33,8 +35,12 @@ struct ServerOptions {
   bool insecure = false;  // listen beyond the loopback
   ServerInfo info;
   QueueLimits limits;
-  // Answers plain HTTP requests (method, target); default: a page naming the WebSocket URL.
-  std::function<HttpAnswer(const std::string&, const std::string&)> http;
+  // How errors name the address ("--live 127.0.0.1:8765: cannot listen there ...") and what
+  // they suggest instead of a port in use.
+  std::string option = "--live";
+  std::string another_port = "--live 127.0.0.1:8766";
+  // Answers plain HTTP requests; default: a page naming the WebSocket URL.
+  std::function<HttpAnswer(const HttpRequest&)> http;
 };
 
 // One client, while connected and after.
@@ -71,6 +77,14 @@ class LiveServer final : private ConnectionHost {
   // The simulation's time, to every client (binary `time`), when it has advanced.
   void publish_time(uint64_t time_ns);
 
+  // Clients may advertise channels on `topic` with `encoding` and publish on them: `handler`
+  // gets each message's payload (on the server's thread, without the server's lock: it may
+  // publish) and returns "" or an error for a status message to that client. Before clients
+  // connect; ServerOptions::info should name the capability "clientPublish".
+  using ClientMessageHandler = std::function<std::string(std::string_view payload)>;
+  void accept_client_topic(const std::string& topic, const std::string& encoding,
+                           ClientMessageHandler handler);
+
   // Closes every connection once its queue is sent (at most `drain_s`), then stops.
   void stop(double drain_s = 1.0);
   std::vector<ClientStats> stats() const;
@@ -78,17 +92,24 @@ class LiveServer final : private ConnectionHost {
  private:
   ClientId on_open(std::shared_ptr<WsConnection> connection) override;
   void on_text(ClientId client, std::string_view text) override;
-  void on_binary(ClientId client, size_t bytes) override;
+  void on_binary(ClientId client, std::string_view bytes) override;
   void on_close(ClientId client, const std::string& why) override;
-  HttpAnswer on_http(const std::string& method, const std::string& target) override;
+  HttpAnswer on_http(const HttpRequest& request) override;
 
   struct Client {
     std::shared_ptr<WsConnection> connection;
     ClientStats stats;
+    std::map<uint32_t, ClientChannel> channels;  // advertised by the client
+  };
+  struct AcceptedTopic {
+    std::string encoding;
+    ClientMessageHandler handler;
   };
   // Under mutex_.
   void send_status(Client& c, StatusLevel level, const std::string& message);
   void subscribe(Client& c, const Subscription& s);
+  void advertise(Client& c, const ClientChannel& channel);
+  std::string accepted_topics() const;
   ClientStats snapshot(const Client& c) const;
 
   ServerOptions options_;
@@ -99,6 +120,7 @@ class LiveServer final : private ConnectionHost {
   mutable std::mutex mutex_;
   std::condition_variable closed_;
   ChannelTable table_;
+  std::map<std::string, AcceptedTopic> accepted_;
   std::map<ClientId, Client> clients_;
   std::vector<ClientStats> gone_;
   ClientId next_client_ = 1;

@@ -1,5 +1,6 @@
 #include "loop/engine_handle.h"
 
+#include <chrono>
 #include <deque>
 #include <fstream>
 #include <sstream>
@@ -78,6 +79,11 @@ void EngineHandle::finish(engine::Reply* reply) {
       busy_ = true;  // the reply may still come; shutdown() drains it
       throw EngineError(name(), "interrupted while waiting for engine '" + name() + "'");
   }
+}
+
+void EngineHandle::postpone(int64_t ns) {
+  call_started_ns += ns;
+  if (channel_) channel_->postpone(std::chrono::nanoseconds(ns));
 }
 
 void EngineHandle::call(const engine::Request& request, const char* what, engine::Reply* reply,

@@ -43,6 +43,9 @@ class EngineHandle {
   void start(const engine::Request& request, const char* what, double timeout_s = 0);
   // Collects the reply. Throws EngineError on an engine error, crash, hang, or interrupt.
   void finish(engine::Reply* reply);
+  // The coordinator held the loop for `ns` (a viewer paused the run): the call in flight's
+  // deadline and round trip start that much later.
+  void postpone(int64_t ns);
   // start() + finish().
   void call(const engine::Request& request, const char* what, engine::Reply* reply,
             double timeout_s = 0);
@@ -57,6 +60,7 @@ class EngineHandle {
   size_t index = 0;  // position in the config
   int64_t time_ns = 0;
   std::vector<engine::DataPackId> wanted;        // datapacks the functions read from it
+  std::vector<engine::DataPackId> registered;    // what it said at Initialize it provides
   std::vector<engine::DataPack> pending_inputs;  // TF outputs for its next step
   int64_t call_started_ns = 0;
   int64_t last_roundtrip_ns = -1, last_compute_ns = -1;

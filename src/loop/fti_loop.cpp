@@ -20,6 +20,17 @@ std::string key(const std::string& engine, const std::string& name) {
   k += name;
   return k;
 }
+
+// Adds `name` to the datapacks `e` hands over; false when it is there already.
+bool add_wanted(EngineHandle& e, const std::string& name) {
+  if (std::any_of(e.wanted.begin(), e.wanted.end(),
+                  [&](const engine::DataPackId& id) { return id.name() == name; }))
+    return false;
+  engine::DataPackId& id = e.wanted.emplace_back();
+  id.set_name(name);
+  id.set_engine_name(e.name());
+  return true;
+}
 }  // namespace
 
 FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
@@ -38,16 +49,7 @@ FtiLoop::FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
   for (const LoadedFunction* fn : readers) {
     for (const auto& in : fn->inputs) {
       if (in.preprocessed || in.kind != InputKind::kDataPack) continue;
-      auto* e = by_name_.at(in.engine);
-      bool known =
-          std::any_of(e->wanted.begin(), e->wanted.end(),
-                      [&](const engine::DataPackId& id) { return id.name() == in.datapack; });
-      if (!known) {
-        engine::DataPackId id;
-        id.set_name(in.datapack);
-        id.set_engine_name(in.engine);
-        e->wanted.push_back(id);
-      }
+      add_wanted(*by_name_.at(in.engine), in.datapack);
     }
   }
   source_.engine_datapack = [this](const std::string& engine,
@@ -115,6 +117,16 @@ void FtiLoop::add_input(engine::DataPack datapack) {
   pending.insert(pending.begin(), std::move(datapack));
 }
 
+bool FtiLoop::also_want(const std::string& engine, const std::string& datapack) {
+  auto it = by_name_.find(engine);
+  if (it == by_name_.end())
+    throw std::invalid_argument("datapack '" + datapack + "' wanted of unknown engine '" + engine +
+                                "'");
+  if (!add_wanted(*it->second, datapack)) return false;
+  extra_.insert(key(engine, datapack));
+  return true;
+}
+
 void FtiLoop::prime() {
   for (auto* e : engines_) {
     if (e->wanted.empty()) continue;
@@ -127,9 +139,10 @@ void FtiLoop::prime() {
     engine::Reply reply;
     e->finish(&reply);
     for (auto& dp : *reply.mutable_get_datapacks()->mutable_datapacks()) {
-      if (keep_observations_) keep_observation(dp, e->name());
+      std::string k = key(e->name(), dp.id().name());
+      if (keep_observations_ && !extra_.count(k)) keep_observation(dp, e->name());
       if (tap_) tap_->from_engine(e->name(), dp, *e->blob_reader(), cycles_, sim_time_ns_);
-      auto& slot = pool_[key(e->name(), dp.id().name())];
+      auto& slot = pool_[k];
       slot.datapack.Swap(&dp);
       slot.cycle = 0;
     }
@@ -269,11 +282,25 @@ bool FtiLoop::cycle(int64_t next, int64_t bound_ns, bool stop_on_done) {
   return !finished;
 }
 
+bool FtiLoop::pass_gate() {
+  const int64_t held = gate_->wait(sim_time_ns_);
+  if (held > 0) {
+    // The engines were idle meanwhile: neither their deadlines nor the cycle's wall time
+    // count the pause.
+    for (auto* e : engines_)
+      if (e->busy()) e->postpone(held);
+    last_cycle_ns_ += held;
+    last_progress_ns_ += held;
+  }
+  return !interrupted();
+}
+
 void FtiLoop::run(int64_t until_ns) {
   last_cycle_ns_ = last_progress_ns_ = now_ns();
   while (!queue_.empty()) {
     const int64_t next = queue_.begin()->first;
     if (until_ns > 0 && next > until_ns) break;
+    if (gate_ && !pass_gate()) break;
     if (!cycle(next, until_ns, /*stop_on_done=*/true)) break;
   }
 }
@@ -282,6 +309,7 @@ void FtiLoop::advance(int64_t stop_ns, const std::atomic<bool>* stop) {
   if (last_cycle_ns_ == 0) last_cycle_ns_ = last_progress_ns_ = now_ns();
   while (!queue_.empty() && queue_.begin()->first < stop_ns) {
     if ((stop && stop->load(std::memory_order_relaxed)) || interrupted()) return;
+    if (gate_ && !pass_gate()) return;
     if (!cycle(queue_.begin()->first, 0, /*stop_on_done=*/false)) return;
   }
   sim_time_ns_ = std::max(sim_time_ns_, stop_ns);

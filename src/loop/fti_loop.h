@@ -18,11 +18,13 @@
 #include <map>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "loop/datapack_tap.h"
 #include "loop/engine_handle.h"
 #include "loop/function_runner.h"
+#include "loop/pause_gate.h"
 
 namespace convoy::loop {
 
@@ -38,11 +40,24 @@ class FtiLoop {
   // Shows every datapack taken from an engine and every one the functions send to `tap`
   // (null: none). The tap must outlive the loop.
   void set_tap(DataPackTap* tap) { tap_ = tap; }
+  // Waits at `gate` before each cycle (null: never). The time it holds the loop counts neither
+  // against the engines' EngineCommandTimeout nor in the cycles' wall times. The gate must
+  // outlive the loop.
+  void set_gate(PauseGate* gate) { gate_ = gate; }
   // Calls `report(sim_time_ns)` about every `period_s` of wall time while running.
   void set_progress(double period_s, std::function<void(int64_t)> report) {
     progress_period_ns_ = static_cast<int64_t>(period_s * 1e9);
     progress_ = std::move(report);
   }
+
+  // Also asks engine `engine` for datapack `datapack` after Initialize and with each of its
+  // steps, though no function reads it: for the viewers (the live scene, a recording), which
+  // see it through the tap. The functions' inputs are unchanged; it is no observation. A
+  // datapack already wanted is asked for once; an engine that has no such datapack answers
+  // it empty (as engines answer an unknown id), which the loop keeps like any other. Before
+  // prime(). Returns whether it was not wanted yet. Throws std::invalid_argument naming an
+  // unknown engine.
+  bool also_want(const std::string& engine, const std::string& datapack);
 
   // Fetches the functions' inputs from every engine (after Initialize). With
   // keep_observations(), the non-empty ones are the first observations (what NRP-Core's
@@ -86,6 +101,8 @@ class FtiLoop {
   void keep_observation(const engine::DataPack& dp, const std::string& engine);
   void route(std::vector<engine::DataPack>& outputs, const LoadedFunction& fn);
   void write_row(int64_t cycle_wall_ns);
+  // Waits at the gate; false on an interrupt.
+  bool pass_gate();
 
   std::vector<EngineHandle*> engines_;
   std::unordered_map<std::string, EngineHandle*> by_name_;
@@ -101,6 +118,7 @@ class FtiLoop {
     uint64_t cycle = 0;  // the loop cycle it came in (prime(): 0)
   };
   std::unordered_map<std::string, Pooled> pool_;  // "engine\0name" -> latest
+  std::unordered_set<std::string> extra_;         // also_want()'s, "engine\0name"
   std::multimap<int64_t, size_t> queue_;          // completion time -> engine
   std::vector<engine::DataPack> outputs_;
   std::vector<engine::DataPack> observations_;
@@ -113,6 +131,7 @@ class FtiLoop {
   int64_t last_progress_ns_ = 0;
   std::FILE* csv_ = nullptr;
   DataPackTap* tap_ = nullptr;
+  PauseGate* gate_ = nullptr;
   int64_t sim_time_ns_ = 0;
   uint64_t cycles_ = 0;
   int64_t progress_period_ns_ = 0;

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "python/datapack_convert.h"
+#include "python/live_module.h"
 #include "transport/frame_socket.h"
 
 namespace convoy::python {
@@ -123,6 +124,7 @@ py::object FunctionRuntime::input_object(const FunctionInput& in, const InputSou
 }
 
 py::object FunctionRuntime::call(const LoadedFunction& fn, const InputSource& src) {
+  set_live_time(src.time_ns);  // what convoy_live.publish stamps its messages with
   try {
     py::dict kwargs;
     for (const auto& in : fn.inputs) kwargs[py::str(in.keyword)] = input_object(in, src, fn);

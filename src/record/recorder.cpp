@@ -1,9 +1,13 @@
 #include "record/recorder.h"
 
+#include <algorithm>
+
 #include "datapack/camera.h"
 #include "datapack/registry.h"
 #include "record/datapack_codec.h"
 #include "record/jpeg.h"
+#include "record/scene_schemas.h"
+#include "scene/scene_json.h"
 
 namespace convoy::record {
 
@@ -13,13 +17,24 @@ namespace {
 constexpr const char* kJsonSchema =
     R"js({"type":"object","description":"a Convoy JSON datapack (docs/recording.md)"})js";
 constexpr const char* kCameraType = "convoy.data.Camera";
+// The scene's channels say they are for viewers (a replay leaves them out, as the cameras').
+const StringMap kViewer = {{"viewer", "scene"}};
 }  // namespace
 
 Recorder::Recorder(const std::filesystem::path& path, bool record_blobs, const StringMap& metadata,
                    const RecorderOptions& options)
-    : record_blobs_(record_blobs), options_(options) {
+    : record_blobs_(record_blobs),
+      options_(options),
+      scene_(options.scene),
+      scene_pacer_(options.scene_hz) {
   writer_.open(path, std::string("convoy ") + metadata.at("convoy_version"), options.mcap);
   writer_.write_metadata("convoy", metadata);
+  if (options_.map) {
+    const uint16_t ch =
+        writer_.add_channel(scene::kMapTopic, "json", foxglove_schema(scene_update_schema()),
+                            {{"viewer", "scene"}, {"source", options_.map->source}});
+    writer_.write_message(ch, 0, 0, 0, scene::map_update_json(*options_.map, 0));
+  }
 }
 
 Recorder::~Recorder() { writer_.close(); }
@@ -66,6 +81,7 @@ uint16_t Recorder::channel(const std::string& engine, const std::string& name, b
 void Recorder::write(const std::string& engine, const engine::DataPack& dp,
                      const datapack::BlobReader& blobs, bool to_engine, const std::string&,
                      uint64_t cycle, int64_t time_ns) {
+  if (!to_engine) scene(engine, dp, blobs, cycle, time_ns);
   Encoded enc;
   try {
     enc = encode(dp, blobs, record_blobs_);
@@ -125,6 +141,27 @@ void Recorder::camera(const std::string& topic, const engine::DataPack& dp,
   ++camera_frames_;
 }
 
+void Recorder::scene(const std::string& engine, const engine::DataPack& dp,
+                     const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns) {
+  if (const auto due = scene_pacer_.due(time_ns, !scene_.empty())) {
+    if (!scene_channels_) {
+      scene_channels_ = true;
+      scene_channel_ = writer_.add_channel(scene::kSceneTopic, "json",
+                                           foxglove_schema(scene_update_schema()), kViewer);
+      transforms_channel_ = writer_.add_channel(
+          scene::kTransformsTopic, "json", foxglove_schema(frame_transforms_schema()), kViewer);
+    }
+    const auto t = static_cast<uint64_t>(*due);
+    const auto seq = static_cast<uint32_t>(scene_cycle_);
+    writer_.write_message(scene_channel_, seq, t, t,
+                          scene::scene_update_json(scene_, options_.map.get(), t));
+    writer_.write_message(transforms_channel_, seq, t, t, scene::frame_transforms_json(scene_, t));
+    scene_.clear_deleted();
+  }
+  scene_cycle_ = cycle;
+  scene_.ingest(engine, datapack::View(dp, blobs), time_ns);
+}
+
 void Recorder::from_engine(const std::string& engine, const engine::DataPack& dp,
                            const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns) {
   write(engine, dp, blobs, false, "", cycle, time_ns);
@@ -134,6 +171,29 @@ void Recorder::to_engine(const std::string& engine, const engine::DataPack& dp,
                          const datapack::BlobReader& blobs, const loop::LoadedFunction& fn,
                          uint64_t cycle, int64_t time_ns) {
   write(engine, dp, blobs, true, fn.name, cycle, time_ns);
+}
+
+bool Recorder::viewer_json(const std::string& topic, const std::string& json, int64_t time_ns) {
+  const bool metrics = topic == "/convoy/metrics";
+  if (!writer_.is_open() || (!metrics && topic != "/convoy/infractions")) return false;
+  nlohmann::json msg = nlohmann::json::parse(json, nullptr, false);
+  if (!msg.is_object()) return false;
+  auto [it, added] = viewer_channels_.emplace(topic, 0);
+  if (added) {
+    const FoxgloveSchema schema{metrics ? "convoy.Metrics" : "convoy.Infraction", "jsonschema",
+                                kJsonSchema};
+    it->second =
+        writer_.add_channel(topic, "json", foxglove_schema(schema), {{"viewer", "metrics"}});
+  }
+  std::string text = json;
+  if (metrics) {
+    latest_metrics_.update(msg);
+    latest_metrics_["time_ns"] = time_ns;
+    text = latest_metrics_.dump();
+  }
+  const auto t = static_cast<uint64_t>(std::max<int64_t>(time_ns, 0));
+  writer_.write_message(it->second, viewer_sequence_[topic]++, t, t, text);
+  return true;
 }
 
 std::string Recorder::finish(const StringMap& end) {

@@ -14,10 +14,17 @@
 // `<engine>/<datapack>/calibration` as `foxglove.CameraCalibration`, the live server's
 // channels (record/foxglove_schemas.h): every frame when blobs are recorded, else at
 // `camera_hz` per simulated second. Chunks are compressed with zstd.
+//
+// The scene (scene/scene_json.h): `/convoy/map` once at the start when a map is given,
+// `/convoy/scene` and `/convoy/transforms` at `scene_hz` per simulated second from the road
+// users, signals and route of the datapacks taken from engines, so that a viewer's 3D panel
+// shows the run.
 #pragma once
 
 #include <filesystem>
 #include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <tuple>
 
@@ -25,6 +32,8 @@
 #include "record/datapack_codec.h"
 #include "record/foxglove_schemas.h"
 #include "record/mcap_writer.h"
+#include "scene/scene_map.h"
+#include "scene/scene_state.h"
 
 namespace convoy::record {
 
@@ -36,6 +45,9 @@ struct RecorderOptions {
   double camera_hz = 1;        // JPEG frames per simulated second without blobs (0: none)
   int jpeg_quality = 80;       // as the live server's
   double camera_hfov = 1.047;  // the calibration's field of view (rad): the datapack has none
+  double scene_hz = 10;  // /convoy/scene and /convoy/transforms per simulated second (0: none)
+  std::shared_ptr<const scene::SceneMap> map;  // null: no /convoy/map
+  scene::SceneOptions scene;
 };
 
 class Recorder final : public loop::DataPackTap {
@@ -50,6 +62,12 @@ class Recorder final : public loop::DataPackTap {
   void to_engine(const std::string& engine, const engine::DataPack& dp,
                  const datapack::BlobReader& blobs, const loop::LoadedFunction& fn, uint64_t cycle,
                  int64_t time_ns) override;
+
+  // What the run's functions publish for viewers (python/live_module.h: convoy_live.publish):
+  // /convoy/metrics, merged into the latest summary fields, which are written with "time_ns";
+  // /convoy/infractions, one message each. Channels marked {"viewer": "metrics"}: a replay
+  // leaves them out. Returns false for another topic or a message that is not a JSON object.
+  bool viewer_json(const std::string& topic, const std::string& json, int64_t time_ns);
 
   // Writes the `convoy_end` metadata and finishes the file. Returns a write error, or "".
   std::string finish(const StringMap& end);
@@ -71,6 +89,10 @@ class Recorder final : public loop::DataPackTap {
   void camera(const std::string& topic, const engine::DataPack& dp,
               const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns);
   uint16_t foxglove_schema(const FoxgloveSchema& schema);
+  // The scene before a datapack of `time_ns` is taken in (when an update is due), then the
+  // datapack.
+  void scene(const std::string& engine, const engine::DataPack& dp,
+             const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns);
 
   struct Camera {
     uint16_t image = 0, calibration = 0;
@@ -84,6 +106,14 @@ class Recorder final : public loop::DataPackTap {
   uint64_t camera_frames_ = 0;
   uint64_t skipped_ = 0;
   std::string first_skip_;
+  scene::SceneState scene_;
+  scene::ScenePacer scene_pacer_;
+  uint16_t scene_channel_ = 0, transforms_channel_ = 0;
+  bool scene_channels_ = false;
+  uint64_t scene_cycle_ = 0;
+  std::map<std::string, uint16_t> viewer_channels_;  // by topic
+  std::map<std::string, uint32_t> viewer_sequence_;  // by topic
+  nlohmann::json latest_metrics_ = nlohmann::json::object();
   std::map<std::string, uint16_t> schemas_;  // "kind\0type" -> schema id
   std::map<std::tuple<std::string, std::string, bool, int, std::string>, uint16_t> channels_;
 };

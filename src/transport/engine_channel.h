@@ -23,6 +23,9 @@ class EngineChannel {
   // Waits for the reply of the call in flight, until the deadline given to start() or
   // `limit`, whichever comes first.
   virtual CallStatus finish(engine::Reply* reply, Deadline limit = Deadline::max()) = 0;
+  // The deadline of the call in flight (and, where it is measured, its start) moves on by
+  // `delay`: the coordinator held the loop meanwhile (a paused live run).
+  virtual void postpone(SteadyClock::duration delay) { (void)delay; }
   // Closes the connection; a local engine server exits when it sees this.
   virtual void close() = 0;
   // Human-readable transport, for logs ("socket fd 7", "grpc localhost:23001").

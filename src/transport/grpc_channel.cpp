@@ -38,6 +38,11 @@ class GrpcChannel final : public EngineChannel {
     pending_ = std::async(std::launch::async, [this, request] { return call(request); });
   }
 
+  // The call's own gRPC deadline stays: the engine answered (or not) in its time meanwhile.
+  void postpone(SteadyClock::duration delay) override {
+    if (deadline_ != Deadline::max()) deadline_ += delay;
+  }
+
   CallStatus finish(engine::Reply* reply, Deadline limit) override {
     Deadline deadline = std::min(deadline_, limit);
     for (;;) {

@@ -47,6 +47,11 @@ class SocketChannel final : public EngineChannel {
     return CallStatus::kOk;
   }
 
+  void postpone(SteadyClock::duration delay) override {
+    if (deadline_ != Deadline::max()) deadline_ += delay;
+    started_ns_ += std::chrono::duration_cast<std::chrono::nanoseconds>(delay).count();
+  }
+
   void close() override { socket_.close(); }
   std::string describe() const override { return "socket fd " + std::to_string(socket_.fd()); }
 

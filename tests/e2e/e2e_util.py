@@ -18,6 +18,7 @@ import os
 import re
 import shutil
 import signal
+import socket
 import subprocess
 import tempfile
 import textwrap
@@ -120,6 +121,13 @@ class Result:
     def __repr__(self):
         return "exit %s after %.2f s\n--- stderr ---\n%s\n--- stdout ---\n%s" % (
             self.code, self.wall, self.stderr, self.stdout)
+
+
+def free_port():
+    """A TCP port on the loopback that nothing listens on now."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
 
 
 def pid_alive(pid):

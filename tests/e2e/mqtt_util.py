@@ -14,13 +14,9 @@ import tempfile
 import threading
 import time
 
+from e2e_util import free_port
+
 MOSQUITTO = "/usr/sbin/mosquitto"
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class Broker:

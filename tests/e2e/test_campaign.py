@@ -133,6 +133,23 @@ class Local(CampaignTest):
         page = report.render(records, plan)
         self.assertIn("per km", page)
         self.assertIn("<svg", page)
+        # No recordings: no dashboard links, no "convoy view" line.
+        self.assertNotIn("mcap=", page)
+        self.assertNotIn("convoy view", page)
+
+
+    def test_record_gives_each_run_a_recording_linked_from_the_report(self):
+        out = os.path.join(self.dir, "out")
+        r = campaign(self.cut_in_suite(), "--weathers", "clear", "--seconds", 2, "--record",
+                     "--out", out)
+        self.assertExit(r, 0)
+        run_dir = os.path.join(out, "runs", "cut_in__s0__clear")
+        self.assertTrue(os.path.isfile(os.path.join(run_dir, "recording.mcap")))
+        self.assertIn("--record", read_json(os.path.join(out, "plan.json"))["tasks"][0]["argv"])
+        with open(os.path.join(out, "report.html")) as f:
+            page = f.read()
+        self.assertIn('href="/?mcap=/files/runs/cut_in__s0__clear/recording.mcap"', page)
+        self.assertIn("<code>convoy view %s</code>" % out, page)
 
 
 class Slurm(CampaignTest):
@@ -272,6 +289,39 @@ class Interrupt(CampaignTest):
 
     def test_sigterm(self):
         self.interrupt(signal.SIGTERM)
+
+
+class RecordingLinks(unittest.TestCase):
+    """report.html links each run that has a recording.mcap to the dashboard as `convoy view
+    CAMPAIGN_DIR` serves it (no engines run here)."""
+
+    def test_runs_with_a_recording_link_to_the_dashboard(self):
+        out = tempfile.mkdtemp(prefix="convoy_report_")
+        self.addCleanup(shutil.rmtree, out, True)
+        records = []
+        for seed in (0, 1):
+            name = "cut in__s%d__clear" % seed
+            run_dir = os.path.join(out, "runs", name)
+            os.makedirs(run_dir)
+            records.append({"name": name, "scenario": "cut_in", "seed": seed, "weather": "clear",
+                            "config": "cut_in.json", "run_dir": run_dir, "state": "done",
+                            "exit_code": 0, "attempts": 1, "wall_s": 1.0, "reason": None,
+                            "log": os.path.join(run_dir, "task.log"), "summary": {},
+                            "score": None})
+        plan = {"seeds": 2, "weathers": ["clear"], "out": out}
+        page = report.render(records, plan)
+        self.assertNotIn("mcap=", page)
+        self.assertNotIn("convoy view", page)
+        with open(os.path.join(out, "runs", "cut in__s1__clear", "recording.mcap"), "wb") as f:
+            f.write(b"\x89MCAP0\r\n")
+        page = report.render(records, plan)
+        self.assertIn("open with <code>convoy view CAMPAIGN_DIR</code>", page)
+        self.assertIn("<code>convoy view %s</code>" % out, page)
+        self.assertEqual(page.count("mcap="), 1)   # only the run with a recording
+        self.assertIn('<a href="/?mcap=/files/runs/cut%20in__s1__clear/recording.mcap">view</a>',
+                      page)
+        self.assertLess(page.index("convoy view"), page.index("<h2>"))   # at the top
+        self.assertNotIn("<script", page)
 
 
 class BadInput(CampaignTest):

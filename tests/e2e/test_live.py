@@ -2,7 +2,8 @@
 Foxglove's own protocol client (@foxglove/ws-protocol's FoxgloveClient, tools/live_check,
 when npm installed it) watches the wheeled-robot experiment (a world engine with a camera,
 JSON and protobuf datapacks; about 2 s) while a client sends garbage and another one drops its
-connection mid-frame; and the addresses that must be refused before any engine starts."""
+connection mid-frame; and the addresses that must be refused before any engine starts.
+Control, View and the rest: test_live_control.py."""
 import json
 import os
 import re
@@ -10,10 +11,9 @@ import shutil
 import socket
 import subprocess
 import tempfile
-import time
 import unittest
 
-from e2e_util import CONVOY, REPO
+from e2e_util import CONVOY, REPO, free_port
 
 LIVE_CHECK = os.path.join(REPO, "tools", "live_check")
 CONFIG = os.path.join(REPO, "experiments", "wheeled_robot", "simulation_config.json")
@@ -25,11 +25,6 @@ def have_client():
     return shutil.which("node") and os.path.isdir(
         os.path.join(LIVE_CHECK, "node_modules", "@foxglove", "ws-protocol"))
 
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def convoy(tmp, name, *extra):
@@ -235,9 +230,6 @@ class BadAddresses(unittest.TestCase):
 
     def test_the_help_names_the_options(self):
         r = subprocess.run([CONVOY, "run", "--help"], capture_output=True, text=True, timeout=30)
-        for option in ("--live [HOST:]PORT", "--insecure", "--live-camera-hz"):
+        for option in ("--live [HOST:]PORT", "--insecure", "--live-camera-hz",
+                       "view PATH [--port P]"):
             self.assertIn(option, r.stdout)
-
-
-if __name__ == "__main__":
-    unittest.main()

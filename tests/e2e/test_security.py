@@ -9,22 +9,18 @@ import json
 import os
 import pickle
 import shutil
-import socket
 import subprocess
 import tempfile
 import textwrap
 import time
 import unittest
 
+from e2e_util import free_port
+
 from test_core import BIN_DIR, RECORDER, RELAY, Experiment
 
 ENGINE = os.path.join(BIN_DIR, "convoy-engine-python_json")
 
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def openssl(*args, cwd):

@@ -5,11 +5,15 @@
 #include <chrono>
 #include <thread>
 
+#include "convoy/road_users.pb.h"
 #include "datapack/camera.h"
 #include "datapack/json.h"
+#include "datapack/proto.h"
 #include "live_client.h"
 #include "loop/tap_fanout.h"
 #include "record/datapack_codec.h"
+#include "scene/scene_json.h"
+#include "test_support/eventually.h"
 
 namespace convoy::live {
 namespace {
@@ -17,14 +21,7 @@ namespace {
 using testing::TestClient;
 using json = nlohmann::json;
 
-template <typename P>
-bool eventually(P pred) {
-  for (int i = 0; i < 500; ++i) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return pred();
-}
+using test_support::eventually;
 
 engine::DataPack json_datapack(double x) {
   engine::DataPack dp;
@@ -46,17 +43,19 @@ engine::DataPack camera_datapack(uint8_t shade) {
   return dp;
 }
 
-// The id of the advertised channel `topic`, reading advertise messages as they come.
-uint32_t channel_id(TestClient& c, const std::string& topic, json* schema = nullptr) {
-  for (;;) {
+// The id of the advertised channel `topic`, reading advertise messages as they come. `seen`
+// keeps the channels of the messages read, for the next call: a client that connects after
+// several channels were added gets them in one message.
+uint32_t channel_id(TestClient& c, const std::string& topic, json* schema = nullptr,
+                    std::map<std::string, json>* seen = nullptr) {
+  std::map<std::string, json> local;
+  if (!seen) seen = &local;
+  while (!seen->count(topic)) {
     const json adv = c.next_op("advertise");
-    for (const auto& ch : adv["channels"]) {
-      if (ch["topic"] == topic) {
-        if (schema) *schema = ch;
-        return ch["id"];
-      }
-    }
+    for (const auto& ch : adv["channels"]) (*seen)[ch["topic"]] = ch;
   }
+  if (schema) *schema = seen->at(topic);
+  return seen->at(topic)["id"];
 }
 
 struct LiveTapTest : ::testing::Test {
@@ -109,18 +108,20 @@ TEST_F(LiveTapTest, ACameraGivesAJpegAndItsCalibrationAtTheChosenRate) {
   TestClient client(server.port());
   tap.from_engine("eng", camera_datapack(10), blobs, 0, 0);
   json ch;
-  const uint32_t raw = channel_id(client, "eng/cam", &ch);
+  std::map<std::string, json> seen;
+  const uint32_t raw = channel_id(client, "eng/cam", &ch, &seen);
   EXPECT_EQ(ch["encoding"], "protobuf");
   EXPECT_EQ(ch["schemaName"], "convoy.data.Camera");
   EXPECT_FALSE(record::base64_decode(ch["schema"].get<std::string>()).empty());
-  const uint32_t image = channel_id(client, "eng/cam/image", &ch);
+  const uint32_t image = channel_id(client, "eng/cam/image", &ch, &seen);
   EXPECT_EQ(ch["schemaName"], "foxglove.CompressedImage");
-  const uint32_t calibration = channel_id(client, "eng/cam/calibration", &ch);
+  const uint32_t calibration = channel_id(client, "eng/cam/calibration", &ch, &seen);
   EXPECT_EQ(ch["schemaName"], "foxglove.CameraCalibration");
   EXPECT_GT(raw, 0u);
   client.subscribe(7, image);
   client.subscribe(8, calibration);
-  ASSERT_TRUE(eventually([&] { return server.has_subscribers(calibration); }));
+  ASSERT_TRUE(eventually(
+      [&] { return server.has_subscribers(image) && server.has_subscribers(calibration); }));
   // 10 Hz of simulated time: of frames 20 ms apart, one in five.
   for (int i = 1; i <= 10; ++i)
     tap.from_engine("eng", camera_datapack(100), blobs, i, i * 20000000);
@@ -196,6 +197,83 @@ TEST(TapFanout, EveryTapSeesEveryDataPackInOrder) {
   fan.from_engine("e", json_datapack(1), datapack::inline_blob_reader(), 0, 0);
   fan.to_engine("e", json_datapack(1), datapack::inline_blob_reader(), fn, 0, 0);
   EXPECT_EQ(seen, (std::vector<std::string>{"a:state", "b:state", "a:state/in", "b:state/in"}));
+}
+
+}  // namespace
+}  // namespace convoy::live
+
+namespace convoy::live {
+namespace {
+
+engine::DataPack road_user_datapack(const std::string& id, double x) {
+  data::RoadUser u;
+  u.set_id(id);
+  u.set_category("car");
+  u.set_x(x);
+  engine::DataPack dp;
+  dp.mutable_id()->set_name("state");
+  datapack::InlineBlobWriter writer;
+  datapack::Builder b(&dp, writer);
+  datapack::write_proto(b, u);
+  return dp;
+}
+
+struct LiveSceneTest : ::testing::Test {
+  LiveSceneTest() : server(LiveTapTest::make_options()), tap(server, options()) {}
+  static TapOptions options() {
+    TapOptions o;
+    o.scene_hz = 10;
+    o.map = std::make_shared<const scene::SceneMap>(
+        scene::load_scene_map(std::string(CONVOY_OPENDRIVE_TEST_DATA) + "/lane_graph.xodr"));
+    return o;
+  }
+  LiveServer server;
+  LiveTap tap;
+  const datapack::BlobReader& blobs = datapack::inline_blob_reader();
+};
+
+TEST_F(LiveSceneTest, TheMapIsKeptForLateViewersTheSceneSentToSubscribers) {
+  // Before anyone is there: the road user is taken in, no scene is built.
+  for (int i = 0; i <= 10; ++i)
+    tap.from_engine("car_0", road_user_datapack("car_0", i), blobs, i, i * 20000000LL);
+  TestClient client(server.port());
+  std::map<std::string, json> channels;  // a new client's first advertise has them all
+  const json advertised = client.next_op("advertise");
+  for (const auto& ch : advertised["channels"]) channels[ch["topic"]] = ch;
+  ASSERT_EQ(channels.count(scene::kMapTopic), 1u);
+  EXPECT_EQ(channels[scene::kMapTopic]["schemaName"], "foxglove.SceneUpdate");
+  EXPECT_EQ(channels[scene::kMapTopic]["encoding"], "json");
+  EXPECT_EQ(channels[scene::kTransformsTopic]["schemaName"], "foxglove.FrameTransforms");
+  EXPECT_EQ(channels[scene::kFramesTopic]["schemaName"], "convoy.CameraFrame");
+  const uint32_t map = channels[scene::kMapTopic]["id"];
+  const uint32_t scene = channels[scene::kSceneTopic]["id"];
+  const uint32_t transforms = channels[scene::kTransformsTopic]["id"];
+  client.subscribe(1, map);
+  auto [sub, t, payload] = client.next_data();
+  EXPECT_EQ(sub, 1u);
+  EXPECT_EQ(json::parse(payload)["entities"][0]["id"], "lanes");
+  client.subscribe(2, scene);
+  client.subscribe(3, transforms);
+  ASSERT_TRUE(eventually([&] { return server.has_subscribers(transforms); }));
+  // 20 ms cycles at 10 Hz: the update for 0.2 s comes when 0.22 s begins, 0.3 s at 0.32 s.
+  for (int i = 11; i <= 16; ++i)
+    tap.from_engine("car_0", road_user_datapack("car_0", i), blobs, i, i * 20000000LL);
+  std::vector<std::pair<uint64_t, double>> scenes;
+  int tfs = 0;
+  while (scenes.size() + tfs < 4) {
+    auto [s, time, data] = client.next_data();
+    const json j = json::parse(data);
+    if (s == 2) {
+      ASSERT_EQ(j["entities"].size(), 1u);
+      EXPECT_EQ(j["entities"][0]["id"], "car_0");
+      scenes.push_back({time, j["entities"][0]["cubes"][0]["pose"]["position"]["x"]});
+    } else {
+      ++tfs;
+      EXPECT_EQ(s, 3u);
+      EXPECT_TRUE(j["transforms"].empty());  // no ego
+    }
+  }
+  EXPECT_EQ(scenes, (std::vector<std::pair<uint64_t, double>>{{200000000, 10}, {300000000, 15}}));
 }
 
 }  // namespace

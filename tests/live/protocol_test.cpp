@@ -10,7 +10,8 @@ namespace {
 using json = nlohmann::json;
 
 TEST(Protocol, ServerInfoHasTheSpecsFields) {
-  const auto j = json::parse(server_info_json({"convoy", "123", {{"simulation", "x"}}}));
+  const auto j =
+      json::parse(server_info_json({"convoy", "123", {{"simulation", "x"}}, {"time"}, {}}));
   EXPECT_EQ(j["op"], "serverInfo");
   EXPECT_EQ(j["name"], "convoy");
   EXPECT_EQ(j["capabilities"], json::array({"time"}));

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "live_client.h"
+#include "test_support/eventually.h"
 
 namespace convoy::live {
 namespace {
@@ -19,7 +20,7 @@ using tcp = net::ip::tcp;
 ServerOptions options(uint16_t port = 0) {
   ServerOptions o;
   o.address = parse_listen_address(std::to_string(port));
-  o.info = {"convoy test", "session-1", {{"simulation", "t"}}};
+  o.info = {"convoy test", "session-1", {{"simulation", "t"}}, {"time"}, {}};
   return o;
 }
 
@@ -27,15 +28,7 @@ std::shared_ptr<const std::string> text(const std::string& s) {
   return std::make_shared<const std::string>(s);
 }
 
-// Waits until `pred` holds (at most 5 s).
-template <typename P>
-bool eventually(P pred) {
-  for (int i = 0; i < 500; ++i) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return pred();
-}
+using test_support::eventually;
 
 TEST(LiveServer, GreetsAdvertisesAndSendsWhatIsSubscribed) {
   LiveServer server(options());

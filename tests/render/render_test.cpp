@@ -360,7 +360,9 @@ TEST(RenderTest, TheSkyGoesFromTheHorizonToTheZenithBehindTheScene) {
   for (size_t p = 0; p < with.depth.size(); ++p) {
     const bool sky_pixel = std::isinf(with.depth[p]);
     const bool same = std::equal(&with.rgb[3 * p], &with.rgb[3 * p] + 3, &without.rgb[3 * p]);
-    if (!sky_pixel) EXPECT_TRUE(same) << "pixel " << p;
+    if (!sky_pixel) {
+      EXPECT_TRUE(same) << "pixel " << p;
+    }
     differ += sky_pixel && !same;
   }
   EXPECT_GT(differ, with.depth.size() / 4);

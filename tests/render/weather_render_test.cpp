@@ -55,7 +55,9 @@ TEST(WeatherRenderTest, FogContrastFollowsKoschmieder) {
     const double contrast = (bg - obj) / bg;
     EXPECT_NEAR(contrast, std::exp(-3.912 * d / v), 0.05) << "d " << d << " V " << v;
     // At the visibility distance itself: 2 %.
-    if (d == 20.0) EXPECT_NEAR(std::exp(-3.912 * v / v), 0.02, 0.001);
+    if (d == 20.0) {
+      EXPECT_NEAR(std::exp(-3.912 * v / v), 0.02, 0.001);
+    }
   }
 }
 
