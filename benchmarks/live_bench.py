@@ -128,9 +128,9 @@ def main():
                   (i + 1, args.clients, live[-1], counts, images,
                    summary["live"]["dropped_messages"]), flush=True)
         page = dashboard(args, tmp)
-        print("dashboard run: %d camera frames drawn, %d latencies, %d road users" %
-              (page.get("framesDrawn", 0), page.get("latencies", 0), page.get("roadUsers", 0)),
-              flush=True)
+        print("dashboard run: %d camera frames drawn, %d latency samples (p90 %s ms), %d road users"
+              % (page.get("framesDrawn", 0), page.get("latencySamples", 0),
+                 page.get("frameLatencyP90Ms"), page.get("roadUsers", 0)), flush=True)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print("cpu: %s (%d cores)" % (cpu_model(), os.cpu_count()))
