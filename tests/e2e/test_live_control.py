@@ -18,21 +18,9 @@ import urllib.request
 
 from e2e_util import CONVOY, REPO, free_port
 from live_ws import LiveClient
+from test_live import CONFIG, convoy, read  # the wheeled-robot run both files watch
 
 DASHBOARD = os.path.join(os.path.dirname(CONVOY), "..", "share", "convoy", "dashboard")
-CONFIG = os.path.join(REPO, "experiments", "wheeled_robot", "simulation_config.json")
-SIM_S = "6"  # simulated seconds: about 1.5 s of wall time, 300 loop cycles
-
-
-
-def convoy(tmp, name, *extra):
-    return [CONVOY, "run", "-c", CONFIG, "-o", "SimulationTimeout=" + SIM_S, "--run-dir",
-            os.path.join(tmp, name), *extra]
-
-
-def read(path):
-    with open(path, "rb") as f:
-        return f.read()
 
 
 def http_get(url, headers=None, timeout=10):
