@@ -3,8 +3,9 @@
 From the car's pose it tracks the Parkring waypoints (the autonomous-driving experiment's
 Trajectory) and returns, as one JsonRawData: the time, the pose, the speed, the heading error
 towards the waypoint a few points ahead, the distance from the path, the waypoints reached,
-and whether the episode is over (lap done, or more than OFF_TRACK m from the path). It
-returns done=True every step, so that each run_loop(1) brings its observation back."""
+a few route points ahead in the car's frame (`ahead`, for convoy_gym's DrivingEnv) and
+whether the episode is over (lap done, or more than OFF_TRACK m from the path). It returns
+done=True every step, so that each run_loop(1) brings its observation back."""
 import math
 import os
 import sys
@@ -18,12 +19,32 @@ import relateAngle_computation  # noqa: E402
 from euler_from_quaternion import euler_from_quaternion  # noqa: E402
 
 OFF_TRACK = 3.0  # m
+AHEAD = (1, 2, 4, 8, 12)  # the route points returned, in waypoints (2 m apart) after the target
 track = None
 
 
 def distance_to_path(points, index, x, y):
+    """The distance from the route's segments near the target waypoint `index`."""
     near = [points[i % len(points)] for i in range(max(index - 2, 0), index + 3)]
-    return min(math.hypot(px - x, py - y) for px, py in near)
+    best = math.inf
+    for (ax, ay), (bx, by) in zip(near, near[1:]):
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        u = 0.0 if length2 == 0 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / length2))
+        best = min(best, math.hypot(ax + u * dx - x, ay + u * dy - y))
+    return best
+
+
+def route_ahead(points, index, x, y, yaw):
+    """The route points AHEAD waypoints after `index`, in the car's frame ([forward, left] m);
+    past the lap's end, the last point."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    out = []
+    for k in AHEAD:
+        px, py = points[min(index + k, len(points) - 1)]
+        dx, dy = px - x, py - y
+        out.append([c * dx + s * dy, -s * dx + c * dy])
+    return out
 
 
 @EngineDataPack(keyword='car', id=DataPackIdentifier('smart_car_link_plugin::base_link', 'gazebo'))
@@ -45,4 +66,5 @@ def observe(car, iteration, time_ns):
         "t": time_ns * 1e-9, "x": x, "y": y, "yaw": yaw, "speed": speed,
         "heading_error": heading_error, "off_path": off_path,
         "waypoint": track.index, "waypoints": len(track.points),
+        "ahead": route_ahead(track.points, track.index, x, y, yaw),
         "episode_over": track.finished or off_path > OFF_TRACK})]

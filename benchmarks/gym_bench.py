@@ -1,0 +1,94 @@
+#!/usr/bin/python3
+"""convoy_gym benchmark: DrivingEnv.step() calls per second, 1 process, no camera.
+
+  /usr/bin/python3 benchmarks/gym_bench.py [--steps 3000] [--runs 3] [--physics-step 0.005]
+
+One DrivingEnv on experiments/rl_parkring (Gazebo's smart car, the weather engine, the
+python_json agent engine, drive_tf and the observe status function; 0.05 s per step). Each
+run resets with a new seed and times --steps step() calls of a heading-error policy at
+6 m/s, resetting when an episode ends (resets are timed too). A second figure times the
+same number of bare nrp_client run_loop(1) calls on the same server, to show what the
+environment adds. Then the same with DrivingEnv(physics_step=...) (default 0.005 s instead
+of the world's 1 ms physics step; 0 skips it). Prints each run, the medians and the CPU model.
+The issue's target is 2,000 steps/s (MetaDrive: "1000+ FPS").
+"""
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "python"))
+import numpy as np  # noqa: E402
+
+from convoy_gym import DrivingEnv  # noqa: E402
+
+
+def cpu_model():
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
+    except OSError:
+        return "unknown"
+    for line in out.splitlines():
+        if line.startswith("Model name:"):
+            return line.split(":", 1)[1].strip()
+    return "unknown"
+
+
+def time_env(env, steps, seed):
+    obs, _ = env.reset(seed=seed)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        action = np.array([np.clip(0.8 * obs[4], -0.55, 0.55), 6.0], dtype=np.float32)
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            obs, _ = env.reset()
+    return steps / (time.perf_counter() - t0)
+
+
+def time_client(env, steps):
+    nrp = env._nrp  # the bare client under the environment, the same policy
+    obs, _ = env.reset(seed=0)
+    heading_error = float(obs[4])
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        steer = max(-0.55, min(0.55, 0.8 * heading_error))
+        nrp.set_json_datapack("action", "agent", {"steer": steer, "speed": 6.0})
+        _, data = nrp.run_loop(1)
+        heading_error = data[-1]["heading_error"]
+    return steps / (time.perf_counter() - t0)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--steps", type=int, default=3000, help="timed steps per run")
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--physics-step", type=float, default=0.005,
+                        help="also time DrivingEnv(physics_step=S) (0: skip)")
+    args = parser.parse_args()
+    medians = {}
+    for physics_step in (None, args.physics_step or None):
+        if physics_step is None and medians:
+            break
+        name = "world's step" if physics_step is None else "physics_step %g s" % physics_step
+        # max_steps beyond a timed run, so that episodes end only on the track's account
+        with DrivingEnv(max_steps=100000, physics_step=physics_step) as env:
+            time_env(env, 100, seed=99)  # warm-up
+            rates = []
+            for run in range(args.runs):
+                rates.append(time_env(env, args.steps, seed=run))
+                print("%s, run %d: %.0f steps/s" % (name, run + 1, rates[-1]), flush=True)
+            bare = time_client(env, args.steps)
+        print("%s, bare run_loop(1) on the same server: %.0f calls/s" % (name, bare))
+        medians[physics_step] = statistics.median(rates)
+    print("CPU: %s (%d cores)" % (cpu_model(), os.cpu_count()))
+    print("DrivingEnv steps/s: %.0f" % medians[None])
+    for physics_step, rate in medians.items():
+        if physics_step is not None:
+            print("DrivingEnv steps/s with physics_step %g s: %.0f" % (physics_step, rate))
+
+
+if __name__ == "__main__":
+    main()

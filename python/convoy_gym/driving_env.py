@@ -1,0 +1,258 @@
+"""DrivingEnv: one car on a track as a gymnasium environment, on NRP-Core's Python client.
+
+    from convoy_gym import DrivingEnv
+
+    with DrivingEnv(max_steps=400) as env:
+        obs, info = env.reset(seed=1)
+        for _ in range(400):
+            steer = max(-0.55, min(0.55, 0.8 * obs[4]))  # obs[4]: heading error
+            obs, reward, terminated, truncated, info = env.step([steer, 6.0])
+            if terminated or truncated:
+                break
+
+The simulation is experiments/rl_parkring (or any config with its conventions): a
+python_json engine "agent" holding the datapack "action" = {"steer": rad, "speed": m/s},
+which a transceiver function turns into the car's joint targets, and a status function
+returning done=True and one JSON observation every step with the keys t, x, y, yaw, speed,
+heading_error, off_path, waypoint, waypoints, episode_over and (optionally) ahead, a list of
+[forward, left] route points in the car's frame. One step() is one run_loop(1), i.e. one
+step of the smallest EngineTimestep (0.05 s on the Parkring). See docs/gym.md.
+"""
+import os
+import shutil
+import socket
+
+import numpy as np
+
+from convoy_gym import spaces
+from convoy_gym.world_variant import variant_config
+from nrp_client import NrpCore
+
+__all__ = ["DrivingEnv", "default_reward", "OBSERVATION_KEYS"]
+
+_REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+DEFAULT_CONFIG = os.path.join(_REPO, "experiments", "rl_parkring", "simulation_config.json")
+
+MAX_STEER = 0.55   # rad, the smart car's steering limit (drive_tf.py clamps to it too)
+MAX_SPEED = 15.0   # m/s
+N_AHEAD = 5        # route points ahead in the observation (observe.py's AHEAD)
+OBSERVATION_KEYS = ("x", "y", "yaw", "speed", "heading_error", "off_path") + tuple(
+    "ahead%d_%s" % (i, axis) for i in range(N_AHEAD) for axis in ("forward", "left"))
+ACTION_NAMES = ("steer", "speed")
+OFF_TRACK_PENALTY = 10.0
+STOP = {"steer": 0.0, "speed": 0.0}
+
+
+def default_reward(before, after, action):
+    """Waypoints gained (2 m each on the Parkring), minus 0.1 per metre from the path, minus
+    OFF_TRACK_PENALTY when the episode ends off the track (before the lap's end).
+    `before` and `after` are the status function's observation dicts, `action` the array."""
+    r = (after["waypoint"] - before["waypoint"]) - 0.1 * after["off_path"]
+    if after["episode_over"] and after["waypoint"] < after["waypoints"]:
+        r -= OFF_TRACK_PENALTY
+    return float(r)
+
+
+def _free_address():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return "127.0.0.1:%d" % s.getsockname()[1]
+
+
+class DrivingEnv:
+    """The gymnasium API (reset, step, close, observation_space, action_space) over one
+    NRPCoreSim server process, started by the constructor and stopped by close().
+
+    Observation: Box float32 (16,) = OBSERVATION_KEYS: x, y (m, world), yaw (rad), speed
+    (m/s), heading_error (rad, towards the route a few points ahead), off_path (m), then
+    N_AHEAD route points ahead (2, 4, 8, 16, 24 m along the route) as [forward, left] m in
+    the car's frame (zeros when the status function gives no `ahead`).
+    Action: Box float32 (2,) = [steer in [-0.55, 0.55] rad, target speed in [0, 15] m/s].
+    An action outside it raises ValueError.
+    """
+
+    metadata = {"render_modes": []}
+    render_mode = None
+
+    def __init__(self, config=DEFAULT_CONFIG, max_steps=1000, reward_fn=None,
+                 start_steps=20, start_speed=6.0, start_steer=0.05, physics_step=None,
+                 args="", address=None, log_output=""):
+        """:param config: the simulation config; its folder is the experiment folder
+        :param max_steps: steps per episode before `truncated`
+        :param reward_fn: reward_fn(before, after, action) -> float; default_reward if None
+        :param start_steps, start_speed, start_steer: reset(seed) drives 1 to start_steps
+            steps at a speed in [0, start_speed] m/s and a steer in +-start_steer rad, all
+            drawn from the seed, so each seed starts the episode from its own state
+        :param physics_step: the Gazebo world's physics step in s (None: the world's own,
+            1 ms on the Parkring); 0.005 runs about 3x faster, with coarser physics
+        :param args: more NRPCoreSim options, e.g. "-o SimulationTimeout=600"
+        :param address: HOST:PORT for the server (default: a free loopback port)
+        :param log_output: file in the experiment folder for the server's output ("" none)
+        """
+        self._nrp = None
+        self._tmp = None
+        config = os.path.abspath(config)
+        if not os.path.isfile(config):
+            raise FileNotFoundError("DrivingEnv: config %s not found" % config)
+        if int(max_steps) <= 0:
+            raise ValueError("DrivingEnv: max_steps must be > 0, got %r" % (max_steps,))
+        if int(start_steps) < 1:
+            raise ValueError("DrivingEnv: start_steps must be >= 1, got %r" % (start_steps,))
+        self.config = config
+        self.max_steps = int(max_steps)
+        self.reward_fn = reward_fn or default_reward
+        self.start = (int(start_steps), float(start_speed), float(start_steer))
+        inf = np.inf
+        self.observation_space = spaces.Box(
+            low=np.array([-inf, -inf, -np.pi, 0.0, -np.pi, 0.0] + [-inf] * (2 * N_AHEAD)),
+            high=np.array([inf, inf, np.pi, inf, np.pi, inf] + [inf] * (2 * N_AHEAD)),
+            dtype=np.float32)
+        self.action_space = spaces.Box(low=np.array([-MAX_STEER, 0.0]),
+                                       high=np.array([MAX_STEER, MAX_SPEED]), dtype=np.float32)
+        self.np_random = np.random.Generator(np.random.PCG64())
+        self._raw = None
+        self._steps = 0
+        run_config = config
+        if physics_step is not None:
+            run_config, self._tmp = variant_config(config, physics_step)
+        try:
+            self._nrp = NrpCore(address or _free_address(),
+                                experiment_folder=os.path.dirname(config),
+                                config_file=run_config, args=args, log_output=log_output)
+            self._nrp.initialize()
+        except BaseException:
+            self.close()
+            raise
+        self._needs_reset = False  # the first episode starts from initialize()'s state
+
+    # --- gymnasium's API -------------------------------------------------------------------
+    def reset(self, seed=None, options=None):
+        """Starts an episode. `seed` (an int) reseeds the environment's generator: the same
+        seed gives the same episode for the same actions, bit for bit. options may hold
+        start_steps / start_speed / start_steer to fix the start instead of drawing it.
+        Returns (observation, info)."""
+        self._check_open()
+        if seed is not None:
+            self.np_random = np.random.Generator(np.random.PCG64(seed))
+        options = dict(options or {})
+        unknown = set(options) - {"start_steps", "start_speed", "start_steer"}
+        if unknown:
+            raise ValueError("reset(): unknown options %s" % sorted(unknown))
+        max_steps, max_speed, max_steer = self.start
+        rng = self.np_random
+        n = int(options.get("start_steps", rng.integers(1, max_steps + 1)))
+        speed = float(options.get("start_speed", rng.uniform(0.0, max_speed)))
+        steer = float(options.get("start_steer", rng.uniform(-max_steer, max_steer)))
+        if self._needs_reset:
+            self._nrp.set_json_datapack("action", "agent", dict(STOP))
+            self._nrp.reset()
+        self._needs_reset = True
+        for _ in range(max(n, 1)):
+            self._raw = self._run({"steer": steer, "speed": speed})
+        self._steps = 0
+        info = self._info()
+        info["start"] = {"steps": n, "speed": speed, "steer": steer}
+        return self._observation(), info
+
+    def step(self, action):
+        """Applies `action` for one step. Returns (obs, reward, terminated, truncated,
+        info): terminated when the car left the track or finished the lap, truncated after
+        max_steps steps."""
+        self._check_open()
+        if self._raw is None:
+            raise RuntimeError("DrivingEnv.step() before reset()")
+        a = self._check_action(action)
+        before = self._raw
+        self._raw = self._run({"steer": float(a[0]), "speed": float(a[1])})
+        self._steps += 1
+        reward = float(self.reward_fn(before, self._raw, a))
+        terminated = bool(self._raw["episode_over"])
+        truncated = not terminated and self._steps >= self.max_steps
+        return self._observation(), reward, terminated, truncated, self._info()
+
+    def close(self):
+        """Stops the simulation (the NRPCoreSim process and its engines). Safe to call twice."""
+        nrp, self._nrp = getattr(self, "_nrp", None), None
+        tmp, self._tmp = getattr(self, "_tmp", None), None
+        try:
+            if nrp is not None:
+                nrp.shutdown()
+        finally:
+            if tmp:
+                shutil.rmtree(tmp, ignore_errors=True)
+
+    def render(self):
+        return None
+
+    @property
+    def unwrapped(self):
+        return self
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - nothing to do about it at collection
+            pass
+
+    # --- the rest --------------------------------------------------------------------------
+    def _check_open(self):
+        if self._nrp is None:
+            raise RuntimeError("DrivingEnv is closed; make a new one")
+
+    def _check_action(self, action):
+        try:
+            a = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError("action %r is not an array of 2 numbers [steer, speed]"
+                             % (action,)) from None
+        if a.shape != self.action_space.shape:
+            raise ValueError("action %r has shape %s, the action space %s"
+                             % (action, a.shape, self.action_space.shape))
+        for i, name in enumerate(ACTION_NAMES):
+            low, high = float(self.action_space.low[i]), float(self.action_space.high[i])
+            if not np.isfinite(a[i]):
+                raise ValueError("action[%d] (%s) = %r is not a finite number" % (i, name, a[i]))
+            if a[i] < low:
+                raise ValueError("action[%d] (%s) = %r is below the action space's bound %g"
+                                 % (i, name, a[i], low))
+            if a[i] > high:
+                raise ValueError("action[%d] (%s) = %r is above the action space's bound %g"
+                                 % (i, name, a[i], high))
+        return a
+
+    def _run(self, action):
+        self._nrp.set_json_datapack("action", "agent", action)
+        _, observations = self._nrp.run_loop(1)
+        if not observations:  # the status function had no car pose yet
+            if self._raw is None:
+                raise RuntimeError("DrivingEnv: the status function returned no observation "
+                                   "(%s)" % self.config)
+            return self._raw
+        raw = observations[-1]
+        missing = [k for k in ("x", "y", "yaw", "speed", "heading_error", "off_path",
+                               "waypoint", "waypoints", "episode_over") if k not in raw]
+        if missing:
+            raise KeyError("DrivingEnv: the status function of %s returned no %s"
+                           % (self.config, ", ".join(missing)))
+        return raw
+
+    def _observation(self):
+        r = self._raw
+        ahead = r.get("ahead") or [[0.0, 0.0]] * N_AHEAD
+        values = [r["x"], r["y"], r["yaw"], r["speed"], r["heading_error"], r["off_path"]]
+        for i in range(N_AHEAD):
+            values += ahead[min(i, len(ahead) - 1)][:2]
+        obs = np.asarray(values, dtype=np.float32)
+        return np.clip(obs, self.observation_space.low, self.observation_space.high)
+
+    def _info(self):
+        r = self._raw
+        return {"t": r.get("t"), "waypoint": r["waypoint"], "waypoints": r["waypoints"],
+                "off_path": r["off_path"], "steps": self._steps,
+                "lap_done": bool(r["episode_over"]) and r["waypoint"] >= r["waypoints"]}
