@@ -7,9 +7,14 @@ client (nrp_client). See docs/gym.md.
     obs, reward, terminated, truncated, info = env.step([0.0, 6.0])
     env.close()
 
+    from convoy_gym import VectorDrivingEnv
+    envs = VectorDrivingEnv(2)              # 2 servers, stepped together
+    obs, infos = envs.reset(seed=0)         # obs: (2, 16); env i gets seed 0 + i
+
 Pure Python with numpy; uses gymnasium.spaces when gymnasium is installed.
 """
 from convoy_gym import spaces
 from convoy_gym.driving_env import DrivingEnv, default_reward
+from convoy_gym.vector_env import VectorDrivingEnv
 
-__all__ = ["DrivingEnv", "default_reward", "spaces"]
+__all__ = ["DrivingEnv", "VectorDrivingEnv", "default_reward", "spaces"]

@@ -2,7 +2,9 @@
 contract (reset / step shapes and dtypes, observations in the observation space), seeding
 (same seed -> the same episode bit for bit, another seed -> another), actions outside the
 space, termination and truncation, a custom reward, another physics step, and that close(),
-a `with` block and garbage collection leave no process behind.
+a `with` block and garbage collection leave no process behind. `Vector`: VectorDrivingEnv(2)
+(batch shapes, each sub-environment equal to a DrivingEnv with its seed, autoreset, a bad
+action naming the env, an error in one env closing all, no process left after close()).
 
 Run: cd tests/e2e && CONVOY_BIN_DIR=../../build/bin /usr/bin/python3 -m unittest -v test_gym"""
 import gc
@@ -18,7 +20,7 @@ from e2e_util import BIN_DIR, REPO, pid_alive
 
 os.environ.setdefault("CONVOY_BIN_DIR", BIN_DIR)
 sys.path.insert(0, os.path.join(REPO, "python"))
-from convoy_gym import DrivingEnv  # noqa: E402
+from convoy_gym import DrivingEnv, VectorDrivingEnv  # noqa: E402
 
 
 def policy(obs):
@@ -192,6 +194,126 @@ class LifecycleTest(unittest.TestCase):
         left = subprocess.run(["pgrep", "-f", "NRPCoreSim"], capture_output=True,
                               text=True).stdout.split()
         self.assertEqual([p for p in left if p in mine], [])
+
+
+def batch_policy(obs):
+    """policy() for each row of a batch of observations."""
+    return np.stack([policy(o) for o in obs])
+
+
+class Vector(unittest.TestCase):
+    """VectorDrivingEnv: 2 DrivingEnvs (2 servers) stepped together, 30-step episodes."""
+    STEPS = 30
+
+    @classmethod
+    def setUpClass(cls):
+        cls.envs = VectorDrivingEnv(2, max_steps=cls.STEPS)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.envs.close()
+
+    def episode(self, seed):
+        """Resets with `seed`, runs STEPS steps (ending truncated) and one more (the
+        autoreset); returns the observations, actions, rewards and the last step."""
+        envs = self.envs
+        obs, infos = envs.reset(seed=seed)
+        trajectory, actions, rewards = [obs], [], []
+        for i in range(self.STEPS):
+            a = batch_policy(obs)
+            obs, reward, terminated, truncated, infos = envs.step(a)
+            trajectory.append(obs)
+            actions.append(a)
+            rewards.append(reward)
+            self.assertEqual(list(terminated), [False, False])
+            self.assertEqual(list(truncated), [i == self.STEPS - 1] * 2)
+        after = envs.step(batch_policy(obs))  # the autoreset
+        return np.array(trajectory), np.array(actions), np.array(rewards), after
+
+    def test_spaces_and_shapes(self):
+        envs = self.envs
+        self.assertEqual(envs.num_envs, 2)
+        self.assertEqual(envs.single_observation_space.shape, (16,))
+        self.assertEqual(envs.single_action_space.shape, (2,))
+        self.assertEqual(envs.observation_space.shape, (2, 16))
+        self.assertEqual(envs.action_space.shape, (2, 2))
+        self.assertEqual(envs.metadata["autoreset_mode"], "next_step")
+        obs, infos = envs.reset(seed=0)
+        self.assertEqual(obs.shape, (2, 16))
+        self.assertEqual(obs.dtype, np.float32)
+        self.assertTrue(envs.observation_space.contains(obs))
+        self.assertEqual(list(infos["_waypoint"]), [True, True])
+        self.assertEqual(infos["start"]["steps"].shape, (2,))
+        obs, rewards, terminated, truncated, infos = envs.step(envs.action_space.sample())
+        self.assertEqual(obs.shape, (2, 16))
+        self.assertEqual((rewards.shape, rewards.dtype), ((2,), np.float64))
+        self.assertEqual((terminated.shape, terminated.dtype), ((2,), bool))
+        self.assertEqual((truncated.shape, truncated.dtype), ((2,), bool))
+        self.assertEqual(list(infos["steps"]), [1, 1])
+
+    def test_seeds_autoreset_and_single_envs(self):
+        traj, actions, rewards, after = self.episode(seed=21)
+        self.assertFalse(np.array_equal(traj[:, 0], traj[:, 1]), "seeds 21 and 22 differ")
+        again, _, rewards2, after2 = self.episode(seed=21)
+        np.testing.assert_array_equal(traj, again)
+        np.testing.assert_array_equal(rewards, rewards2)
+        # the step after the truncation reset both envs, continuing their generators
+        obs, reward, terminated, truncated, infos = after
+        self.assertEqual(list(reward), [0.0, 0.0])
+        self.assertEqual(list(terminated) + list(truncated), [False] * 4)
+        self.assertEqual(list(infos["steps"]), [0, 0])
+        self.assertEqual(list(infos["_start"]), [True, True])
+        np.testing.assert_array_equal(obs, after2[0])
+        # each sub-environment is a DrivingEnv with seed 21 + i
+        for i in range(2):
+            with DrivingEnv(max_steps=self.STEPS) as env:
+                o, _ = env.reset(seed=21 + i)
+                single, single_rewards = [o], []
+                for a in actions[:, i]:
+                    o, r, terminated, truncated, _ = env.step(a)
+                    single.append(o)
+                    single_rewards.append(r)
+                self.assertTrue(truncated)
+                np.testing.assert_array_equal(np.array(single), traj[:, i])
+                np.testing.assert_array_equal(single_rewards, rewards[:, i])
+                o, _ = env.reset()  # the autoreset's: no seed, the generator goes on
+                np.testing.assert_array_equal(o, obs[i])
+
+    def test_bad_action_names_the_env(self):
+        envs = self.envs
+        envs.reset(seed=0)
+        with self.assertRaisesRegex(ValueError, r"env 1: action\[0\] \(steer\) = 0\.9 is above"):
+            envs.step([[0.0, 5.0], [0.9, 5.0]])
+        with self.assertRaisesRegex(ValueError, r"env 0: action\[1\] \(speed\) = -1.* below"):
+            envs.step([[0.0, -1.0], [0.0, 5.0]])
+        with self.assertRaisesRegex(ValueError, r"shape \(2,\)"):
+            envs.step([0.0, 5.0])
+        obs, _, _, _, infos = envs.step([[0.0, 5.0], [0.0, 5.0]])  # nothing stepped before
+        self.assertEqual(list(infos["steps"]), [1, 1])
+
+    def test_error_in_one_env_closes_all(self):
+        envs = VectorDrivingEnv(2, max_steps=10)
+        pids = [p for env in envs.envs for p in server_processes(env)]
+        envs.reset(seed=0)
+        envs.envs[1]._nrp._server.process.kill()  # env 1's server dies
+        with self.assertRaisesRegex(RuntimeError, r"^env 1: "):
+            for _ in range(5):
+                envs.step([[0.0, 5.0], [0.0, 5.0]])
+        assert_gone(self, pids)
+        with self.assertRaisesRegex(RuntimeError, "closed"):
+            envs.reset()
+
+    def test_close_leaves_no_process(self):
+        with VectorDrivingEnv(2) as envs:
+            pids = [p for env in envs.envs for p in server_processes(env)]
+            self.assertEqual(len({env._nrp._server.process.pid for env in envs.envs}), 2)
+            envs.reset(seed=5)
+            envs.step([[0.0, 5.0], [0.1, 5.0]])
+        assert_gone(self, pids)
+        envs.close()  # twice is fine
+        left = subprocess.run(["pgrep", "-f", "NRPCoreSim"], capture_output=True,
+                              text=True).stdout.split()
+        self.assertEqual([p for p in left if int(p) in pids], [])
 
 
 if __name__ == "__main__":

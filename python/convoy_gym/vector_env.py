@@ -1,0 +1,338 @@
+"""VectorDrivingEnv: several DrivingEnvs stepped together, in gymnasium's vector-env shape.
+
+    from convoy_gym import VectorDrivingEnv
+
+    with VectorDrivingEnv(2, max_steps=400) as envs:
+        obs, infos = envs.reset(seed=1)              # env i: seed 1 + i; obs: (2, 16)
+        for _ in range(400):
+            steer = np.clip(0.8 * obs[:, 4], -0.55, 0.55)
+            actions = np.stack([steer, np.full(2, 6.0)], axis=1)   # (2, 2)
+            obs, rewards, terminations, truncations, infos = envs.step(actions)
+
+Each sub-environment is a DrivingEnv, i.e. its own NRPCoreSim server process (and its
+engines' processes) on its own port: the simulations already run in parallel processes. This
+class only drives them at the same time, from one thread per environment: a step is a few
+gRPC calls that release the GIL while the server works, so the Python side is not the
+bottleneck (see docs/gym.md, "Parallel environments", for the measured speed-up).
+
+Autoreset: gymnasium's default for AsyncVectorEnv (gymnasium >= 1.0, AutoresetMode.NEXT_STEP).
+When a sub-environment's episode ends at step t, step t returns its last observation with
+terminated / truncated set; the next step() resets that sub-environment (its action is
+ignored) and returns the new episode's first observation with reward 0.0,
+terminated = truncated = False. The reset draws no new seed: it continues the
+sub-environment's generator, as DrivingEnv.reset() does.
+autoreset_mode="same_step" gives gymnasium 0.29's behaviour instead (the reset happens in the
+same step; the last observation and info are in infos["final_obs"] / infos["final_info"]),
+and "disabled" leaves the resetting to the caller (reset(options={"reset_mask": mask})).
+
+infos: gymnasium's vector layout, a dict whose values are arrays of length num_envs, each key
+`k` with a boolean mask `_k` saying which sub-environments gave it (nested dicts likewise).
+
+Errors: an action outside the action space raises ValueError naming the sub-environment and
+the element (`env 1: action[0] (steer) = 0.9 is above ...`) before any environment steps, so
+nothing changes and the vector env stays usable. Any other error in a sub-environment (its
+server died, an observation is missing, ...) closes every sub-environment and is raised with
+the sub-environment's index: no NRPCoreSim is left behind.
+"""
+import concurrent.futures
+import threading
+
+import numpy as np
+
+from convoy_gym import spaces
+from convoy_gym.driving_env import DrivingEnv
+
+__all__ = ["VectorDrivingEnv", "AUTORESET_MODES"]
+
+AUTORESET_MODES = ("next_step", "same_step", "disabled")
+
+
+class SubEnvError(RuntimeError):
+    """An error inside sub-environment `index` (the vector env is closed)."""
+
+    def __init__(self, index, error):
+        super().__init__("env %d: %s: %s" % (index, type(error).__name__, error))
+        self.index = index
+        self.error = error
+
+
+class VectorDrivingEnv:
+    """num_envs DrivingEnv(**env_kwargs), each its own NRPCoreSim, stepped concurrently.
+
+    The gymnasium vector API: reset(seed=None, options=None) -> (obs [num_envs, 16], infos),
+    step(actions [num_envs, 2]) -> (obs, rewards, terminations, truncations, infos), close(),
+    num_envs, single_observation_space, single_action_space, observation_space and
+    action_space (batched Boxes), and a `with` block."""
+
+    metadata = {"render_modes": [], "autoreset_mode": "next_step"}
+    render_mode = None
+
+    def __init__(self, num_envs, autoreset_mode="next_step", env_fns=None, **env_kwargs):
+        """:param num_envs: number of sub-environments (processes), >= 1
+        :param autoreset_mode: "next_step" (gymnasium's default), "same_step" or "disabled"
+        :param env_fns: optional list of num_envs callables returning a DrivingEnv-like
+            environment (instead of DrivingEnv(**env_kwargs))
+        :param env_kwargs: DrivingEnv's arguments, the same for every sub-environment
+            (address must not be given: each gets a free port)"""
+        self.envs = []
+        self._pool = None
+        num_envs = int(num_envs)
+        if num_envs < 1:
+            raise ValueError("VectorDrivingEnv: num_envs must be >= 1, got %r" % (num_envs,))
+        if autoreset_mode not in AUTORESET_MODES:
+            raise ValueError("VectorDrivingEnv: autoreset_mode must be one of %s, got %r"
+                             % (", ".join(AUTORESET_MODES), autoreset_mode))
+        if env_kwargs.get("address"):
+            raise ValueError("VectorDrivingEnv: every sub-environment needs its own address; "
+                             "do not pass address=")
+        if env_fns is not None and len(env_fns) != num_envs:
+            raise ValueError("VectorDrivingEnv: %d env_fns for %d envs" % (len(env_fns), num_envs))
+        self.num_envs = num_envs
+        self.autoreset_mode = autoreset_mode
+        self.metadata = dict(self.metadata, autoreset_mode=autoreset_mode)
+        self._lock = threading.Lock()
+        self._pool = concurrent.futures.ThreadPoolExecutor(
+            max_workers=num_envs, thread_name_prefix="VectorDrivingEnv")
+        make = env_fns or [lambda: DrivingEnv(**env_kwargs)] * num_envs
+        # start the servers at the same time; if one fails, close the others
+        futures = [self._pool.submit(fn) for fn in make]
+        errors = []
+        for i, f in enumerate(futures):
+            try:
+                self.envs.append(f.result())
+            except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
+                errors.append((i, e))
+        if errors:
+            self.close()
+            i, e = errors[0]
+            raise SubEnvError(i, e) from e
+        self.single_observation_space = self.envs[0].observation_space
+        self.single_action_space = self.envs[0].action_space
+        self.observation_space = _batch_box(self.single_observation_space, num_envs)
+        self.action_space = _batch_box(self.single_action_space, num_envs)
+        self._autoreset = np.zeros(num_envs, dtype=bool)
+        self._started = False
+
+    # --- gymnasium's vector API ------------------------------------------------------------
+    def reset(self, seed=None, options=None):
+        """Resets every sub-environment (or those in options["reset_mask"]). seed: an int
+        (env i gets seed + i), a list of num_envs ints / None, or None (each continues its
+        generator). Returns (obs [num_envs, ...], infos)."""
+        self._check_open()
+        if seed is None or isinstance(seed, (int, np.integer)):
+            seeds = [None if seed is None else int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+            if len(seeds) != self.num_envs:
+                raise ValueError("reset(): %d seeds for %d envs" % (len(seeds), self.num_envs))
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        mask = np.ones(self.num_envs, bool) if mask is None else np.asarray(mask, dtype=bool)
+        if mask.shape != (self.num_envs,):
+            raise ValueError("reset(): reset_mask has shape %s, expected (%d,)"
+                             % (mask.shape, self.num_envs))
+        if not self._started and not mask.all():
+            raise RuntimeError("VectorDrivingEnv: the first reset() must reset every env")
+        jobs = {i: (lambda e=e, s=seeds[i]: e.reset(seed=s, options=options or None))
+                for i, e in enumerate(self.envs) if mask[i]}
+        results = self._run(jobs)
+        if not self._started:
+            self._obs = np.zeros(self.observation_space.shape, self.observation_space.dtype)
+            self._started = True
+        infos = {}
+        for i, (obs, info) in results.items():
+            self._obs[i] = obs
+            self._autoreset[i] = False
+            _add_info(infos, info, i, self.num_envs)
+        return self._obs.copy(), infos
+
+    def step(self, actions):
+        """Steps every sub-environment with its row of `actions` ([num_envs, 2]); a
+        sub-environment whose episode ended at the previous step is reset instead (see the
+        module's docstring). Returns (obs, rewards, terminations, truncations, infos)."""
+        self._check_open()
+        if not self._started:
+            raise RuntimeError("VectorDrivingEnv.step() before reset()")
+        actions = self._check_actions(actions)
+        n = self.num_envs
+        jobs = {}
+        for i, env in enumerate(self.envs):
+            if self._autoreset[i]:
+                jobs[i] = lambda e=env: ("reset",) + tuple(e.reset())
+            else:
+                jobs[i] = self._step_job(env, actions[i])
+        results = self._run(jobs)
+        obs = self._obs
+        rewards = np.zeros(n, dtype=np.float64)
+        terminations = np.zeros(n, dtype=bool)
+        truncations = np.zeros(n, dtype=bool)
+        infos = {}
+        for i in range(n):
+            r = results[i]
+            if r[0] == "reset":
+                obs[i], info = r[1], r[2]
+            else:
+                obs[i], rewards[i], terminations[i], truncations[i], info = r[1:6]
+                if len(r) > 6:  # same_step: reset in this step, the last one in final_*
+                    _add_info(infos, {"final_obs": r[1], "final_info": info}, i, n)
+                    obs[i], info = r[6], r[7]
+            _add_info(infos, info, i, n)
+        if self.autoreset_mode == "next_step":
+            self._autoreset = terminations | truncations
+        return obs.copy(), rewards, terminations, truncations, infos
+
+    def close(self):
+        """Closes every sub-environment (their servers and engines). Safe to call twice."""
+        envs, self.envs = getattr(self, "envs", []), []
+        pool, self._pool = getattr(self, "_pool", None), None
+        errors = []
+        if envs:
+            # shut the servers down together: each close() waits for its processes
+            closer = concurrent.futures.ThreadPoolExecutor(max_workers=len(envs))
+            for f in [closer.submit(e.close) for e in envs]:
+                try:
+                    f.result()
+                except Exception as e:  # noqa: BLE001 - close the others first
+                    errors.append(e)
+            closer.shutdown(wait=True)
+        if pool is not None:
+            pool.shutdown(wait=True)
+        if errors:
+            raise errors[0]
+
+    def call(self, name, *args, **kwargs):
+        """Calls `name` (a method or an attribute) on every sub-environment; a tuple."""
+        self._check_open()
+        out = []
+        for env in self.envs:
+            attr = getattr(env, name)
+            out.append(attr(*args, **kwargs) if callable(attr) else attr)
+        return tuple(out)
+
+    def get_attr(self, name):
+        return tuple(getattr(env, name) for env in self.envs)
+
+    def render(self):
+        return None
+
+    @property
+    def closed(self):
+        return not self.envs
+
+    @property
+    def unwrapped(self):
+        return self
+
+    def __len__(self):
+        return self.num_envs
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - nothing to do about it at collection
+            pass
+
+    def __repr__(self):
+        return "VectorDrivingEnv(num_envs=%d, autoreset_mode=%r)" % (self.num_envs,
+                                                                     self.autoreset_mode)
+
+    # --- the rest --------------------------------------------------------------------------
+    def _step_job(self, env, action):
+        same_step = self.autoreset_mode == "same_step"
+
+        def job():
+            out = ("step",) + tuple(env.step(action))
+            if same_step and (out[3] or out[4]):
+                out += tuple(env.reset())
+            return out
+        return job
+
+    def _check_open(self):
+        if not self.envs:
+            raise RuntimeError("VectorDrivingEnv is closed; make a new one")
+
+    def _check_actions(self, actions):
+        try:
+            a = np.asarray(actions, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError("actions %r are not a [%d, %d] array of numbers"
+                             % (actions, self.num_envs, self.single_action_space.shape[0])) \
+                from None
+        if a.shape != (self.num_envs,) + tuple(self.single_action_space.shape):
+            raise ValueError("actions have shape %s, expected %s (num_envs, action)"
+                             % (a.shape, (self.num_envs,) + tuple(self.single_action_space.shape)))
+        for i, env in enumerate(self.envs):
+            if self._autoreset[i]:
+                continue  # this env resets instead of stepping: its action is ignored
+            check = getattr(env, "_check_action", None)
+            if check is None:
+                continue
+            try:
+                check(a[i])
+            except ValueError as e:
+                raise ValueError("env %d: %s" % (i, e)) from None
+        return a
+
+    def _run(self, jobs):
+        """Runs {index: callable} concurrently; returns {index: result}. If any fails, closes
+        everything and raises the first failure (lowest index) as SubEnvError."""
+        with self._lock:
+            futures = {i: self._pool.submit(job) for i, job in jobs.items()}
+            results, errors = {}, []
+            for i, f in futures.items():
+                try:
+                    results[i] = f.result()
+                except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
+                    errors.append((i, e))
+        if errors:
+            try:
+                self.close()
+            finally:
+                i, e = errors[0]
+                if isinstance(e, KeyboardInterrupt):
+                    raise e
+                raise SubEnvError(i, e) from e
+        return results
+
+
+def _batch_box(space, n):
+    return spaces.Box(low=np.stack([space.low] * n), high=np.stack([space.high] * n),
+                      dtype=space.dtype)
+
+
+def _add_info(infos, info, i, n):
+    """gymnasium's vector info layout: infos[k][i] = info[k], infos["_k"][i] = True."""
+    for key, value in info.items():
+        if isinstance(value, dict):
+            sub = infos.get(key)
+            if not isinstance(sub, dict):
+                sub = infos[key] = {}
+            _add_info(sub, value, i, n)
+        else:
+            array = infos.get(key)
+            if array is None:
+                if isinstance(value, (bool, np.bool_)):
+                    array = np.zeros(n, dtype=bool)
+                elif isinstance(value, (int, np.integer)):
+                    array = np.zeros(n, dtype=np.int64)
+                elif isinstance(value, (float, np.floating)):
+                    array = np.zeros(n, dtype=np.float64)
+                else:
+                    array = np.full(n, None, dtype=object)
+                infos[key] = array
+            if array.dtype != object:
+                kind = np.asarray(value).dtype.kind if np.isscalar(value) else "O"
+                if kind not in "biuf" or "biuf".index(kind) > "biuf".index(array.dtype.kind):
+                    # another type than the first env's: widen (never truncate)
+                    array = infos[key] = array.astype(object if kind not in "biuf"
+                                                      else np.float64 if kind == "f"
+                                                      else np.int64)
+            array[i] = value
+        mask = infos.setdefault("_" + key, np.zeros(n, dtype=bool))
+        mask[i] = True
