@@ -25,6 +25,7 @@ import socket
 import numpy as np
 
 from convoy_gym import spaces
+from convoy_gym.closing import ClosesOnExit
 from convoy_gym.world_variant import variant_config
 from nrp_client import NrpCore
 
@@ -59,7 +60,7 @@ def _free_address():
         return "127.0.0.1:%d" % s.getsockname()[1]
 
 
-class DrivingEnv:
+class DrivingEnv(ClosesOnExit):
     """The gymnasium API (reset, step, close, observation_space, action_space) over one
     NRPCoreSim server process, started by the constructor and stopped by close().
 
@@ -187,18 +188,6 @@ class DrivingEnv:
     @property
     def unwrapped(self):
         return self
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # noqa: BLE001 - nothing to do about it at collection
-            pass
 
     # --- the rest --------------------------------------------------------------------------
     def _check_open(self):

@@ -40,6 +40,7 @@ import threading
 import numpy as np
 
 from convoy_gym import spaces
+from convoy_gym.closing import ClosesOnExit
 from convoy_gym.driving_env import DrivingEnv
 
 __all__ = ["VectorDrivingEnv", "AUTORESET_MODES"]
@@ -56,7 +57,7 @@ class SubEnvError(RuntimeError):
         self.error = error
 
 
-class VectorDrivingEnv:
+class VectorDrivingEnv(ClosesOnExit):
     """num_envs DrivingEnv(**env_kwargs), each its own NRPCoreSim, stepped concurrently.
 
     The gymnasium vector API: reset(seed=None, options=None) -> (obs [num_envs, 16], infos),
@@ -225,18 +226,6 @@ class VectorDrivingEnv:
 
     def __len__(self):
         return self.num_envs
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # noqa: BLE001 - nothing to do about it at collection
-            pass
 
     def __repr__(self):
         return "VectorDrivingEnv(num_envs=%d, autoreset_mode=%r)" % (self.num_envs,
