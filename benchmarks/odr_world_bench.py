@@ -5,7 +5,7 @@
         [--render] [--frames MAP] [--build build] [--json out.json]
 
 Generates each map's world from an empty folder (default: esmini's 20 maps in
-tests/opendrive/data/esmini) and prints one line per map, `MAP: generated in S s, N
+tests/data/esmini/xodr) and prints one line per map, `MAP: generated in S s, N
 triangles`, then `worlds generated: N/M, median S s, max S s`. With --render, each world is
 also loaded, rendered and driven: benchmarks/worlds/<map>.xosc runs to its end (20 s) on the
 generated world (`convoy run --scenario`: the report's smart car with its camera and detector
@@ -32,7 +32,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
-MAPS = os.path.join(REPO, "tests", "opendrive", "data", "esmini")
+MAPS = os.path.join(REPO, "tests", "data", "esmini", "xodr")
 
 
 def generate(odr, xodr, out, scenery, seed):
@@ -75,7 +75,7 @@ def ego_start(odr, scenario):
     text = open(scenario).read()
     m = re.search(r'LanePosition roadId="([^"]+)" laneId="([^"]+)" s="\$EgoS"', text)
     s = float(re.search(r'name="EgoS" parameterType="double" value="([^"]+)"', text).group(1))
-    xodr = os.path.join(REPO, "tests", "opendrive", "data", "esmini",
+    xodr = os.path.join(REPO, "tests", "data", "esmini",
                         re.search(r'esmini/([^"]+\.xodr)', text).group(1))
     q = json.dumps({"op": "pose", "road": m.group(1), "lane": int(m.group(2)), "s": s})
     r = json.loads(subprocess.run([odr, "query", xodr], input=q + "\n", capture_output=True,

@@ -29,18 +29,24 @@ def params(p):
     return "\n".join(out)
 
 
-def vehicle(name, entry, assign=None):
+# Road users other than the ego are Convoy's agents (vehicle_agent, pedestrian_agent): their
+# own AI drives them between the scenario's actions (docs/scenarios.md, "Controllers")
+AGENT = ('      <ObjectController><Controller name="convoy.agent"><Properties/></Controller>'
+         '</ObjectController>\n')
+
+
+def vehicle(name, entry, assign=None, agent=True):
     a = ""
     if assign:
         a = "\n        <ParameterAssignments>%s</ParameterAssignments>\n      " % "".join(
             '<ParameterAssignment parameterRef="%s" value="%s"/>' % kv for kv in assign.items())
     return ('    <ScenarioObject name="%s">\n      <CatalogReference catalogName="SuiteVehicles" entryName="%s">%s'
-            '</CatalogReference>\n    </ScenarioObject>' % (name, entry, a))
+            '</CatalogReference>\n%s    </ScenarioObject>' % (name, entry, a, AGENT if agent else ""))
 
 
 def pedestrian(name, entry):
     return ('    <ScenarioObject name="%s">\n      <CatalogReference catalogName="SuitePedestrians" entryName="%s"/>\n'
-            '    </ScenarioObject>' % (name, entry))
+            '%s    </ScenarioObject>' % (name, entry, AGENT))
 
 
 def lane_pos(road, lane, s, offset="0"):
@@ -240,7 +246,7 @@ def scenario(description, p, entities, init, groups, xodr=CITY):
 
 # --- the scenarios --------------------------------------------------------------------------------
 
-EGO = vehicle("Ego", "smart_car")
+EGO = vehicle("Ego", "smart_car", agent=False)
 
 
 def ego_init(s="$EgoS", lane="-1", road="1"):

@@ -23,7 +23,7 @@ import xml.etree.ElementTree as ET
 from make_map_scenarios import story_end
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ESMINI = "../../tests/opendrive/data/esmini/"
+ESMINI = "../../tests/data/esmini/xodr/"
 # map -> (LogicFile relative to this folder, road, ego lane, oncoming lane, sidewalks (right,
 # left), ego's s)
 MAPS = {

@@ -12,7 +12,8 @@ Sections, from results.collect's records:
    own summary.json counts (collisions, red_light_violations) per run, so labelled.
 4. DS spread across seeds: per scenario and weather, the mean, min, max and population
    standard deviation of DS over the seeds.
-5. A table per scenario: one row per task (seed, weather, DS, RC, penalty, infractions,
+5. A table per scenario (under its scenario file, and a distribution variant's parameters):
+   one row per task (seed, weather, DS, RC, penalty, infractions,
    collisions, red-light violations, min TTC, detector mAP@0.5, simulated s, exit code,
    attempts, wall s).
 6. Failed tasks: exit code, reason, log path and the last LOG_TAIL_LINES lines of its log.
@@ -28,7 +29,7 @@ import math
 import os
 import urllib.parse
 
-from .results import INFRACTION_KINDS, infraction_counts
+from .results import INFRACTION_KINDS, infraction_counts, parameters_label
 
 LOG_TAIL_LINES = 40
 CSS = """
@@ -220,7 +221,8 @@ def render(records, plan, scorer_missing=None):
     # 5. per scenario
     for name, rs in by_scenario.items():
         out.append('<h2 id="%s">%s</h2>' % (_e(name), _e(name)))
-        out.append('<p class="note">%s</p>' % _e(rs[0]["config"]))
+        params = parameters_label(rs[0].get("parameters"))
+        out.append('<p class="note">%s%s</p>' % (_e(rs[0]["config"]), " with %s" % _e(params) if params else ""))
         out.append("<table><tr><th>seed</th><th>weather</th><th>DS</th><th>RC</th><th>penalty</th>"
                    "<th>infractions</th><th>collisions</th><th>red lights</th><th>min TTC s</th>"
                    "<th>mAP@0.5</th><th>sim s</th><th>exit</th><th>attempts</th><th>wall s</th>%s"

@@ -13,8 +13,9 @@ Per task (collect):
   the ego's tracks.jsonl).
 
 leaderboard.csv: one row per task, sorted by (scenario, seed, weather); columns COLUMNS:
-scenario, seed, weather, driving_score, route_completion, infraction_penalty (empty without a
-score), one count per infraction kind of INFRACTION_KINDS (the score's infractions with
+scenario, seed, weather, parameters (a parameter distribution variant's values,
+`name=value;...` in the distribution's order; empty for other entries), driving_score,
+route_completion, infraction_penalty (empty without a score), one count per infraction kind of INFRACTION_KINDS (the score's infractions with
 "counted" not false; empty without a score), exit_code (empty when unknown), wall_s (3
 decimals; empty when unknown). Numbers are written as Python's repr of the float, so the file
 is the same byte for byte for the same runs, apart from wall_s.
@@ -30,7 +31,7 @@ INFRACTION_KINDS = ("collision_pedestrian", "collision_vehicle", "collision_stat
                     "stop_sign", "scenario_timeout", "yield_emergency", "min_speed", "off_route",
                     "off_road", "wrong_way", "agent_blocked")
 SCORE_COLUMNS = ("driving_score", "route_completion", "infraction_penalty")
-COLUMNS = ("scenario", "seed", "weather") + SCORE_COLUMNS + INFRACTION_KINDS + ("exit_code", "wall_s")
+COLUMNS = ("scenario", "seed", "weather", "parameters") + SCORE_COLUMNS + INFRACTION_KINDS + ("exit_code", "wall_s")
 
 
 def load_scorer():
@@ -67,7 +68,7 @@ def collect(plan, state, scorer=None, scorer_missing=None):
     records = []
     for task, st in zip(plan["tasks"], state.tasks):
         rec = {"name": task["name"], "scenario": task["scenario"], "seed": task["seed"],
-               "weather": task["weather"], "config": task["config"], "run_dir": task["run_dir"],
+               "weather": task["weather"], "parameters": task.get("parameters") or {}, "config": task["config"], "run_dir": task["run_dir"],
                "state": st["state"], "exit_code": st["exit_code"], "wall_s": st["wall_s"],
                "attempts": st["attempts"], "log": st["log"], "reason": st["reason"],
                "summary": _read_json(os.path.join(task["run_dir"], "summary.json")),
@@ -90,6 +91,14 @@ def collect(plan, state, scorer=None, scorer_missing=None):
     return records
 
 
+def parameters_label(parameters):
+    """`name=value;...` of a variant's parameters (numbers as %.10g), None without any."""
+    if not parameters:
+        return None
+    return ";".join("%s=%s" % (k, "%.10g" % v if isinstance(v, float) else v)
+                    for k, v in parameters.items())
+
+
 def _cell(v):
     if v is None:
         return ""
@@ -101,7 +110,8 @@ def _cell(v):
 def leaderboard_rows(records):
     rows = []
     for r in records:
-        row = {"scenario": r["scenario"], "seed": r["seed"], "weather": r["weather"]}
+        row = {"scenario": r["scenario"], "seed": r["seed"], "weather": r["weather"],
+               "parameters": parameters_label(r.get("parameters"))}
         score = r["score"]
         for k in SCORE_COLUMNS:
             v = score.get(k) if score else None

@@ -33,7 +33,9 @@ weather holds for the whole run. If the config gives the sun as SunAltitude / Su
 weather's TimeOfDay is given as those two angles instead (the weather engine takes one or the
 other), computed as the engine does (sun_angles). A config without an engine named "weather"
 is bad input. Another entry type (OpenSCENARIO ".xosc") registers its suffix with
-register_entry_type.
+register_entry_type. An entry expander (register_entry_expander) may replace an entry by
+several: an OpenSCENARIO parameter distribution becomes one entry per variant
+(convoy_scenario/distribution_entry.py), each with its "parameters".
 
 Errors (bad input) raise SuiteError with a message naming the file or option.
 """
@@ -162,6 +164,7 @@ def load_suite(suite_dir):
         if not entries:
             raise SuiteError("suite folder %s holds no run definitions (a suite.json, or "
                              "simulation configs *.json)" % suite_dir)
+    entries = _expand(entries)
     seen = {}
     for e in entries:
         if not isinstance(e["name"], str) or not NAME_RE.match(e["name"]):
@@ -178,6 +181,17 @@ def load_suite(suite_dir):
 
 def _suffix(path):
     return os.path.splitext(path)[1].lower()
+
+
+def _expand(entries):
+    """Each entry, or in its place the entries an expander of its type makes of it (a
+    parameter distribution's variants), in order."""
+    out = []
+    for e in entries:
+        expander = ENTRY_EXPANDERS.get(e["type"])
+        more = expander(e) if expander is not None else None
+        out += [e] if more is None else more
+    return out
 
 
 # --- entry types ------------------------------------------------------------------------------
@@ -222,12 +236,22 @@ def config_command(entry, seed, weather, options):
 
 
 ENTRY_TYPES = {".json": config_command}
+ENTRY_EXPANDERS = {}
 
 
 def register_entry_type(suffix, command):
     """Adds an entry type: `command(entry, seed, weather, options)` returns the argv of the
     task's run (options: "convoy", "run_dir", "seconds"), raising SuiteError for bad input."""
     ENTRY_TYPES[suffix.lower()] = command
+
+
+def register_entry_expander(suffix, expand):
+    """Adds an expander for entries of type `suffix`: `expand(entry)` returns None (the entry
+    stays as it is) or the list of entries to run in its place, each with "name", "config",
+    "overrides", "type", "source" and optionally "parameters" ({name: value}, shown in the
+    leaderboard); SuiteError for bad input. The parameter distributions of
+    convoy_scenario.distribution_entry expand so."""
+    ENTRY_EXPANDERS[suffix.lower()] = expand
 
 
 # --- the plan ---------------------------------------------------------------------------------
@@ -239,7 +263,7 @@ def task_name(scenario, seed, weather):
 def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=False):
     """The campaign's plan: {"version", "out", "convoy", "seconds", "seeds", "weathers",
     "record", "tasks": [{"index", "name", "scenario", "seed", "weather", "config", "run_dir",
-    "argv"}]}. With `record` each run also writes RUN_DIR/recording.mcap (`convoy run
+    "argv", ["parameters"]}]} ("parameters": a distribution variant's, when it has any). With `record` each run also writes RUN_DIR/recording.mcap (`convoy run
     --record`), which report.html links to the dashboard."""
     out_dir = os.path.abspath(out_dir)
     tasks = []
@@ -251,9 +275,12 @@ def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=Fa
                 argv = ENTRY_TYPES[e["type"]](e, seed, weather, {
                     "convoy": convoy, "run_dir": run_dir, "seconds": seconds})
                 if record:
-                    argv.insert(2, "--record")  # after `convoy run`
-                tasks.append({"index": len(tasks), "name": name, "scenario": e["name"],
-                              "seed": seed, "weather": weather, "config": e["config"],
-                              "run_dir": run_dir, "argv": argv})
+                    argv.insert(argv.index("run") + 1, "--record")  # after `convoy run`
+                task = {"index": len(tasks), "name": name, "scenario": e["name"],
+                        "seed": seed, "weather": weather, "config": e["config"],
+                        "run_dir": run_dir, "argv": argv}
+                if e.get("parameters"):
+                    task["parameters"] = dict(e["parameters"])
+                tasks.append(task)
     return {"version": 1, "out": out_dir, "convoy": convoy, "seconds": seconds, "seeds": seeds,
             "weathers": list(weathers), "record": bool(record), "tasks": tasks}

@@ -114,9 +114,19 @@ class SpeedRun(ActionRun):
     def _target(self, env):
         tgt = self.spec.target
         if isinstance(tgt, m.AbsoluteTargetSpeed):
-            return tgt.value
-        ref = env.body(tgt.entity, self).speed
-        return ref + tgt.value if tgt.value_type == "delta" else ref * tgt.value
+            v = tgt.value
+        else:
+            ref = env.body(tgt.entity, self).speed
+            v = ref + tgt.value if tgt.value_type == "delta" else ref * tgt.value
+        return max(-self._max_speed(env), min(self._max_speed(env), v))
+
+    def _max_speed(self, env):
+        """The actor's Performance maxSpeed (the target is capped there, as in esmini)."""
+        try:
+            perf = env.scenario.entity(self.actor).object.performance
+        except (AttributeError, KeyError):
+            return float("inf")
+        return perf.max_speed if perf is not None and perf.max_speed else float("inf")
 
     def start(self, env):
         self.v0 = env.body(self.actor, self).speed
@@ -244,11 +254,49 @@ class TrajectoryRun(ActionRun):
                 t >= ts[-1] - TIME_EPS)
 
 
+PLAYER_LONGITUDINAL = (m.LongitudinalDistanceAction, m.SynchronizeAction, m.SpeedProfileAction)
+PLAYER_LATERAL = (m.LaneOffsetAction, m.LateralDistanceAction)
+
+
+class MoveRun(ActionRun):
+    """An action the player (player.py) carries out on an entity it moves: it runs until the
+    player lists it in the actor's state as `finished`. On an entity the player does not move
+    (a road-user engine's), it ends at once."""
+
+    def start(self, env):
+        spec = self.spec
+        if isinstance(spec, PLAYER_LONGITUDINAL):
+            self.domains = frozenset(("longitudinal",))
+        elif isinstance(spec, PLAYER_LATERAL):
+            self.domains = frozenset(("lateral",))
+        else:
+            timed = getattr(spec, "timing", None) is not None
+            self.domains = frozenset(("longitudinal", "lateral") if timed else ("lateral",))
+
+    def update(self, t, env):
+        state = (getattr(env, "world", None) or {}).get(self.actor) or {}
+        if "finished" not in state:
+            return {}, True
+        return {}, self.name in state["finished"]
+
+
+def _played(env, actor):
+    world = getattr(env, "world", None) or {}
+    return actor is not None and "finished" in (world.get(actor) or {})
+
+
 def make_run(name, spec, actor, t0, env, where=""):
     if isinstance(spec, m.SpeedAction):
         cls = SpeedRun
     elif isinstance(spec, m.LaneChangeAction):
         cls = LaneChangeRun
+    elif isinstance(spec, PLAYER_LONGITUDINAL + PLAYER_LATERAL) or (
+            isinstance(spec, m.FollowTrajectoryAction) and _played(env, actor)):
+        cls = MoveRun
+    elif isinstance(spec, m.FollowTrajectoryAction) and (
+            not spec.vertices or spec.closed or
+            not all(isinstance(v.position, m.WorldPosition) for v in spec.vertices)):
+        cls = InstantRun   # issue 25: other shapes and positions wait for their run
     elif isinstance(spec, m.FollowTrajectoryAction):
         cls = TrajectoryRun
     else:

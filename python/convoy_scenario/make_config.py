@@ -5,10 +5,13 @@ runs; docs/scenarios.md, "Running a scenario"):
 - the world engine on the world of the scenario's RoadNetwork LogicFile (MAPS below; for any
   other map a world generated from it, cached: worlds.py; --world FILE.sdf overrides), the ego
   (the report's smart car with its camera) inserted at its Init teleport;
-- one vehicle_agent per other Vehicle entity and one pedestrian_agent per Pedestrian entity,
-  started at their Init teleports (StartPose) with their Init AbsoluteTargetSpeed
-  (InitialSpeed, and a vehicle's desired speed v0 when its own AI drives it), sized from their BoundingBox, their model from the catalog entry or the
-  vehicle's name when the actor-model table has it, else from the category;
+- every other entity moved exactly by the scenario engine (its default controller: the
+  player, player.py), except those with a driver-model or `convoy.*` controller, or `convoy.*`
+  Properties (controllers.py): one vehicle_agent per such Vehicle and one pedestrian_agent per
+  such Pedestrian, started at their Init teleports (StartPose) with their Init
+  AbsoluteTargetSpeed (InitialSpeed, and a vehicle's desired speed v0 when its own AI drives
+  it), sized from their BoundingBox, their model from the catalog entry or the vehicle's name
+  when the actor-model table has it, else from the category;
 - the weather engine with the Init EnvironmentActions; the traffic_lights engine when the map
   has traffic lights;
 - the scenario engine (engines/scenario) driving the entities, and the ego: the report's PID
@@ -49,7 +52,13 @@ if PYTHON not in sys.path:
 
 from convoy_scenario import ScenarioError, load, weather_config  # noqa: E402
 from convoy_scenario import model as m  # noqa: E402
-from convoy_scenario.odr import OdrQuery, world_pose  # noqa: E402
+from convoy_scenario.config_exact import build_exact  # noqa: E402
+from convoy_scenario.controllers import agent_keys, controller_of  # noqa: E402
+from convoy_scenario.controllers import kind as controller_kind  # noqa: E402
+from convoy_scenario.odr import OdrQuery  # noqa: E402
+from convoy_scenario.parsed import save_parsed  # noqa: E402
+from convoy_scenario.player import Player  # noqa: E402
+from convoy_scenario.roads import RoadMap  # noqa: E402
 from convoy_scenario.worlds import generated_world  # noqa: E402
 
 CITY = os.path.join(REPO, "experiments", "city_traffic")
@@ -96,15 +105,19 @@ def engine_name(entity):
 
 
 def stop_time(scenario):
-    """The smallest SimulationTimeCondition value of the storyboard's StopTrigger, or None."""
+    """The earliest time the storyboard's StopTrigger fires by a ConditionGroup that is one
+    SimulationTimeCondition (value + delay), or None."""
     best = None
     if scenario.stop_trigger is None:
         return None
     for group in scenario.stop_trigger.groups:
-        for c in group:
-            if isinstance(c.test, m.SimulationTimeCondition):
-                v = c.test.value + c.delay
-                best = v if best is None else min(best, v)
+        if len(group) != 1:
+            continue   # ANDed with another condition: no bound on its own
+        c = group[0]
+        if isinstance(c.test, m.SimulationTimeCondition) and c.test.rule in (
+                "greaterThan", "greaterOrEqual", "equalTo"):
+            v = c.test.value + c.delay
+            best = v if best is None else min(best, v)
     return best
 
 
@@ -112,18 +125,17 @@ def init_actions(scenario, entity):
     return [a for a in scenario.init if a.entity == entity]
 
 
-def init_pose(scenario, entity, odr):
-    for a in init_actions(scenario, entity):
-        if isinstance(a.spec, m.TeleportAction):
-            return world_pose(odr, a.spec.position.as_dict())
-    return None
+def init_pose(scenario, entity, player):
+    """(x, y, yaw) where the entity starts (its Init actions applied by the player), or None
+    when no Init action places it."""
+    st = player.states[entity]
+    return (st.x, st.y, st.h) if st.placed else None
 
 
-def init_speed(scenario, entity):
-    for a in init_actions(scenario, entity):
-        if isinstance(a.spec, m.SpeedAction) and isinstance(a.spec.target, m.AbsoluteTargetSpeed):
-            return float(a.spec.target.value)
-    return 0.0
+def pose_of(player, position):
+    """(x, y, yaw) of a model position (any kind) now."""
+    x, y, _, h = player.world_pose_of(position)
+    return x, y, (h if h is not None else 0.0)
 
 
 def ego_route_action(scenario, ego):
@@ -180,18 +192,43 @@ def lane_of(odr, x, y, yaw, what, types=("driving",)):
     return loc
 
 
-def route_points(odr, spec, start):
+def route_points(odr, spec, start, player):
     """Points of an AssignRouteAction from the ego's start through its waypoints."""
     pts, prev = [], start
     for w in spec.waypoints:
-        x, y, yaw = world_pose(odr, w.position.as_dict())
+        x, y, yaw = pose_of(player, w.position)
         loc = lane_of(odr, x, y, yaw, "a route waypoint")
         if (loc["road"], loc["lane"]) == tuple(prev[:2]) and abs(loc["s"] - prev[2]) < 1.0:
             continue  # the start itself (a route's first waypoint usually is)
-        r = odr.route(prev, (loc["road"], loc["lane"], loc["s"]))
+        try:
+            r, to = lane_route(odr, player.roads, prev, (loc["road"], loc["lane"], loc["s"]))
+        except ScenarioError:
+            if pts:
+                raise
+            continue   # a waypoint behind where the ego starts on its route
         pts += r["points"] if not pts else r["points"][1:]
-        prev = (loc["road"], loc["lane"], loc["s"])
+        prev = to
     return pts, prev
+
+
+def lane_route(odr, roads, frm, to):
+    """(route, end) from a lane position to a waypoint: to its lane, else (a route goes by
+    roads, as esmini's) to another lane of its road at its s driven the same way."""
+    try:
+        return odr.route(frm, to), to
+    except ScenarioError as first:
+        forward = roads.lane_info(to[0], to[1], to[2])["forward"]
+        for lane in sorted(roads.lanes_at(to[0], to[2]), key=lambda ln: abs(ln - to[1])):
+            if lane == to[1] or lane == 0:
+                continue
+            info = roads.lane_info(to[0], lane, to[2])
+            if info["type"] != "driving" or info["forward"] != forward:
+                continue
+            try:
+                return odr.route(frm, (to[0], lane, to[2])), (to[0], lane, to[2])
+            except ScenarioError:
+                continue
+        raise first
 
 
 def polyline_length(points):
@@ -260,6 +297,8 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     """(config dict, ego route points [[x, y, heading]], scored route length)."""
     scenario = load(xosc, parameters=parameters or None)
     base = os.path.basename(xosc)
+    if ego_fragment == "scenario":
+        return build_exact(scenario, xosc, parameters, stop_time)
     if not scenario.logic_file:
         raise ScenarioError("%s: no RoadNetwork LogicFile: a scenario needs an OpenDRIVE map" % base)
     world_sdf = os.path.abspath(world) if world else world_for(scenario.logic_file)
@@ -278,7 +317,8 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     xodr = scenario.logic_file
     with OdrQuery(xodr, bin_dir) as odr:
         has_lights = bool(odr.info()["signals"])
-        ego_pose = init_pose(scenario, ego, odr)
+        player = Player(scenario, RoadMap(xodr), [e.name for e in scenario.entities])
+        ego_pose = init_pose(scenario, ego, player)
         if ego_pose is None:
             raise ScenarioError("%s: the ego %r has no Init TeleportAction (where does it start?)" % (base, ego))
         start = lane_of(odr, *ego_pose, "the ego's Init position")
@@ -286,7 +326,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         length = route_length(scenario)
         spec = ego_route_action(scenario, ego)
         if spec is not None:
-            pts, last = route_points(odr, spec, (start["road"], start["lane"], start["s"]))
+            pts, last = route_points(odr, spec, (start["road"], start["lane"], start["s"]), player)
             ext = odr.follow(last[0], last[1], last[2], ROUTE_EXTRA_M)["points"]
             scored_len = polyline_length(pts)
             drive = pts + ext[1:]
@@ -300,7 +340,11 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         for i, ent in enumerate(scenario.entities):
             if ent.name == ego:
                 continue
-            pose = init_pose(scenario, ent.name, odr)
+            ctl = controller_of(scenario, ent.name)
+            if controller_kind(ctl) != "driver" and not properties(ent.object):
+                entity_map[ent.name] = "scenario"   # the default controller: exact control
+                continue
+            pose = init_pose(scenario, ent.name, player)
             if pose is None:
                 raise ScenarioError("%s: entity %r has no Init TeleportAction" % (base, ent.name))
             name = engine_name(ent.name)
@@ -312,7 +356,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                 onward = odr.follow(loc["road"], loc["lane"], loc["s"], 400.0)["lanes"][-1]
                 for ia in init_actions(scenario, ent.name):
                     if isinstance(ia.spec, m.AssignRouteAction):  # routed to its last waypoint
-                        last = lane_of(odr, *world_pose(odr, ia.spec.waypoints[-1].position.as_dict()),
+                        last = lane_of(odr, *pose_of(player, ia.spec.waypoints[-1].position),
                                        "entity %r's route's last waypoint" % ent.name)
                         onward = [last["road"], last["lane"]]
                 wheelbase = None
@@ -322,7 +366,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                 a = {"EngineType": "vehicle_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
                      "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
                      "Route": {"to": "%s:%d" % (onward[0], onward[1])},
-                     "InitialSpeed": init_speed(scenario, ent.name), "Model": vehicle_model(ent, cat, models),
+                     "InitialSpeed": player.states[ent.name].speed, "Model": vehicle_model(ent, cat, models),
                      "Category": cat, "Length": bb.length, "Width": bb.width, "Height": bb.height,
                      "LaneChanges": False, "Seed": i}
                 if not (wheelbase and 0 < wheelbase < bb.length) and bb.length <= 2.7:
@@ -341,9 +385,11 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                      "Route": {"to": "%s:%d" % (loc["road"], loc["lane"]), "to_s": to_s},
                      "Seed": 100 + i, "Length": max(bb.length, 0.3), "Width": max(bb.width, 0.3),
                      "Height": bb.height}
-                speed = init_speed(scenario, ent.name)
+                speed = player.states[ent.name].speed
                 if speed > 0:
                     a["Speed"], a["SpeedSd"] = speed, 0.0
+            if ctl is not None:
+                a.update(agent_keys(ctl))
             a.update(properties(ent.object))
             agents.append(a)
 
@@ -401,6 +447,12 @@ def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapsh
     out_dir = os.path.dirname(os.path.abspath(out))
     os.makedirs(out_dir, exist_ok=True)
     config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots, scenery)
+    # the scenario as read here, handed to the scenario engine (read once: parsed.py)
+    parsed = os.path.join(out_dir, "scenario.parsed")
+    save_parsed(load(xosc, parameters=parameters or None), xosc, parameters, parsed)
+    for e in config["EngineConfigs"]:
+        if e.get("EngineType") == "scenario":
+            e["ParsedScenario"] = parsed
     with open(os.path.join(out_dir, "ego_route.csv"), "w") as f:
         f.write("x,y,heading\n")
         for x, y, h in drive:
@@ -429,7 +481,8 @@ def main(argv=None):
                     "else one generated from the map (cached)")
     ap.add_argument("--scenery", default="auto", choices=["auto", "none", "roadside", "urban"],
                     help="the scenery of a generated world (auto: urban where the map has sidewalks)")
-    ap.add_argument("--ego", help="a config fragment {EngineConfigs, DataPackProcessingFunctions, EgoState}: the user's ego")
+    ap.add_argument("--ego", help="a config fragment {EngineConfigs, DataPackProcessingFunctions, EgoState}: the user's ego; "
+                    "'scenario': the scenario moves the ego too (config_exact.py)")
     ap.add_argument("--param", action="append", type=_param, default=[], help="NAME=VALUE: a scenario parameter")
     ap.add_argument("--bin-dir", help="where convoy-odr is")
     ap.add_argument("--snapshots", help="T1,T2,...: save the ego camera's frame at these simulated "

@@ -7,36 +7,13 @@ from dataclasses import dataclass, field
 from typing import Optional, Tuple
 
 
-# --- positions -----------------------------------------------------------------------------
+# --- positions (model_positions) and the new actions and conditions (model_actions,
+# model_conditions) are part of this module's namespace -----------------------------------
 
-@dataclass(frozen=True)
-class WorldPosition:
-    x: float
-    y: float
-    z: float = 0.0
-    h: Optional[float] = None  # None: not given
-    p: float = 0.0
-    r: float = 0.0
+from .model_positions import *  # noqa: F401,F403,E402
+from .model_actions import *  # noqa: F401,F403,E402
+from .model_conditions import *  # noqa: F401,F403,E402
 
-    def as_dict(self):
-        return {"type": "world", "x": self.x, "y": self.y, "z": self.z,
-                "h": self.h, "p": self.p, "r": self.r}
-
-
-@dataclass(frozen=True)
-class LanePosition:
-    road_id: str
-    lane_id: str
-    s: float
-    offset: float = 0.0
-    orientation: Optional[Tuple[str, float, float, float]] = None  # (type, h, p, r)
-
-    def as_dict(self):
-        out = {"type": "lane", "road": self.road_id, "lane": self.lane_id, "s": self.s,
-               "offset": self.offset}
-        if self.orientation is not None:
-            out["orientation"] = dict(zip(("type", "h", "p", "r"), self.orientation))
-        return out
 
 
 # --- entities ------------------------------------------------------------------------------
@@ -65,6 +42,39 @@ class Vehicle:
     axles: Tuple[Tuple[str, Tuple[Tuple[str, float], ...]], ...] = ()
     properties: Tuple[Tuple[str, str], ...] = ()
     model3d: Optional[str] = None
+    mass: Optional[float] = None
+    role: Optional[str] = None                # 1.2: none, ambulance, police, ...
+    trailer_hitch: Optional[float] = None     # dx of the hitch from the reference point
+    trailer_coupler: Optional[float] = None   # dx of the coupler (a trailer)
+    trailer: Optional[object] = None          # Trailer: what is hitched at the start
+
+
+@dataclass(frozen=True)
+class Trailer:
+    """A Vehicle's Trailer: an entity by name (TrailerRef) or a vehicle of its own (read as
+    an entity named as the Vehicle, hitched to this one)."""
+    entity: Optional[str] = None
+    vehicle: Optional[Vehicle] = None
+
+
+@dataclass(frozen=True)
+class MiscObject:
+    name: str
+    category: str                             # obstacle, pole, tree, barrier, ...
+    mass: float
+    bounding_box: BoundingBox
+    properties: Tuple[Tuple[str, str], ...] = ()
+    model3d: Optional[str] = None
+
+
+@dataclass(frozen=True)
+class Controller:
+    """A controller (ObjectController, ControllerCatalog entry or AssignControllerAction):
+    its name, controllerType (1.2) and Properties; what it means is the player's."""
+    name: str
+    controller_type: Optional[str] = None     # movement, lateral, longitudinal, lighting, ...
+    properties: Tuple[Tuple[str, str], ...] = ()
+    catalog: Optional[object] = None          # CatalogSource
 
 
 @dataclass(frozen=True)
@@ -91,9 +101,10 @@ class CatalogSource:
 @dataclass(frozen=True)
 class Entity:
     name: str
-    kind: str                                 # "vehicle" or "pedestrian"
-    object: object                            # Vehicle or Pedestrian
+    kind: str                                 # "vehicle", "pedestrian" or "misc"
+    object: object                            # Vehicle, Pedestrian or MiscObject
     catalog: Optional[CatalogSource] = None
+    controllers: Tuple[Tuple[str, Controller], ...] = ()  # ObjectControllers (name, controller)
 
 
 # --- environment ---------------------------------------------------------------------------
@@ -184,15 +195,29 @@ class Waypoint:
 
 
 @dataclass(frozen=True)
+class Route:
+    name: str
+    closed: bool
+    waypoints: Tuple[Waypoint, ...]
+    catalog: Optional[CatalogSource] = None
+
+    def as_dict(self):
+        return {"name": self.name, "closed": self.closed,
+                "waypoints": [{"position": w.position.as_dict(),
+                               "route_strategy": w.route_strategy} for w in self.waypoints]}
+
+
+@dataclass(frozen=True)
 class AssignRouteAction:
     name: str
     closed: bool
     waypoints: Tuple[Waypoint, ...]
+    catalog: Optional[CatalogSource] = None   # the Route came from a RouteCatalog
 
 
 @dataclass(frozen=True)
 class Vertex:
-    position: WorldPosition
+    position: object                          # any position (WorldPosition in most files)
     time: Optional[float] = None
 
 
@@ -206,9 +231,13 @@ class Timing:
 @dataclass(frozen=True)
 class FollowTrajectoryAction:
     name: str
-    vertices: Tuple[Vertex, ...]
+    vertices: Tuple[Vertex, ...]              # a Polyline's; () for the other shapes
     timing: Optional[Timing]                  # None: TimeReference/None (times ignored)
     following_mode: str = "follow"            # position or follow
+    shape: object = None                      # Polyline, Clothoid, ClothoidSpline or Nurbs
+    closed: bool = False
+    initial_distance_offset: float = 0.0      # 1.2
+    catalog: Optional[CatalogSource] = None   # the Trajectory came from a TrajectoryCatalog
 
 
 @dataclass(frozen=True)
@@ -244,7 +273,8 @@ class RelativeDistanceCondition:
     freespace: bool
     distance_type: str                        # longitudinal, lateral, cartesianDistance, euclidianDistance
     rule: str
-    coordinate_system: str = "entity"         # entity or road
+    coordinate_system: str = "entity"         # entity, road, lane (as road), trajectory
+    along_route: bool = False                 # 1.0 alongRoute (read as coordinateSystem road)
 
 
 @dataclass(frozen=True)
@@ -254,37 +284,42 @@ class TimeHeadwayCondition:
     freespace: bool
     rule: str
     coordinate_system: str = "entity"
+    along_route: bool = False
 
 
 @dataclass(frozen=True)
 class TimeToCollisionCondition:
-    entity: str
+    entity: object                            # an entity's name, or a position
     value: float
     freespace: bool
     rule: str
     distance_type: str = "euclidianDistance"
     coordinate_system: str = "entity"
+    along_route: bool = False
 
 
 @dataclass(frozen=True)
 class ReachPositionCondition:
-    position: WorldPosition
+    position: object                          # any position (model_positions)
     tolerance: float
 
 
 @dataclass(frozen=True)
 class DistanceCondition:
-    position: WorldPosition
+    position: object
     value: float
     freespace: bool
     rule: str
     distance_type: str = "euclidianDistance"
+    coordinate_system: str = "entity"
+    along_route: bool = False
 
 
 @dataclass(frozen=True)
 class SpeedCondition:
     value: float
     rule: str
+    direction: Optional[str] = None           # 1.2: longitudinal, lateral, vertical
 
 
 @dataclass(frozen=True)
@@ -341,6 +376,7 @@ class ManeuverGroup:
     actors: Tuple[str, ...]
     maneuvers: Tuple[Maneuver, ...]
     where: str = ""
+    select_triggering_entities: bool = False  # actors += the Act's triggering entities
 
 
 @dataclass(frozen=True)
@@ -375,6 +411,8 @@ class FileHeader:
     date: str
     description: str
     author: str
+    license: Optional[Tuple[str, str, str, str]] = None  # (name, resource, spdxId, text)
+    properties: Tuple[Tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -389,6 +427,9 @@ class Scenario:
     stories: Tuple[Story, ...]
     stop_trigger: Optional[Trigger]
     catalog_dirs: Tuple[Tuple[str, str], ...] = field(default=())
+    variables: Tuple[Tuple[str, str, object], ...] = ()  # (name, type, initial value)
+    traffic_signal_controllers: Tuple[TrafficSignalController, ...] = ()
+    parameter_types: Tuple[Tuple[str, str], ...] = ()    # global parameters' types
 
     def entity(self, name):
         for e in self.entities:

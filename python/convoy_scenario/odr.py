@@ -1,16 +1,14 @@
-"""Lane lookups on an OpenDRIVE map through `convoy-odr query` (tools/opendrive): one child
-process per map, JSON requests and replies a line each. Used by the config generator
-(make_config.py) and the scenario engine (engine.py) to turn LanePositions into world poses,
-to find the lane a world point is on, and to follow a lane onward (the ego's default route).
+"""Lane lookups on an OpenDRIVE map: OdrQuery answers `convoy-odr query`'s ops (tools/opendrive,
+src/opendrive/query.h) in-process on a RoadMap (roads.py; it used to run the tool as a child
+process, and its replies are the same). Used by the config generator (make_config.py) and the
+scenario engine (engine_script.py) to turn LanePositions into world poses, to find the lane a
+world point is on, and to follow a lane onward (the ego's default route). find_odr finds the
+convoy-odr program for what still runs it (worlds.py)."""
 
-The child reads its requests from a pipe and exits when the pipe closes, so it never outlives
-its parent (a killed parent closes the pipe)."""
-
-import json
 import os
 import shutil
-import subprocess
 
+from .roads import RoadMap
 from .xmltree import ScenarioError
 
 
@@ -30,39 +28,32 @@ def find_odr(bin_dir=None):
 
 
 class OdrQuery:
+    """The query ops on one map; bin_dir (optional) is the Convoy build's bin directory (the
+    module is found in bin_dir/../python, see roads.py)."""
+
     def __init__(self, xodr, bin_dir=None):
         self.xodr = xodr
-        self.proc = subprocess.Popen([find_odr(bin_dir), "query", xodr], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                     bufsize=1)
+        self.map = RoadMap(xodr, bin_dir)
 
     def ask(self, **request):
-        try:
-            self.proc.stdin.write(json.dumps(request) + "\n")
-            self.proc.stdin.flush()
-            line = self.proc.stdout.readline()
-        except BrokenPipeError:
-            line = ""
-        if not line:
-            err = self.proc.stderr.read().strip() if self.proc.poll() is not None else ""
-            raise ScenarioError("%s: convoy-odr query failed%s" % (
-                os.path.basename(self.xodr), ": " + err if err else ""))
-        reply = json.loads(line)
-        if not reply.pop("ok"):
-            raise ScenarioError("%s: %s: %s" % (os.path.basename(self.xodr), request.get("op"),
-                                                reply["error"]))
-        return reply
+        """The reply to one request (dict with "op"); ScenarioError "file: op: error"."""
+        if self.map is None:
+            raise ScenarioError("%s: the map was closed" % os.path.basename(self.xodr))
+        return self.map.query(**request)
 
     def pose(self, road, lane, s, offset=0.0):
         """(x, y, heading in the lane's driving direction) of a lane position."""
-        r = self.ask(op="pose", road=str(road), lane=int(lane), s=float(s), offset=float(offset))
-        return r["x"], r["y"], r["heading"]
+        x, y, _, h, _ = self.map.lane_pose(str(road), int(lane), float(s), float(offset))
+        return x, y, h
 
     def locate(self, x, y, yaw=None, max_distance=5.0):
-        """The lane at (x, y): dict road, lane, s, t, road_t, heading, distance, type, junction;
-        None when no road is within max_distance."""
-        r = self.ask(op="locate", x=float(x), y=float(y), yaw=yaw, max_distance=max_distance)
-        return r if r.get("found") else None
+        """The lane at (x, y): dict found, road, lane, s, t, road_t, heading, z, distance, type,
+        junction; None when no road is within max_distance."""
+        r = self.map.locate(float(x), float(y), None if yaw is None else float(yaw),
+                            float(max_distance))
+        if r is not None:
+            r["found"] = True
+        return r
 
     def follow(self, road, lane, s, length, ds=2.0):
         return self.ask(op="follow", road=str(road), lane=int(lane), s=float(s),
@@ -76,15 +67,7 @@ class OdrQuery:
         return self.ask(op="info")
 
     def close(self):
-        if self.proc.poll() is None:
-            self.proc.stdin.close()
-            try:
-                self.proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        for f in (self.proc.stdout, self.proc.stderr):
-            f.close()
+        self.map = None
 
     def __enter__(self):
         return self

@@ -143,6 +143,28 @@ def _tokens(source):
     return out
 
 
+class _Text(str):
+    """Text in an expression: esmini joins words and numbers with + (``${Name + _ + $n}``),
+    which OpenSCENARIO's numeric expressions do not have; the result is a string. param:
+    the string parameter it came from, if any."""
+    param = None
+
+
+def _param_text(name, value):
+    t = _Text(value)
+    t.param = name
+    return t
+
+
+CONSTANTS = {"pi": math.pi}   # esmini's expressions know pi
+
+
+def _text(v):
+    if isinstance(v, _Text):
+        return str(v)
+    return str(int(v)) if float(v) == math.floor(v) and abs(v) < 1e15 else repr(v)
+
+
 def evaluate(source, scope):
     """The value (a float) of an OpenSCENARIO expression (without its ${ and })."""
     tokens = _tokens(source)
@@ -169,7 +191,12 @@ def evaluate(source, scope):
         while peek() in (("op", "+"), ("op", "-")):
             op = take()[1]
             rhs = term()
-            value = value + rhs if op == "+" else value - rhs
+            if isinstance(value, _Text) or isinstance(rhs, _Text):
+                if op != "+":
+                    fail("text can only be joined with +")
+                value = _Text(_text(value) + _text(rhs))
+            else:
+                value = value + rhs if op == "+" else value - rhs
         return value
 
     def term():
@@ -177,6 +204,10 @@ def evaluate(source, scope):
         while peek() in (("op", "*"), ("op", "/"), ("op", "%")):
             op = take()[1]
             rhs = unary()
+            for v in (value, rhs):
+                if isinstance(v, _Text):
+                    fail("$%s is a string parameter, not a number" % v.param if v.param
+                         else "%r needs numbers" % op)
             if op == "*":
                 value = value * rhs
             elif rhs == 0:
@@ -190,7 +221,10 @@ def evaluate(source, scope):
     def unary():
         if peek() == ("op", "-"):
             take()
-            return -unary()
+            operand = unary()
+            if isinstance(operand, _Text):
+                fail("'-' needs a number")
+            return -operand
         if peek() == ("op", "+"):
             take()
             return unary()
@@ -205,11 +239,20 @@ def evaluate(source, scope):
                 ptype, value = scope.lookup(val)
             except ParameterError as e:
                 fail(str(e))
+            if ptype == "string":
+                try:   # esmini: a string parameter holding a number is a number
+                    return float(value)
+                except ValueError:
+                    return _param_text(val, value)
             if ptype not in INT_TYPES and ptype != "double":
                 fail("$%s is a %s parameter, not a number" % (val, ptype))
             return float(value)
         if kind == "name":
             if val not in FUNCTIONS:
+                if val in CONSTANTS and peek() != ("op", "("):
+                    return CONSTANTS[val]
+                if peek() != ("op", "("):
+                    return _Text(val)   # a bare word: text (esmini's string expressions)
                 fail("unknown function %r (%s)" % (val, ", ".join(FUNCTIONS)))
             expect("(")
             args = [expr()]
@@ -240,6 +283,8 @@ def evaluate(source, scope):
     value = expr()
     if peek()[0] != "end":
         fail("unexpected %r" % (peek()[1],))
+    if isinstance(value, _Text):
+        return str(value)
     if not math.isfinite(value):
         fail("the value is not finite")
     return value

@@ -59,6 +59,8 @@ def setup(config):
     mapping = {}
     for ent in scenario.entities:
         spec = (scen.get("Entities") or {}).get(ent.name, ent.name)
+        if spec == "scenario":     # moved by the scenario engine itself
+            continue
         engine, dp = spec.split("/", 1) if "/" in spec else (spec, "state")
         if engine not in by_name:
             raise RuntimeError("scenario_tf.py: entity %r maps to engine %r, which the config "

@@ -16,8 +16,10 @@ Rules:
   with it; an Act when its StartTrigger is true (at once without one); a ManeuverGroup and a
   Maneuver when their parent runs; an Event when its StartTrigger is true (at once without
   one) while its Maneuver runs. A start resets the element's descendants to standby with
-  no executions. Events of priority overwrite (override) stop the running Events of their
-  Maneuver; skip does not start while one runs; parallel starts regardless.
+  no executions. Events of priority overwrite (override) end the running Events of their
+  Maneuver (endTransition, as esmini: back to standby while executions are left; their
+  actions end, their runs are stopped); skip does not start while one runs; parallel starts
+  regardless.
 - Goals: an Action ends when all its runs (one per actor) have reached their goal
   (convoy_scenario.actions); an Event when all its Actions are complete, and so on up to the
   storyboard. maximumExecutionCount (ManeuverGroup, Event) counts starts: an element that
@@ -28,11 +30,15 @@ Rules:
   while the Act is in standby or running.
 - A run on an actor stops the actor's runs of other actions sharing a control domain; an
   Action left without runs by such overrides takes the stopTransition.
-- Conditions are all evaluated at every step, in document order, before any state changes,
-  against the world at t and the storyboard as it was at the end of the previous step:
-  StoryboardElementStateCondition with a state is true while the element is in it, with a
-  transition when the element took it in the previous step (so a chain of elements moves
-  one step per link). Then the edge: none passes the value; rising is true when it is true
+- Conditions are evaluated as esmini does: a trigger when the storyboard reaches it in its
+  walk of the tree at each step (the storyboard's StopTrigger first, then each Act's
+  StopTrigger while it runs and StartTrigger while in standby, then its Events' StartTriggers
+  while their Maneuver runs), against the world at t and the states as they are at that point
+  of the walk: a StoryboardElementStateCondition sees every transition made since it was last
+  evaluated, this step's earlier ones included (so a chain of elements triggered by each
+  other's start moves within one step); with a state it is true when one of those changes
+  went to the state, else while the element is in it; with a transition, when one of those
+  changes was that transition. A condition is evaluated at most once a step. Then the edge: none passes the value; rising is true when it is true
   and was false at the previous step, falling the opposite, risingOrFalling on either; an
   edge is never detected at the first evaluation. Then the delay: each step whose edge
   output is true fires the condition once, at the first step with time >= its time +
@@ -46,9 +52,11 @@ import math
 from dataclasses import dataclass, field
 from typing import List, Optional
 
+from . import conditions as conds
+from .conditions_geometry import geometric_value
 from . import geometry as g
 from . import model as m
-from .actions import make_run
+from .actions import ActionRun, InstantRun, make_run
 from .xmltree import ScenarioError
 
 STANDBY, RUNNING, COMPLETE = "standbyState", "runningState", "completeState"
@@ -116,8 +124,27 @@ class _Element:
 class _Cond:
     def __init__(self, spec):
         self.spec = spec
+        self.seen = 0              # state conditions: changes of the log already seen
         self.previous = None
-        self.pending = []
+        self.pending = []          # (fire time, the entities that made it true)
+        self.entities = ()         # the entities that made it true at this step
+        self.fired_entities = ()
+
+
+_LEGACY_INSTANT = (m.TeleportAction, m.AssignRouteAction, m.EnvironmentAction)
+_ISSUE25_CONDITIONS = (m.TraveledDistanceCondition, m.EndOfRoadCondition, m.OffroadCondition,
+                       m.StandStillCondition, m.CollisionCondition, m.AccelerationCondition,
+                       m.RelativeSpeedCondition, m.RelativeClearanceCondition)
+
+
+class _DoneRun(ActionRun):
+    """An action that ends at once with no target from the executor: one the storyboard
+    executed itself (ParameterAction, VariableAction, traffic signal actions), or one whose
+    run the player has yet to give (controllers, appearance, trailers, traffic...). The
+    command still carries the spec."""
+
+    def update(self, t, env):
+        return {}, True
 
 
 class _Env:
@@ -163,12 +190,39 @@ class _Env:
         return value
 
 
+class _Outputs:
+    """The conditions' outputs at one step, each evaluated when first asked for."""
+
+    def __init__(self, board, t, env):
+        self.board, self.t, self.env = board, t, env
+        self.values = {}
+
+    def __getitem__(self, i):
+        if i not in self.values:
+            self.values[i] = self.board._evaluate(self.board.conditions[i], self.t, self.env)
+        return self.values[i]
+
+
 class Storyboard:
     """The mutable execution state of one scenario's storyboard (the Scenario is not
     changed)."""
 
-    def __init__(self, scenario):
+    def __init__(self, scenario, end_on_complete=True, resolve_position=None):
+        """end_on_complete False: the storyboard stays running when all its stories are
+        complete and ends by its StopTrigger only (as esmini plays it). resolve_position
+        (model position, world) -> (x, y): the player's resolver of road, lane and route
+        positions in conditions (the storyboard resolves world and entity-relative ones)."""
         self.scenario = scenario
+        self.end_on_complete = end_on_complete
+        self.resolve_position = resolve_position
+        self.parameters = dict(scenario.parameters)
+        self.variables = {name: value for name, _, value in scenario.variables}
+        self.signals = {}              # traffic signal id -> state set by an action
+        self.controller_start = {c.name: (c.delay, 0)
+                                 for c in scenario.traffic_signal_controllers}
+        self.since = {}                # (condition, entity) -> time its state began to hold
+        self.group_actors = {}         # maneuverGroup path -> its actors this execution
+        self.act_entities = {}         # act path -> the entities that made it start
         self.root = _Element("storyboard", "Storyboard", None)
         self.elements = {}
         self.conditions = []
@@ -196,8 +250,7 @@ class Storyboard:
                             self._collect(ev.start_trigger)
         self.runs = []                # active runs, in start order
         self.last_time = None
-        self.prev_states = {}
-        self.prev_transitions = set()
+        self.log = []                 # (element key, transition, to state) of every change
         self.done = False
 
     def _add(self, etype, spec, parent, max_count=1):
@@ -225,82 +278,100 @@ class Storyboard:
 
     # --- conditions ------------------------------------------------------------------------
 
-    def _raw(self, c, t, env):
+    def _state_condition(self, cs, test):
+        """A StoryboardElementStateCondition on the changes since cs was last evaluated."""
+        key = (test.element_type, test.element_path)
+        new = [c for c in self.log[cs.seen:] if c[0] == key]
+        cs.seen = len(self.log)
+        if test.state.endswith("State"):
+            if new:
+                return any(c[2] == test.state for c in new)
+            return self.state(*key) == test.state
+        return any(c[1] == test.state for c in new)
+
+    def _raw(self, cs, t, env):
+        """(value, the triggering entities whose value is true)."""
+        c = cs.spec
         test = c.test
         if isinstance(test, m.SimulationTimeCondition):
-            return compare(t, test.rule, test.value)
+            return compare(t, test.rule, test.value), ()
         if isinstance(test, m.StoryboardElementStateCondition):
-            key = (test.element_type, test.element_path)
-            if test.state.endswith("State"):
-                return self.prev_states.get(key, STANDBY) == test.state
-            return key + (test.state,) in self.prev_transitions
+            return self._state_condition(cs, test), ()
+        if not c.triggering:
+            return conds.value_condition(self, test, t, env, c, compare), ()
         values = [self._entity_value(c, test, name, env) for name in c.triggering]
-        return any(values) if c.triggering_rule == "any" else all(values)
+        true = tuple(n for n, v in zip(c.triggering, values) if v)
+        return (any(values) if c.triggering_rule == "any" else all(values)), true
+
+    def signal_state(self, signal, t):
+        return conds.signal_state(self, signal, t)
+
+    def controller_phase(self, name, t):
+        return conds.controller_phase(self, name, t)
 
     def _entity_value(self, c, test, name, env):
-        a = env.body(name, c)
-        need = lambda body, key: env.need(body, key, c)  # noqa: E731
-        try:
-            if isinstance(test, m.SpeedCondition):
-                return compare(a.speed, test.rule, test.value)
-            if isinstance(test, m.ReachPositionCondition):
-                p = test.position
-                return math.hypot(a.x - p.x, a.y - p.y) <= test.tolerance
-            if isinstance(test, m.DistanceCondition):
-                p = test.position
-                if test.distance_type in ("euclidianDistance", "cartesianDistance"):
-                    d = g.point_euclidean(a, p.x, p.y, test.freespace)
-                else:
-                    axis = 0 if test.distance_type == "longitudinal" else 1
-                    d = abs(g.point_axis_distance(a, p.x, p.y, axis, test.freespace))
-                return compare(d, test.rule, test.value)
-            b = env.body(test.entity, c)
-            if isinstance(test, m.RelativeDistanceCondition):
-                d = g.relative_distance(a, b, test.distance_type, test.freespace,
-                                        test.coordinate_system, need)
-            elif isinstance(test, m.TimeHeadwayCondition):
-                d = g.time_headway(a, b, test.freespace, test.coordinate_system, need)
-            else:
-                d = g.time_to_collision(a, b, test.distance_type, test.freespace)
-            return compare(d, test.rule, test.value)
-        except ValueError as e:
-            raise env.error(c, str(e)) from None
+        if isinstance(test, _ISSUE25_CONDITIONS):
+            return conds.entity_value(self, c, test, name, env, compare)
+        return geometric_value(self, c, test, name, env, compare)
 
-    def _evaluate_conditions(self, t, env):
+    def _evaluate(self, cs, t, env):
+        """The condition's output at this step: its value through its edge and delay."""
+        c = cs.spec
+        value, entities = self._raw(cs, t, env)
+        value = bool(value)
+        prev = cs.previous
+        if c.edge == "none":
+            edged = value
+        elif prev is None:
+            edged = False
+        elif c.edge == "rising":
+            edged = value and not prev
+        elif c.edge == "falling":
+            edged = prev and not value
+        else:
+            edged = value != prev
+        cs.previous = value
+        if edged:
+            cs.pending.append((t + c.delay, entities))
+        due = [p for p in cs.pending if p[0] <= t + TIME_EPS]
+        fired = bool(due)
+        cs.fired_entities = tuple(dict.fromkeys(e for p in due for e in p[1]))
+        cs.pending = [p for p in cs.pending if p[0] > t + TIME_EPS]
+        return fired
+
+    def _triggering_entities(self, trigger, outputs):
+        """The entities that made trigger true this step: of every ConditionGroup that is
+        true, its entity conditions' triggering entities whose value was true (document
+        order, each once)."""
+        if trigger is None:
+            return ()
         out = []
-        for cs in self.conditions:
-            c = cs.spec
-            value = bool(self._raw(c, t, env))
-            prev = cs.previous
-            if c.edge == "none":
-                edged = value
-            elif prev is None:
-                edged = False
-            elif c.edge == "rising":
-                edged = value and not prev
-            elif c.edge == "falling":
-                edged = prev and not value
-            else:
-                edged = value != prev
-            cs.previous = value
-            if edged:
-                cs.pending.append(t + c.delay)
-            fired = any(p <= t + TIME_EPS for p in cs.pending)
-            cs.pending = [p for p in cs.pending if p > t + TIME_EPS]
-            out.append(fired)
-        return out
+        for group in trigger.groups:
+            if all(outputs.values.get(self._cond_index[id(c)]) for c in group):
+                for c in group:
+                    out.extend(self.conditions[self._cond_index[id(c)]].fired_entities)
+        return tuple(dict.fromkeys(out))
 
     def _trigger(self, trigger, outputs, default):
+        """OR of the groups (every group evaluated), AND within a group (after a false
+        condition only those with a delay are evaluated: their timers run), as esmini."""
         if trigger is None:
             return default
-        return any(all(outputs[self._cond_index[id(c)]] for c in group)
-                   for group in trigger.groups)
+        result = False
+        for group in trigger.groups:
+            value = bool(group)
+            for c in group:
+                if value or c.delay > 0:
+                    value = outputs[self._cond_index[id(c)]] and value
+            result = result or value
+        return result
 
     # --- transitions -----------------------------------------------------------------------
 
     def _record(self, el, transition, to_state):
         self._result.transitions.append(Transition(self._t, el.type, el.path, transition,
                                                    el.state, to_state))
+        self.log.append(((el.type, el.path), transition, to_state))
         el.state = to_state
 
     def _reset(self, el):
@@ -336,7 +407,13 @@ class Storyboard:
         self.runs = keep
 
     def _start_run(self, name, spec, actor, element, where, env):
-        run = make_run(name, spec, actor, self._t, env, where)
+        if isinstance(spec, m.STORYBOARD_ACTIONS):
+            conds.execute(self, spec, self._t)
+            run = _DoneRun(name, spec, actor, self._t, env, where)
+        else:
+            run = make_run(name, spec, actor, self._t, env, where)
+            if type(run) is InstantRun and not isinstance(spec, _LEGACY_INSTANT):
+                run = _DoneRun(name, spec, actor, self._t, env, where)
         run.element = element
         if actor is not None and run.domains:
             clash = [r for r in self.runs if r.actor == actor and r.domains & run.domains
@@ -368,7 +445,7 @@ class Storyboard:
             result.done = True
             return result
         env = _Env(self.scenario, world, t)
-        outputs = self._evaluate_conditions(t, env)
+        outputs = _Outputs(self, t, env)
         if self.root.state == STANDBY:
             self._start(self.root)
             for i, action in enumerate(self.scenario.init):
@@ -392,9 +469,6 @@ class Storyboard:
         result.done = self.done
         result.started = [self._commands[id(r)] for r in self._started
                           if id(r) in self._commands]
-        self.prev_states = {k: el.state for k, el in self.elements.items()}
-        self.prev_transitions = {(tr.element_type, tr.element, tr.transition)
-                                 for tr in result.transitions}
         return result
 
     def _act(self, act, outputs, env):
@@ -404,11 +478,16 @@ class Storyboard:
             return
         if act.state == STANDBY and self._trigger(spec.start_trigger, outputs, True):
             self._start(act)
+            self.act_entities[act.path] = self._triggering_entities(spec.start_trigger, outputs)
         if act.state != RUNNING:
             return
         for group in act.children:
             if group.state == STANDBY:
                 self._start(group)
+                actors = group.spec.actors
+                if group.spec.select_triggering_entities:
+                    actors = tuple(dict.fromkeys(actors + self.act_entities.get(act.path, ())))
+                self.group_actors[group.path] = actors
             if group.state != RUNNING:
                 continue
             for man in group.children:
@@ -427,14 +506,24 @@ class Storyboard:
             return
         if ev.spec.priority == "overwrite":
             for o in others:
-                self._stop(o)
+                self._end_overridden(o)
         self._start(ev)
         for action in ev.children:
             self._start(action)
             spec = action.spec
-            actors = group.spec.actors if spec.private else (None,)
+            actors = self.group_actors.get(group.path, group.spec.actors) \
+                if spec.private else (None,)
             for actor in actors:
                 self._start_run(spec.path, spec.spec, actor, action, spec.where, env)
+
+    def _end_overridden(self, ev):
+        """An Event overwritten by another of its Maneuver ends (as esmini: it can run again
+        while it has executions left); its running actions end, their runs are stopped."""
+        for action in ev.children:
+            if action.state == RUNNING:
+                self._drop_runs(lambda r: r.element is action, "stop")
+                self._record(action, "endTransition", COMPLETE)
+        self._end(ev)
 
     def _update_runs(self, env):
         finished = []
@@ -456,5 +545,7 @@ class Storyboard:
         if el.type == "action":
             if not any(r.element is el for r in self.runs):
                 self._end(el)
+        elif el is self.root and not self.end_on_complete:
+            return
         elif all(c.state == COMPLETE for c in el.children):
             self._end(el)

@@ -1,8 +1,9 @@
 """tracks.csv of a scenario run: one row per entity per scenario step,
 `t,entity,x,y,z,heading,speed,road,lane,s`, entities named as in the .xosc (the ego included),
-in name order. Written by the scenario engine into the run folder ($CONVOY_RUN_DIR), a step's
+in name order; heading in (-pi, pi]. Written by the scenario engine into the run folder ($CONVOY_RUN_DIR), a step's
 rows at a time, so a run that ends early keeps the steps it made."""
 
+import math
 import os
 
 HEADER = "t,entity,x,y,z,heading,speed,road,lane,s\n"
@@ -25,7 +26,8 @@ class TracksWriter:
             s = world[name]
             on_road = "road" in s
             rows.append("%.3f,%s,%.4f,%.4f,%.4f,%.6f,%.4f,%s,%s,%s\n" % (
-                t, name, s["x"], s["y"], s.get("z", 0.0), s["yaw"], s["speed"],
+                t, name, s["x"], s["y"], s.get("z", 0.0), math.atan2(math.sin(s["yaw"]), math.cos(s["yaw"])),
+                s["speed"],
                 s["road"] if on_road else "", s["lane"] if on_road else "",
                 "%.4f" % s["s"] if on_road else ""))
         self.f.write("".join(rows))

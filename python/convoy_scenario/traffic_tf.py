@@ -4,7 +4,8 @@ transceiver function at the scenario engine's rate:
 - every vehicle_agent and pedestrian_agent of the config gets its `neighbours` (the road users
   within 100 m: the other agents and the ego) and, with a traffic_lights engine, its
   `traffic_lights`;
-- the world engine gets every agent as an actor (`agents`);
+- the world engine gets every agent, and every entity the scenario engine moves itself (its
+  `entities`), as an actor (`agents`);
 - the ego's planner (an engine named `planner`) gets its ground-truth input: the road users in
   the ego's frame, and a red (or too late yellow) light of the ego's approach as a standing
   object at the stop line, as experiments/city_traffic/traffic_tf.py does.
@@ -25,6 +26,7 @@ from convoy_traffic.ego_planner import ego_state, objects_from_road_users
 from convoy_traffic.neighbours import neighbour_datapacks, road_users
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+WORLD_CATEGORIES = ("car", "truck", "bus", "pedestrian", "cyclist")
 STOP_LOOKAHEAD = 60.0    # m: a light of the ego's approach counts from this far
 YELLOW_STOP_DECEL = 3.0  # m/s^2: on yellow the ego stops if it can with at most this
 
@@ -47,6 +49,8 @@ if SCENARIO is not None:
     if "/" in spec:
         EGO_DP = tuple(spec.split("/", 1))
 LINK = SCENARIO["EngineName"] if SCENARIO is not None else (AGENTS[0] if AGENTS else None)
+# entities the scenario engine moves itself (its `entities` datapack: RoadUsers as JSON)
+PLAYED = SCENARIO is not None and "scenario" in (SCENARIO.get("Entities") or {}).values()
 
 STOP_LINES = []
 if LIGHTS is not None and PLANNER is not None:
@@ -85,6 +89,8 @@ def _traffic(**dps):
     if ego_dp is not None and ego_dp.isEmpty():
         ego_dp = None
     agent_dps = [dps["a_%d" % i] for i in range(len(AGENTS))]
+    if PLAYED:
+        agent_dps.append(dps["played"])
     out = []
     signals = dict(lights.data["signals"]) if lights is not None and not lights.isEmpty() else {}
     everyone = agent_dps + ([ego_dp] if ego_dp is not None else [])
@@ -93,8 +99,10 @@ def _traffic(**dps):
         out += [JsonDataPack("traffic_lights", a, lights.data) for a in AGENTS]
     agents = road_users(agent_dps)
     if WORLD is not None:
+        # the world draws road users; a scenario's MiscObjects (category "object") are not
+        # drawn, but the planner still gets them as objects
         world = RoadUsersDataPack("agents", WORLD)
-        world.data.users.extend(agents)
+        world.data.users.extend(u for u in agents if u.category in WORLD_CATEGORIES)
         out.append(world)
     if PLANNER is not None and ego_dp is not None:
         ego = ego_dp.data
@@ -115,4 +123,6 @@ if LIGHTS is not None:
     traffic = EngineDataPack(keyword="lights", id=DataPackIdentifier("traffic_lights", LIGHTS["EngineName"]))(traffic)
 if EGO_DP is not None:
     traffic = EngineDataPack(keyword="ego", id=DataPackIdentifier(EGO_DP[1], EGO_DP[0]))(traffic)
+if PLAYED:
+    traffic = EngineDataPack(keyword="played", id=DataPackIdentifier("entities", SCENARIO["EngineName"]))(traffic)
 traffic = TransceiverFunction(LINK)(traffic)

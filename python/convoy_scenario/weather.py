@@ -75,7 +75,7 @@ def weather_config(scenario):
     ones override earlier keys)."""
     out = {}
     for action in scenario.init:
-        if action.entity is None:
+        if action.entity is None and hasattr(action.spec, "environment"):
             out.update(environment_to_weather(action.spec.environment))
     return out
 

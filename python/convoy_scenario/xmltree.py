@@ -12,7 +12,7 @@ import xml.parsers.expat
 
 class ScenarioError(Exception):
     """A scenario outside the supported subset, or wrong: the message names the file, the
-    line and the element (``cut_in.xosc:42: <SynchronizeAction> is not supported ...``)."""
+    line and the element (``cut_in.xosc:42: <UserDefinedAction> is not supported ...``)."""
 
 
 class Node:

@@ -9,9 +9,11 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "app/scenario_config.h"
 #include "app/simulation.h"
 #include "app/view.h"
 #include "core/memory.h"
@@ -27,8 +29,9 @@ void usage(const char* prog) {
       "usage: %s run -c simulation_config.json [-o Key=Value]... [--run-dir DIR] [--quiet]\n"
       "                  [--record] [--record-blobs] [--live [HOST:]PORT [--insecure]]\n"
       "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--scenery KIND] [--ego "
-      "FRAGMENT.json]\n"
-      "                [-o Key=Value]... [--run-dir DIR] [--quiet] [--record]\n"
+      "FRAGMENT.json|scenario]\n"
+      "                [--scenario-param NAME=VALUE]... [-o Key=Value]... [--run-dir DIR]\n"
+      "                [--quiet] [--record]\n"
       "       %s replay RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s campaign SUITE_DIR [--seeds N] [--workers N] [--backend local|slurm] [--out DIR]\n"
@@ -65,6 +68,10 @@ void usage(const char* prog) {
       "                      urban where the map has sidewalks, else roadside), none,\n"
       "                      roadside or urban\n"
       "  --ego FILE          with --scenario: a config fragment with the user's ego engines\n"
+      "  --scenario-param NAME=VALUE  with --scenario: a value of one of the scenario's\n"
+      "                      global parameters (repeatable)\n"
+      "  --ego scenario      with --scenario: the scenario moves the ego too, exactly as its\n"
+      "                      actions say (as esmini does; no camera, no stack under test)\n"
       "  -o, --param K=V     override a config key; K may be a path like "
       "EngineConfigs/0/EngineTimestep\n"
       "  --run-dir DIR       where to write logs, steps.csv and summary.json\n"
@@ -224,55 +231,6 @@ int campaign(int argc, char** argv) {
   return rc;
 }
 
-// --scenario: writes the scenario's default config into the run folder (creating it) with
-// python/convoy_scenario/make_config.py; points `options` at it. False after saying why.
-bool prepare_scenario(const std::string& scenario, const std::string& world, const std::string& ego,
-                      const std::string& scenery, convoy::app::RunOptions& options) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::is_regular_file(scenario, ec)) {
-    std::fprintf(stderr, "error: --scenario %s: no such file\n", scenario.c_str());
-    return false;
-  }
-  if (options.run_dir.empty()) {
-    fs::path base = fs::current_path() / "runs";
-    if (const char* b = std::getenv("CONVOY_RUNS_DIR"); b && *b) base = b;
-    char stamp[32];
-    std::time_t t = std::time(nullptr);
-    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&t));
-    options.run_dir = base / ("scenario_" + fs::path(scenario).stem().string() + "-" + stamp + "-" +
-                              std::to_string(getpid()));
-  }
-  fs::create_directories(options.run_dir, ec);
-  if (ec) {
-    std::fprintf(stderr, "error: cannot create the run folder %s: %s\n", options.run_dir.c_str(),
-                 ec.message().c_str());
-    return false;
-  }
-  options.run_dir = fs::absolute(options.run_dir);
-  const fs::path config = options.run_dir / "scenario_config.json";
-  std::vector<std::string> args = {
-      python_exe(),
-      (convoy::python::package_dir() / "convoy_scenario" / "make_config.py").string(),
-      fs::absolute(scenario).string(),
-      "--out",
-      config.string(),
-      "--bin-dir",
-      convoy::app::bin_dir().string()};
-  if (!world.empty()) args.insert(args.end(), {"--world", fs::absolute(world).string()});
-  if (!ego.empty()) args.insert(args.end(), {"--ego", fs::absolute(ego).string()});
-  if (!scenery.empty()) args.insert(args.end(), {"--scenery", scenery});
-  const int rc = run_program(args);
-  if (rc != 0) {
-    if (rc < 0) std::fprintf(stderr, "error: cannot run %s\n", args[0].c_str());
-    std::fprintf(stderr, "error: --scenario %s: no config could be made (run folder %s)\n",
-                 scenario.c_str(), options.run_dir.c_str());
-    return false;
-  }
-  options.config_file = config;
-  return true;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -298,6 +256,8 @@ int main(int argc, char** argv) {
   convoy::app::RunOptions options;
   std::string mode = "standalone", dir, log_output, log_filename = ".console_output.log";
   std::string scenario, world, ego, scenery;
+  std::vector<std::string> scenario_params;
+  std::optional<convoy::python::Interpreter> scenario_python;
   for (; i < argc; ++i) {
     std::string a = argv[i];
     std::string inline_value;  // --key=value
@@ -326,6 +286,8 @@ int main(int argc, char** argv) {
       ego = value();
     else if (a == "--scenery")
       scenery = value();
+    else if (a == "--scenario-param")
+      scenario_params.push_back(value());
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
     else if (a == "--record")
@@ -423,9 +385,13 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "error: --scenario runs standalone only\n");
       return 2;
     }
-    if (!prepare_scenario(scenario, world, ego, scenery, options)) return 2;
-  } else if (!world.empty() || !ego.empty() || !scenery.empty()) {
-    std::fprintf(stderr, "error: --world, --scenery and --ego go with --scenario\n");
+    // the interpreter stays up for the run: its functions find the scenario already read
+    scenario_python.emplace();
+    if (!convoy::app::prepare_scenario({scenario, world, ego, scenery, scenario_params}, options))
+      return 2;
+  } else if (!world.empty() || !ego.empty() || !scenery.empty() || !scenario_params.empty()) {
+    std::fprintf(stderr,
+                 "error: --world, --scenery, --ego and --scenario-param go with --scenario\n");
     return 2;
   }
   if (options.config_file.empty()) {

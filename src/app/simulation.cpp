@@ -226,8 +226,8 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
 }  // namespace
 
 void export_run_environment(const fs::path& run_dir) {
-  setenv("CONVOY_RUN_DIR", run_dir.c_str(), 1);
-  setenv("CONVOY_SHARE_DIR", share_dir().c_str(), 0);
+  python::set_environment("CONVOY_RUN_DIR", run_dir.string(), true);
+  python::set_environment("CONVOY_SHARE_DIR", share_dir().string(), false);
 }
 
 namespace {

@@ -14,7 +14,9 @@ std::filesystem::path package_dir() {
 Interpreter::Interpreter() {
   // Engines and TFs print progress; flush it line by line into the logs.
   setenv("PYTHONUNBUFFERED", "1", 0);
-  guard_ = std::make_unique<py::scoped_interpreter>(false);
+  // Nested in one that is already up (convoy run --scenario keeps one from making the config
+  // to the end of the run): this one only adds the paths.
+  if (!Py_IsInitialized()) guard_ = std::make_unique<py::scoped_interpreter>(false);
   // NRP-Core's generated protobuf modules (nrp_protobuf.dump_pb2...), made by the build.
   add_path(CONVOY_PYTHON_GEN_DIR);
   add_path(package_dir());
@@ -28,6 +30,14 @@ void add_python_path(const std::filesystem::path& dir) {
   py::list path = py::module_::import("sys").attr("path");
   py::str entry(dir.string());
   if (!path.contains(entry)) path.insert(0, entry);
+}
+
+void set_environment(const std::string& name, const std::string& value, bool overwrite) {
+  setenv(name.c_str(), value.c_str(), overwrite ? 1 : 0);
+  if (!Py_IsInitialized()) return;
+  py::object environ = py::module_::import("os").attr("environ");
+  if (overwrite || !environ.contains(name))
+    environ[py::str(name)] = py::str(std::getenv(name.c_str()));
 }
 
 std::string format_exception(py::error_already_set& e) {

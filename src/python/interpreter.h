@@ -12,6 +12,7 @@ namespace convoy::python {
 namespace py = pybind11;
 
 // Starts the interpreter with Convoy's nrp_core package importable; stops it on destruction.
+// Within one already running (in this thread), it only makes the package importable.
 class Interpreter {
  public:
   Interpreter();
@@ -31,6 +32,10 @@ void add_python_path(const std::filesystem::path& dir);
 
 // Directory holding the nrp_core package: $CONVOY_PYTHON_PATH, else the build's.
 std::filesystem::path package_dir();
+
+// setenv, and os.environ too when the interpreter is up (it copied the environment when it
+// started). Needs the GIL when it is up.
+void set_environment(const std::string& name, const std::string& value, bool overwrite);
 
 // The pending Python exception as "Traceback ...\nType: message"; clears it.
 std::string format_exception(py::error_already_set& e);

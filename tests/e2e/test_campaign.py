@@ -9,6 +9,8 @@ tools/campaign/slurm_local.sh in a temp folder; a 4-task campaign; a failing tas
 once; a driver killed while its array runs, then the same command again.
 BadInput: one message naming the file or option, exit 2; a failing task under the local
 backend: the leaderboard is written, exit 1.
+Distribution: an OpenSCENARIO parameter distribution (2 variants of benchmarks/suite/cut_in.xosc,
+3 simulated s each) runs one task per variant, its parameters in the config and leaderboard.
 
 Run with Debian's /usr/bin/python3; the binaries come from $CONVOY_BIN_DIR."""
 
@@ -382,6 +384,58 @@ class BadInput(CampaignTest):
         self.assertBad(campaign(self.cut_in_suite(bad=True), "--seconds", 1, "--seeds", 2,
                                 "--out", out), os.path.join(out, "campaign.json"),
                        "holds another campaign")
+
+
+class Distribution(CampaignTest):
+    """An OpenSCENARIO parameter distribution as a suite entry: one task per variant, its
+    parameters in the generated config and in the leaderboard; a bad distribution is bad input."""
+
+    DIST = """<?xml version="1.0"?>
+<OpenSCENARIO>
+  <FileHeader revMajor="1" revMinor="2" date="2026-11-27T00:00:00" description="d" author="t"/>
+  <ParameterValueDistribution>
+    <ScenarioFile filepath="%s"/>
+    <Deterministic>
+      <DeterministicSingleParameterDistribution parameterName="EgoS">
+        <DistributionRange stepWidth="10"><Range lowerLimit="30" upperLimit="40"/></DistributionRange>
+      </DeterministicSingleParameterDistribution>
+    </Deterministic>
+  </ParameterValueDistribution>
+</OpenSCENARIO>
+"""
+
+    def suite(self, scenario):
+        folder = os.path.join(self.dir, "suite")
+        os.makedirs(folder, exist_ok=True)
+        with open(os.path.join(folder, "ego_start.xosc"), "w") as f:
+            f.write(self.DIST % scenario)
+        return folder
+
+    def test_variants_run(self):
+        out = os.path.join(self.dir, "out")
+        r = campaign(self.suite(os.path.join(REPO, "benchmarks", "suite", "cut_in.xosc")),
+                     "--workers", 2, "--seconds", 3, "--out", out)
+        self.assertExit(r, 0)
+        self.assertIn("campaign: 2 tasks", r.stdout)
+        rows = read_board(out)
+        self.assertEqual([(x["scenario"], x["parameters"], x["exit_code"]) for x in rows],
+                         [("ego_start_001", "EgoS=30", "0"), ("ego_start_002", "EgoS=40", "0")])
+        plan = read_json(os.path.join(out, "plan.json"))
+        self.assertEqual([t["parameters"] for t in plan["tasks"]], [{"EgoS": 30.0}, {"EgoS": 40.0}])
+        xs = []
+        for name, s in (("ego_start_001", 30.0), ("ego_start_002", 40.0)):
+            cfg = read_json(os.path.join(out, "runs", name + "__s0__clear", "scenario_config.json"))
+            scen = [e for e in cfg["EngineConfigs"] if e["EngineType"] == "scenario"][0]
+            self.assertEqual(scen["Parameters"], {"EgoS": s})
+            xs.append(cfg["EngineConfigs"][0]["GazeboSDFModels"][0]["InitPose"][0])
+        self.assertAlmostEqual(xs[1] - xs[0], 10.0)  # the ego starts where EgoS says
+
+    def test_missing_scenario_is_bad_input(self):
+        missing = os.path.join(self.dir, "nowhere", "cut_in.xosc")
+        r = campaign(self.suite(missing), "--out", os.path.join(self.dir, "out"))
+        self.assertExit(r, 2)
+        self.assertIn("ego_start.xosc:5: <ScenarioFile> filepath: the scenario file %s does not exist"
+                      % missing, r.stderr)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,5 @@
 """The world generator end to end (docs/worlds.md): `convoy-odr world` on good and bad maps,
-and scenario runs on esmini's maps (tests/opendrive/data/esmini, scenarios in
+and scenario runs on esmini's maps (tests/data/esmini/xodr, scenarios in
 benchmarks/worlds) whose worlds `convoy run --scenario` generates and caches.
 
 Groups: Cli (the command's outputs, exit codes and warnings), Drive (the smart car on a
@@ -17,7 +17,7 @@ import unittest
 from e2e_util import BIN_DIR, CONVOY, REPO, E2ETestCase
 
 ODR = os.path.join(BIN_DIR, "convoy-odr")
-MAPS = os.path.join(REPO, "tests", "opendrive", "data", "esmini")
+MAPS = os.path.join(REPO, "tests", "data", "esmini", "xodr")
 SCENARIOS = os.path.join(REPO, "benchmarks", "worlds")
 LANE_KEEPING_M = 0.85
 

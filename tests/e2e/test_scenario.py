@@ -30,8 +30,10 @@ from e2e_util import BIN_DIR, CONVOY, REPO, E2ETestCase
 
 sys.path.insert(0, os.path.join(REPO, "python"))
 from convoy_scenario import load  # noqa: E402
-from convoy_scenario.make_config import init_pose, init_speed  # noqa: E402
-from convoy_scenario.odr import OdrQuery  # noqa: E402
+from convoy_scenario.make_config import init_pose  # noqa: E402
+from convoy_scenario.player import Player  # noqa: E402
+from convoy_scenario.player_state import NoRoads  # noqa: E402
+from convoy_scenario.roads import RoadMap  # noqa: E402
 
 FIXTURES = os.path.join(REPO, "tests", "unit", "scenarios")
 STAND_IN = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenario", "stand_in.py")
@@ -50,23 +52,20 @@ class ScenarioCase(E2ETestCase):
         """A config: the scenario engine on xosc, one stand-in per entity (the ego's state only,
         never commanded), the scenario TF and status function."""
         sc = load(xosc, parameters=parameters)
-        odr = OdrQuery(sc.logic_file, BIN_DIR) if sc.logic_file else None
-        try:
-            engines, entities = [], {}
-            for ent in sc.entities:
-                pose = init_pose(sc, ent.name, odr) or (0.0, 0.0, 0.0)
-                name = ent.name.lower()
-                bb = ent.object.bounding_box
-                engines.append({"EngineType": "python_json", "EngineName": name, "PythonFileName": STAND_IN,
-                                "EngineTimestep": 0.05, "CommandDataPack": "command",
-                                "Category": "pedestrian" if ent.kind == "pedestrian" else "car",
-                                "Length": bb.length, "Width": bb.width,
-                                "Start": {"x": pose[0], "y": pose[1], "yaw": pose[2],
-                                          "speed": init_speed(sc, ent.name)}})
-                entities[ent.name] = name + "/state" if ent.name == "Ego" else name
-        finally:
-            if odr is not None:
-                odr.close()
+        player = Player(sc, RoadMap(sc.logic_file, BIN_DIR) if sc.logic_file else NoRoads(),
+                        [e.name for e in sc.entities])
+        engines, entities = [], {}
+        for ent in sc.entities:
+            pose = init_pose(sc, ent.name, player) or (0.0, 0.0, 0.0)
+            name = ent.name.lower()
+            bb = ent.object.bounding_box
+            engines.append({"EngineType": "python_json", "EngineName": name, "PythonFileName": STAND_IN,
+                            "EngineTimestep": 0.05, "CommandDataPack": "command",
+                            "Category": "pedestrian" if ent.kind == "pedestrian" else "car",
+                            "Length": bb.length, "Width": bb.width,
+                            "Start": {"x": pose[0], "y": pose[1], "yaw": pose[2],
+                                      "speed": player.states[ent.name].speed}})
+            entities[ent.name] = name + "/state" if ent.name == "Ego" else name
         if weather:
             engines.append({"EngineType": "weather", "EngineName": "weather", "EngineTimestep": 0.05})
         engines.append({"EngineType": "scenario", "EngineName": "scenario", "EngineTimestep": 0.05,
@@ -166,11 +165,12 @@ class Engine(ScenarioCase):
         car = self.track("car")
         side = 20.0  # the Trajectory's parameter Side: vertices (0, 0) t=0, (20, 0) t=2, (20, 20) t=4
         # starts at t = 1 (relative timing): at (20, 0) at t = 3, at (20, 20) at t = 5; the
-        # command reaches the car one step (50 ms) after the engine computed it
-        at3 = min(car, key=lambda r: abs(r["t"] - 3.05))
+        # storyboard's t is the start of the engine's step, and the command reaches the car one
+        # step (50 ms) after the engine computed it: two steps in all
+        at3 = min(car, key=lambda r: abs(r["t"] - 3.10))
         self.assertAlmostEqual(at3["x"], side, delta=0.01)
         self.assertAlmostEqual(at3["y"], 0.0, delta=0.01)
-        at5 = min(car, key=lambda r: abs(r["t"] - 5.05))
+        at5 = min(car, key=lambda r: abs(r["t"] - 5.10))
         self.assertAlmostEqual(at5["y"], side, delta=0.01)
         self.assertTrue(any("trajectory" in r["cmd"] for r in car))
 
@@ -203,7 +203,7 @@ class BadInput(ScenarioCase):
         self.write_config(cfg)
         r = self.run_convoy(timeout=60)
         self.assertNotEqual(r.code, 0)
-        self.assertStderrHas(r, "bad_unsupported.xosc:56: <SynchronizeAction> is not supported")
+        self.assertStderrHas(r, "bad_unsupported.xosc:56: <UserDefinedAction> is not supported")
         self.assertNotIn("Traceback", r.stderr)
         self.assertEqual(self.scan_engine_processes(), [])
 
@@ -221,7 +221,7 @@ class BadInput(ScenarioCase):
     def test_scenario_command_bad_file(self):
         code, out, err = self.run_scenario(os.path.join(FIXTURES, "bad_unsupported.xosc"))
         self.assertEqual(code, 2)
-        self.assertIn("bad_unsupported.xosc:56: <SynchronizeAction> is not supported", err)
+        self.assertIn("bad_unsupported.xosc:56: <UserDefinedAction> is not supported", err)
         self.assertNotIn("Traceback", err)
         self.assertEqual(self.scan_engine_processes(), [])
 

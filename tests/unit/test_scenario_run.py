@@ -203,7 +203,7 @@ class MakeConfigTest(unittest.TestCase):
                 sys.stderr = old
         self.assertEqual(rc, 2)
         with open(err) as f:
-            self.assertIn("bad_unsupported.xosc:56: <SynchronizeAction> is not supported", f.read())
+            self.assertIn("bad_unsupported.xosc:56: <UserDefinedAction> is not supported", f.read())
 
 
 class LiveScoreTest(unittest.TestCase):

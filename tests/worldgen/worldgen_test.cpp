@@ -1,4 +1,4 @@
-// The world generator on esmini's 20 maps (tests/opendrive/data/esmini): every map becomes a
+// The world generator on esmini's 20 maps (tests/data/esmini/xodr): every map becomes a
 // world, scenery stays off the road, the same seed gives the same files, signals and objects
 // become models, and what cannot be built is a warning naming it.
 #include <gtest/gtest.h>

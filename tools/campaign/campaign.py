@@ -13,8 +13,10 @@ sys.path.insert(0, os.path.join(REPO, "python"))
 
 from convoy_campaign.cli import main  # noqa: E402 (after the path)
 from convoy_scenario.campaign_entry import register as register_xosc  # noqa: E402
+from convoy_scenario.distribution_entry import register as register_distributions  # noqa: E402
 
 register_xosc()  # OpenSCENARIO entries (.xosc): convoy run --scenario
+register_distributions()  # .xosc parameter distributions: one entry per variant
 
 if __name__ == "__main__":
     sys.exit(main())
