@@ -33,6 +33,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from machine import cpu_model  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(REPO, "python"))
@@ -42,17 +45,6 @@ XOSC_DIR = os.path.join(REPO, "tests", "data", "esmini", "xosc")
 REFERENCE_DIR = os.path.join(REPO, "tests", "data", "esmini", "reference")
 WITHIN_M = 0.5
 MIN_COVERAGE = 0.95
-
-
-def cpu_model():
-    try:
-        out = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
-    except OSError:
-        return "unknown"
-    for line in out.splitlines():
-        if line.startswith("Model name:"):
-            return line.split(":", 1)[1].strip()
-    return "unknown"
 
 
 def error_line(stderr):

@@ -5,7 +5,10 @@ and its parts (summary.json's `startup`: the coordinator's own, then each engine
 start-up and Initialize; engines initialize concurrently).
 
   /usr/bin/python3 benchmarks/startup_bench.py [--runs 3] [--timeout 0.1] [--build build]
-                                               [--json out.json] [CONFIG ...]
+                                               [--json out.json] [--ego E] [CONFIG ...]
+
+A CONFIG ending in .xosc runs as `convoy run --scenario FILE` (its config made in the run, which
+the start-up includes), with `--ego E` when given.
 
 Each config runs once with empty caches (a fresh CONVOY_CACHE_DIR and XDG_CACHE_HOME: the
 parsed-world cache, SUMO's converted network...), reported as "cold", then `--runs` times with
@@ -33,8 +36,12 @@ CONFIGS = [
 PARTS = ("process_s", "functions_s", "launch_s", "initialize_s", "prime_s")
 
 
-def run_once(convoy, config, timeout, run_dir, env):
-    r = subprocess.run([convoy, "run", "-q", "-c", config, "-o", "SimulationTimeout=%g" % timeout,
+def run_once(convoy, config, timeout, run_dir, env, ego=None):
+    """One run; an .xosc runs as `convoy run --scenario` (the config made in the run, which
+    start-up counts), with `--ego EGO` when given."""
+    what = ["--scenario", config] + (["--ego", ego] if ego else []) if config.endswith(".xosc") \
+        else ["-c", config]
+    r = subprocess.run([convoy, "run", "-q"] + what + ["-o", "SimulationTimeout=%g" % timeout,
                         "--run-dir", run_dir], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                        text=True, env=env)
     if r.returncode != 0:
@@ -72,6 +79,7 @@ def main():
     ap.add_argument("--timeout", type=float, default=0.1, help="SimulationTimeout of each run, s")
     ap.add_argument("--build", default=os.path.join(REPO, "build"), help="the build folder")
     ap.add_argument("--json", help="also write the figures here")
+    ap.add_argument("--ego", help="for .xosc configs: convoy run --scenario's --ego (e.g. scenario)")
     args = ap.parse_args()
     convoy = os.path.join(args.build, "bin", "convoy")
     if not os.access(convoy, os.X_OK):
@@ -90,8 +98,8 @@ def main():
             name = os.path.relpath(config, REPO)
             cache = os.path.join(work, "cache-%d" % len(results))
             env = dict(os.environ, CONVOY_CACHE_DIR=os.path.join(cache, "convoy"), XDG_CACHE_HOME=cache)
-            cold = run_once(convoy, config, args.timeout, os.path.join(work, "run-cold"), env)
-            warm = [run_once(convoy, config, args.timeout, os.path.join(work, "run-%d" % i), env)
+            cold = run_once(convoy, config, args.timeout, os.path.join(work, "run-cold"), env, args.ego)
+            warm = [run_once(convoy, config, args.timeout, os.path.join(work, "run-%d" % i), env, args.ego)
                     for i in range(args.runs)]
             results[name] = {"cold": median_startup([cold]), "warm": median_startup(warm),
                              "warm_runs_s": [s["startup_s"] for s in warm]}

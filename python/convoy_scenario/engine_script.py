@@ -271,7 +271,7 @@ class Script(EngineScript):
             return None
         from convoy_scenario.player_state import NoRoads
         from convoy_scenario.roads import RoadMap
-        self.roads = RoadMap(xodr) if xodr else NoRoads()
+        self.roads = RoadMap.open(xodr) if xodr else NoRoads()
         return Player(self.scenario, self.roads, driven)
 
     def _publish_entities(self):

@@ -52,7 +52,11 @@ if PYTHON not in sys.path:
 
 from convoy_scenario import ScenarioError, load, weather_config  # noqa: E402
 from convoy_scenario import model as m  # noqa: E402
+from convoy_scenario.config_agents import (CATEGORY, DEFAULT_MODEL, actor_models, agent_config,  # noqa: E402,F401
+                                           init_pose, pose_of, vehicle_model)
 from convoy_scenario.config_exact import build_exact  # noqa: E402
+from convoy_scenario.config_route import (cut, lane_of, lane_route, polyline_length,  # noqa: E402,F401
+                                          route_points, surface_pose)
 from convoy_scenario.controllers import agent_keys, controller_of  # noqa: E402
 from convoy_scenario.controllers import kind as controller_kind  # noqa: E402
 from convoy_scenario.odr import OdrQuery  # noqa: E402
@@ -69,16 +73,13 @@ MAPS = {
     os.path.join(AD, "parkring.xodr"): os.path.join(AD, "parkring_road_no_ego.sdf"),
 }
 EGO_MODEL = os.path.join(CITY, "models", "smart_car", "model.sdf")
-ACTOR_TABLE = os.path.join(REPO, "engines", "gazebo_grpc", "actors", "actor_models.json")
 AGENT_DT = 0.05
 WORLD_DT = 0.02
 DETECTOR_DT = 0.1
 CRUISE = 8.333              # the ego planner's cruise speed (experiments/city_traffic/ego_planner.json)
 ROUTE_EXTRA_M = 30.0
 DEFAULT_DURATION_S = 60.0
-CATEGORY = {"car": "car", "van": "car", "truck": "truck", "trailer": "truck", "semitrailer": "truck",
-            "bus": "bus", "bicycle": "cyclist", "motorbike": "cyclist", "tram": "bus", "train": "bus"}
-DEFAULT_MODEL = {"car": "sedan", "truck": "truck", "bus": "bus", "cyclist": "bicycle"}
+LONGEST_RUN_S = 120.0      # a StopTrigger's time beyond the ego's route time is cut here
 
 
 def _file_id(path):
@@ -125,19 +126,6 @@ def init_actions(scenario, entity):
     return [a for a in scenario.init if a.entity == entity]
 
 
-def init_pose(scenario, entity, player):
-    """(x, y, yaw) where the entity starts (its Init actions applied by the player), or None
-    when no Init action places it."""
-    st = player.states[entity]
-    return (st.x, st.y, st.h) if st.placed else None
-
-
-def pose_of(player, position):
-    """(x, y, yaw) of a model position (any kind) now."""
-    x, y, _, h = player.world_pose_of(position)
-    return x, y, (h if h is not None else 0.0)
-
-
 def ego_route_action(scenario, ego):
     """The first AssignRouteAction for the ego: Init's, else the storyboard's."""
     for a in init_actions(scenario, ego):
@@ -169,101 +157,12 @@ def properties(obj):
     return out
 
 
-def actor_models():
-    with open(ACTOR_TABLE) as f:
-        return json.load(f)["models"]
-
-
-def vehicle_model(entity, category, models):
-    """The actor model: the entity's Property `model`, its catalog entry or its name when the
-    actor-model table has it, else the category's default."""
-    prop = dict(entity.object.properties).get("model")
-    for cand in ([prop] if prop else []) + ([entity.catalog.entry] if entity.catalog else []) + [entity.object.name]:
-        if cand in models:
-            return cand
-    return DEFAULT_MODEL[category]
-
-
-def lane_of(odr, x, y, yaw, what, types=("driving",)):
-    loc = odr.locate(x, y, yaw, max_distance=5.0)
-    if loc is None or loc["type"] not in types:
-        raise ScenarioError("%s at (%.2f, %.2f) is not on a %s lane of %s" % (
-            what, x, y, " or ".join(types), os.path.basename(odr.xodr)))
-    return loc
-
-
-def route_points(odr, spec, start, player):
-    """Points of an AssignRouteAction from the ego's start through its waypoints."""
-    pts, prev = [], start
-    for w in spec.waypoints:
-        x, y, yaw = pose_of(player, w.position)
-        loc = lane_of(odr, x, y, yaw, "a route waypoint")
-        if (loc["road"], loc["lane"]) == tuple(prev[:2]) and abs(loc["s"] - prev[2]) < 1.0:
-            continue  # the start itself (a route's first waypoint usually is)
-        try:
-            r, to = lane_route(odr, player.roads, prev, (loc["road"], loc["lane"], loc["s"]))
-        except ScenarioError:
-            if pts:
-                raise
-            continue   # a waypoint behind where the ego starts on its route
-        pts += r["points"] if not pts else r["points"][1:]
-        prev = to
-    return pts, prev
-
-
-def lane_route(odr, roads, frm, to):
-    """(route, end) from a lane position to a waypoint: to its lane, else (a route goes by
-    roads, as esmini's) to another lane of its road at its s driven the same way."""
-    try:
-        return odr.route(frm, to), to
-    except ScenarioError as first:
-        forward = roads.lane_info(to[0], to[1], to[2])["forward"]
-        for lane in sorted(roads.lanes_at(to[0], to[2]), key=lambda ln: abs(ln - to[1])):
-            if lane == to[1] or lane == 0:
-                continue
-            info = roads.lane_info(to[0], lane, to[2])
-            if info["type"] != "driving" or info["forward"] != forward:
-                continue
-            try:
-                return odr.route(frm, (to[0], lane, to[2])), (to[0], lane, to[2])
-            except ScenarioError:
-                continue
-        raise first
-
-
-def polyline_length(points):
-    return math.fsum(math.hypot(q[0] - p[0], q[1] - p[1]) for p, q in zip(points, points[1:]))
-
-
-def cut(points, length):
-    """The polyline's first `length` m."""
-    out, acc = [points[0]], 0.0
-    for p, q in zip(points, points[1:]):
-        d = math.hypot(q[0] - p[0], q[1] - p[1])
-        if acc + d >= length:
-            u = (length - acc) / d if d > 0 else 0.0
-            out.append([p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1]), q[2]])
-            return out
-        out.append(q)
-        acc += d
-    return out
-
-
 def route_length(scenario):
     for name, value in scenario.parameters:
         if name == "RouteLength":
             return float(value)
     duration = stop_time(scenario) or DEFAULT_DURATION_S
     return max(40.0, min(300.0, 0.5 * CRUISE * duration))
-
-
-def surface_pose(odr, pose, start):
-    """(z, pitch) of a car at `pose` on the road's surface: the height under it and the slope
-    from there to 1 m ahead (0, 0 on a flat map)."""
-    z = start.get("z", 0.0)
-    ahead = odr.locate(pose[0] + math.cos(pose[2]), pose[1] + math.sin(pose[2]), pose[2])
-    dz = (ahead or {}).get("z", z) - z
-    return z, (0.0 if dz == 0 else -math.atan2(dz, 1.0))
 
 
 def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0.0):
@@ -317,7 +216,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     xodr = scenario.logic_file
     with OdrQuery(xodr, bin_dir) as odr:
         has_lights = bool(odr.info()["signals"])
-        player = Player(scenario, RoadMap(xodr), [e.name for e in scenario.entities])
+        player = Player(scenario, RoadMap.open(xodr, bin_dir), [e.name for e in scenario.entities])
         ego_pose = init_pose(scenario, ego, player)
         if ego_pose is None:
             raise ScenarioError("%s: the ego %r has no Init TeleportAction (where does it start?)" % (base, ego))
@@ -344,50 +243,9 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
             if controller_kind(ctl) != "driver" and not properties(ent.object):
                 entity_map[ent.name] = "scenario"   # the default controller: exact control
                 continue
-            pose = init_pose(scenario, ent.name, player)
-            if pose is None:
-                raise ScenarioError("%s: entity %r has no Init TeleportAction" % (base, ent.name))
             name = engine_name(ent.name)
             entity_map[ent.name] = name
-            bb = ent.object.bounding_box
-            if ent.kind == "vehicle":
-                cat = CATEGORY.get(ent.object.category, "car")
-                loc = lane_of(odr, *pose, "entity %r's Init position" % ent.name)
-                onward = odr.follow(loc["road"], loc["lane"], loc["s"], 400.0)["lanes"][-1]
-                for ia in init_actions(scenario, ent.name):
-                    if isinstance(ia.spec, m.AssignRouteAction):  # routed to its last waypoint
-                        last = lane_of(odr, *pose_of(player, ia.spec.waypoints[-1].position),
-                                       "entity %r's route's last waypoint" % ent.name)
-                        onward = [last["road"], last["lane"]]
-                wheelbase = None
-                axles = dict(ent.object.axles)
-                if "FrontAxle" in axles and "RearAxle" in axles:
-                    wheelbase = dict(axles["FrontAxle"])["positionX"] - dict(axles["RearAxle"])["positionX"]
-                a = {"EngineType": "vehicle_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
-                     "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
-                     "Route": {"to": "%s:%d" % (onward[0], onward[1])},
-                     "InitialSpeed": player.states[ent.name].speed, "Model": vehicle_model(ent, cat, models),
-                     "Category": cat, "Length": bb.length, "Width": bb.width, "Height": bb.height,
-                     "LaneChanges": False, "Seed": i}
-                if not (wheelbase and 0 < wheelbase < bb.length) and bb.length <= 2.7:
-                    wheelbase = 0.6 * bb.length   # small vehicles without axles (a bicycle)
-                if wheelbase and 0 < wheelbase < bb.length:
-                    a["Wheelbase"] = wheelbase
-                if a["InitialSpeed"] > 0:
-                    a["v0"] = a["InitialSpeed"]   # its desired speed when its own AI drives
-            else:
-                loc = lane_of(odr, pose[0], pose[1], None, "pedestrian %r's Init position" % ent.name,
-                              types=("sidewalk",))
-                road_len = next(r["length"] for r in odr.info()["roads"] if r["id"] == loc["road"])
-                to_s = loc["s"] + 60.0 if loc["s"] + 60.0 < road_len else max(0.0, loc["s"] - 60.0)
-                a = {"EngineType": "pedestrian_agent", "EngineName": name, "EngineTimestep": AGENT_DT,
-                     "Map": xodr, "StartPose": {"x": pose[0], "y": pose[1], "yaw": pose[2]},
-                     "Route": {"to": "%s:%d" % (loc["road"], loc["lane"]), "to_s": to_s},
-                     "Seed": 100 + i, "Length": max(bb.length, 0.3), "Width": max(bb.width, 0.3),
-                     "Height": bb.height}
-                speed = player.states[ent.name].speed
-                if speed > 0:
-                    a["Speed"], a["SpeedSd"] = speed, 0.0
+            a = agent_config(scenario, ent, i, name, odr, player, models, xodr)
             if ctl is not None:
                 a.update(agent_keys(ctl))
             a.update(properties(ent.object))
@@ -430,8 +288,12 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
                         "PythonFileName": os.path.join(HERE, "snapshot.py"),
                         "EngineEnvParams": ["CONVOY_SNAPSHOT_TIMES=" + ",".join("%g" % t for t in snapshots)]})
         tfs.append({"Name": "snapshot_tf", "FileName": os.path.join(HERE, "snapshot_tf.py")})
+    # the StopTrigger's time, but no longer than the ego's route at half its cruise speed or
+    # LONGEST_RUN_S, whichever is longer (as CARLA's route timeout: a stack that cannot finish
+    # its route does not hold the run for a scenario's 20-minute fallback)
     duration = stop_time(scenario)
-    timeout = duration + 0.5 if duration else max(20.0, math.ceil(scored_len / (0.5 * CRUISE)))
+    route_limit = max(20.0, math.ceil(scored_len / (0.5 * CRUISE)))
+    timeout = min(duration + 0.5, max(route_limit, LONGEST_RUN_S)) if duration else route_limit
     config = {
         "SimulationName": "scenario_" + os.path.splitext(base)[0],
         "SimulationDescription": "Generated by python/convoy_scenario/make_config.py from %s" % os.path.abspath(xosc),

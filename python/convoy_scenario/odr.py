@@ -33,7 +33,7 @@ class OdrQuery:
 
     def __init__(self, xodr, bin_dir=None):
         self.xodr = xodr
-        self.map = RoadMap(xodr, bin_dir)
+        self.map = RoadMap.open(xodr, bin_dir)
 
     def ask(self, **request):
         """The reply to one request (dict with "op"); ScenarioError "file: op: error"."""

@@ -27,7 +27,7 @@ def play(path, dt=0.05, max_time=300.0, parameters=None, on_step=None, end_on_co
     "max_time"). As esmini, a storyboard whose stories are all complete goes on until its
     StopTrigger (end_on_complete: it ends then)."""
     scenario = load(path, parameters=parameters or None)
-    roads = RoadMap(scenario.logic_file) if scenario.logic_file else NoRoads()
+    roads = RoadMap.open(scenario.logic_file) if scenario.logic_file else NoRoads()
     player = Player(scenario, roads, [e.name for e in scenario.entities], dt)
     board = Storyboard(scenario, end_on_complete=end_on_complete, resolve_position=player.resolve_xy)
     board.driving_lanes = player.driving_lanes if scenario.logic_file else None

@@ -78,6 +78,9 @@ def _load_file(path):
     return mod
 
 
+_OPENED = {}   # (path, mtime, size) -> RoadMap (RoadMap.open)
+
+
 class RoadMap:
     """One OpenDRIVE map. `bin_dir` (optional) is the Convoy build's bin directory whose
     ../python holds the module."""
@@ -88,6 +91,20 @@ class RoadMap:
 
     def __repr__(self):
         return "RoadMap(%r)" % self.path
+
+    @classmethod
+    def open(cls, path, bin_dir=None):
+        """The map at path, loaded once per process (a RoadMap is immutable): the config
+        generator, the functions and the player of one process share it."""
+        path = os.path.abspath(os.fspath(path))
+        try:
+            st = os.stat(path)
+            key = (path, st.st_mtime_ns, st.st_size)
+        except OSError:
+            return cls(path, bin_dir)   # the loader says what is wrong with the path
+        if key not in _OPENED:
+            _OPENED[key] = cls(path, bin_dir)
+        return _OPENED[key]
 
     @property
     def warnings(self):
