@@ -42,6 +42,8 @@ EGO_ID = EGO_DP[1].split("::")[0] if "::" in EGO_DP[1] else EGO_DP[0]
 TIMEOUT = float(CONFIG.get("SimulationTimeout") or 0.0)
 DT = float(SCENARIO.get("EngineTimestep", 0.05))
 MAP = SCENARIO.get("Map")
+# entities the scenario engine moves itself (its `entities` datapack, docs/scenarios.md)
+PLAYED = "scenario" in (SCENARIO.get("Entities") or {}).values()
 
 STOP_LINES = []
 if LIGHTS is not None:
@@ -73,8 +75,11 @@ def _metrics(time_ns, route, scenario, ego, collisions, lights=None, **agents):
     e = _user(ego)
     if e is not None and not e.get("absent"):
         others = {}
-        for key in sorted(agents):
-            u = _user(agents[key])
+        users = [_user(agents[k]) for k in sorted(agents) if k != "played"]
+        played = agents.get("played")
+        if played is not None and not played.isEmpty():   # the scenario engine's own entities
+            users += [dict(u) for u in played.data.get("users") or []]
+        for u in users:
             if u is None or u.get("absent"):
                 continue
             others[str(u["id"])] = {"class": u["category"], "x": float(u["x"]), "y": float(u["y"]),
@@ -126,5 +131,7 @@ metrics = EngineDataPack(keyword="collisions", id=DataPackIdentifier("collisions
 metrics = EngineDataPack(keyword="ego", id=DataPackIdentifier(EGO_DP[1], EGO_DP[0]))(metrics)
 metrics = EngineDataPack(keyword="scenario", id=DataPackIdentifier("scenario", SCENARIO["EngineName"]))(metrics)
 metrics = EngineDataPack(keyword="route", id=DataPackIdentifier("route", SCENARIO["EngineName"]))(metrics)
+if PLAYED:
+    metrics = EngineDataPack(keyword="played", id=DataPackIdentifier("entities", SCENARIO["EngineName"]))(metrics)
 metrics = SimulationTime(keyword="time_ns")(metrics)
 metrics = TransceiverFunction(SCENARIO["EngineName"])(metrics)

@@ -165,10 +165,13 @@ def route_length(scenario):
     return max(40.0, min(300.0, 0.5 * CRUISE * duration))
 
 
-def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0.0):
+def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0.0, speed=0.0):
+    """The report's smart car as the ego, at `pose` (x, y, yaw), rolling at the ego's Init
+    `speed` (m/s; forward only: a negative one starts it at rest)."""
     x, y, yaw = pose
     out_engines[0]["GazeboSDFModels"] = [{"Name": "smart_car", "File": EGO_MODEL,
-                                          "InitPose": [x, y, z, 0.0, pitch, yaw]}]
+                                          "InitPose": [x, y, z, 0.0, pitch, yaw],
+                                          "InitSpeed": max(0.0, float(speed))}]
     # the smart car's meshes (model://smart_car/...) are found next to its model
     out_engines[0]["EngineEnvParams"] = ["CONVOY_MODEL_PATH=" + os.path.dirname(os.path.dirname(EGO_MODEL))]
     out_engines += [
@@ -199,7 +202,8 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     if ego_fragment == "scenario":
         return build_exact(scenario, xosc, parameters, stop_time)
     if not scenario.logic_file:
-        raise ScenarioError("%s: no RoadNetwork LogicFile: a scenario needs an OpenDRIVE map" % base)
+        raise ScenarioError("%s: no RoadNetwork LogicFile: the stack under test needs an OpenDRIVE "
+                            "map (its world, route and score); --ego scenario plays it without one" % base)
     world_sdf = os.path.abspath(world) if world else world_for(scenario.logic_file)
     if world_sdf is None:
         try:
@@ -243,6 +247,13 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
             if controller_kind(ctl) != "driver" and not properties(ent.object):
                 entity_map[ent.name] = "scenario"   # the default controller: exact control
                 continue
+            if init_pose(scenario, ent.name, player) is None:
+                # a driver model with no start (esmini's SUMO controller stands for SUMO's
+                # traffic): the scenario moves it, if its actions ever place it
+                print("%s: entity %r has a driver-model controller but no Init position: the "
+                      "scenario moves it" % (base, ent.name))
+                entity_map[ent.name] = "scenario"
+                continue
             name = engine_name(ent.name)
             entity_map[ent.name] = name
             a = agent_config(scenario, ent, i, name, odr, player, models, xodr)
@@ -270,7 +281,8 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
         if "GazeboSDFModels" in frag:
             engines[0]["GazeboSDFModels"] = frag["GazeboSDFModels"]
     else:
-        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs, *ego_surface)
+        ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs, *ego_surface,
+                                speed=player.states[ego].speed)
     if has_lights:
         engines.append({"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
                         "Map": xodr, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0})

@@ -22,6 +22,7 @@ from nrp_core import *  # noqa: F401,F403
 from nrp_core.data.nrp_json import JsonDataPack
 from nrp_core.data.nrp_protobuf import RoadUsersDataPack
 
+from convoy_scenario.player import box_collisions
 from convoy_traffic.ego_planner import ego_state, objects_from_road_users
 from convoy_traffic.neighbours import neighbour_datapacks, road_users
 
@@ -84,6 +85,25 @@ def stop_line_object(ego, signals):
     return None
 
 
+_DRAWN = set()   # ids the world has been given
+
+
+def _drawable(users):
+    """The users the world may draw: a road user the scenario puts where another already is
+    (a bike on a truck: the world refuses two boxes that overlap where they first appear) is
+    drawn once it has left the other's box; the planner still gets it."""
+    users = list(users)
+    new = [u for u in users if u.id not in _DRAWN and not u.absent]
+    if new:
+        boxes = {u.id: {"x": u.x, "y": u.y, "yaw": u.yaw, "length": u.length, "width": u.width,
+                        "length_offset": u.length_offset} for u in users if not u.absent}
+        touching = box_collisions(boxes)
+        for u in new:
+            if not any(o in _DRAWN or o < u.id for o in touching.get(u.id, [])):
+                _DRAWN.add(u.id)
+    return [u for u in users if u.id in _DRAWN]
+
+
 def _traffic(**dps):
     lights, ego_dp = dps.get("lights"), dps.get("ego")
     if ego_dp is not None and ego_dp.isEmpty():
@@ -102,7 +122,7 @@ def _traffic(**dps):
         # the world draws road users; a scenario's MiscObjects (category "object") are not
         # drawn, but the planner still gets them as objects
         world = RoadUsersDataPack("agents", WORLD)
-        world.data.users.extend(u for u in agents if u.category in WORLD_CATEGORIES)
+        world.data.users.extend(_drawable(u for u in agents if u.category in WORLD_CATEGORIES))
         out.append(world)
     if PLANNER is not None and ego_dp is not None:
         ego = ego_dp.data

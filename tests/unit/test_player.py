@@ -15,6 +15,7 @@ if PYTHON_DIR not in sys.path:
 
 from convoy_scenario import model as m  # noqa: E402
 from convoy_scenario.player import Player  # noqa: E402
+from convoy_scenario.player_positions import resolve  # noqa: E402
 from convoy_scenario.storyboard import ActionCommand, StepResult  # noqa: E402
 from convoy_scenario.xmltree import ScenarioError  # noqa: E402
 
@@ -44,6 +45,9 @@ class StraightRoads:
         x0 = 0.0 if road == "1" else LENGTH
         y = self._centre(lane) + t
         return x0 + s, y, 0.0, 0.0 if lane < 0 else math.pi, 0.0
+
+    def lanes_at(self, road, s):
+        return [1, -1, -2] if road == "1" else [-1, -2]
 
     def next_lanes(self, road, lane, s):
         if road == "1" and lane < 0:
@@ -210,6 +214,49 @@ class PlayerTest(unittest.TestCase):
             run(p, 0.0, 3.0, first=started(0.0, ("A", lc), ("B", speed(5.0, "cubic", "time", 2.0))))
             return p.world()
         self.assertEqual(once(), once())
+
+
+class PositionsTest(unittest.TestCase):
+    """Positions resolved by the player (player_positions.py)."""
+
+    def setUp(self):
+        sc = scenario([("A", teleport(10.0)), ("A", speed(20.0)), ("B", teleport(100.0, -2))])
+        self.p = Player(sc, StraightRoads(), ["A", "B"])
+
+    def test_relative_lane_position(self):
+        pos = m.RelativeLanePosition("A", -1, ds=15.0, offset=0.5)
+        x, y = self.p.resolve_xy(pos)
+        self.assertAlmostEqual(x, 25.0)
+        self.assertAlmostEqual(y, -5.25 + 0.5)     # one lane to the right (-2), 0.5 m left of its centre
+        pos = m.RelativeLanePosition("A", 1, ds_lane=-5.0)
+        self.assertEqual(resolve(pos, self.p.everyone, StraightRoads())["lane"], 1)   # lane 0 skipped
+
+    def test_road_position_and_dict_round_trip(self):
+        pos = m.RoadPosition("1", 50.0, -4.0)
+        r = resolve(pos, self.p.everyone, StraightRoads())
+        self.assertEqual((r["lane"], round(r["offset"], 6)), (-2, 1.25))   # -4 is in lane -2
+        self.assertEqual(resolve(pos.as_dict(), self.p.everyone, StraightRoads()), r)
+
+    def test_relative_object_position(self):
+        x, y = self.p.resolve_xy(m.RelativeObjectPosition("B", 3.0, 1.0))
+        self.assertAlmostEqual((x, y), (103.0, -5.25 + 1.0))
+
+    def test_unknown_lane_is_an_error(self):
+        with self.assertRaises(ScenarioError):
+            self.p.resolve_xy(m.LanePosition("1", "-7", 5.0))
+
+
+class ControllersTest(unittest.TestCase):
+    def test_kinds(self):
+        from convoy_scenario.controllers import agent_keys, kind
+        self.assertEqual(kind(None), "default")
+        self.assertEqual(kind(m.Controller("ACCController", None, (("timeGap", "1.5"),))), "driver")
+        self.assertEqual(kind(m.Controller("myAcc", None, (("esminiController", "ACCController"),))), "driver")
+        self.assertEqual(kind(m.Controller("convoy.agent")), "driver")
+        self.assertEqual(kind(m.Controller("InteractiveController")), "external")
+        self.assertEqual(kind(m.Controller("somethingElse")), "default")
+        keys = agent_keys(m.Controller("ACCController", None, (("timeGap", "1.5"), ("convoy.v0", "12"))))
+        self.assertEqual(keys, {"T": 1.5, "v0": 12.0})
 
 
 if __name__ == "__main__":
