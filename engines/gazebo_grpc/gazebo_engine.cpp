@@ -4,12 +4,14 @@
 // (world_system.h, world_systems.h): it loads the world, registers the systems, one line
 // each, and forwards to them. Each system's header lists its config keys and datapacks.
 //
-// Config keys of the adapter: GazeboWorldFile, GazeboSDFModels [{Name, File, InitPose}],
-// GazeboRNGSeed (the camera noise), WorldLoadTime (accepted; loading is synchronous),
-// EngineTimestep. The systems, in registration order (the order of their calls):
+// Config keys of the adapter: GazeboWorldFile, GazeboSDFModels [{Name, File, InitPose,
+// InitSpeed}] (model_inserts.h), GazeboRNGSeed (the camera noise), WorldLoadTime (accepted;
+// loading is synchronous), EngineTimestep. The systems, in registration order (the order of their
+// calls):
 //   weather              systems/weather_input.h        <WeatherDataPack> (JSON, written)
 //   traffic_light_state  systems/traffic_light_state.h  <TrafficLightsDataPack> (JSON, written)
 //   joint_controllers    systems/joint_controllers.h    <joint plugin>::<joint>, <model>::<joint>
+//   initial_speeds       systems/initial_speeds.h       (none: GazeboSDFModels' InitSpeed)
 //   brakes               systems/brakes.h               <brake plugin>::<joint>
 //   link_states          systems/link_states.h          <link plugin>::<link>, <model>::<link>
 //   actors               systems/road_user_actors.h     RoadUser(s) datapacks, any name
@@ -19,13 +21,14 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 
 #include "engine/engine.h"
+#include "model_inserts.h"
 #include "systems/brakes.h"
 #include "systems/camera_datapacks.h"
 #include "systems/contacts.h"
 #include "systems/ego_state.h"
+#include "systems/initial_speeds.h"
 #include "systems/joint_controllers.h"
 #include "systems/link_states.h"
 #include "systems/road_user_actors.h"
@@ -37,42 +40,12 @@
 namespace convoy::engines {
 namespace {
 
-Eigen::Isometry3d pose_from_json(const nlohmann::json& j) {
-  std::vector<double> v;
-  if (j.is_array()) {
-    for (const auto& x : j) v.push_back(x.get<double>());
-  } else if (j.is_string()) {
-    std::istringstream in(j.get<std::string>());
-    double x;
-    while (in >> x) v.push_back(x);
-  }
-  if (v.size() != 6 && v.size() != 3) {
-    throw std::runtime_error("InitPose must be [x, y, z] or [x, y, z, roll, pitch, yaw]");
-  }
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-  if (v.size() == 6) {
-    t.linear() = (Eigen::AngleAxisd(v[5], Eigen::Vector3d::UnitZ()) *
-                  Eigen::AngleAxisd(v[4], Eigen::Vector3d::UnitY()) *
-                  Eigen::AngleAxisd(v[3], Eigen::Vector3d::UnitX()))
-                     .toRotationMatrix();
-  }
-  return t;
-}
-
 // The world file and the extra models (GazeboSDFModels), through the parsed-world cache;
 // `log` gets what the load took.
 world::WorldDesc load(const nlohmann::json& config, std::string* log) {
   std::filesystem::path file = config.value("GazeboWorldFile", "");
   if (file.empty()) throw std::runtime_error("GazeboWorldFile is not set");
-  std::vector<world::ModelInsert> extra;
-  for (const auto& m : config.value("GazeboSDFModels", nlohmann::json::array())) {
-    world::ModelInsert insert;
-    insert.name = m.value("Name", "");
-    insert.file = m.value("File", "");
-    if (m.contains("InitPose")) insert.pose = pose_from_json(m["InitPose"]);
-    extra.push_back(insert);
-  }
+  const std::vector<world::ModelInsert> extra = world::read_model_inserts(config);
   const auto t0 = std::chrono::steady_clock::now();
   world::CacheResult cache;
   world::WorldDesc desc = world::load_world_cached(file, extra, &cache);
@@ -98,6 +71,7 @@ class GazeboEngine final : public Engine {
     world_->add<world::WeatherInput>();
     world_->add<world::TrafficLightState>();  // before the actors, which take any JSON
     world_->add<world::JointControllers>();
+    world_->add<world::InitialSpeeds>();  // after the joint controllers: holds the wheels' spin
     world_->add<world::Brakes>();
     world_->add<world::LinkStates>();
     world_->add<world::RoadUserActors>();

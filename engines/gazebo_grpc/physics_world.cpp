@@ -593,6 +593,25 @@ void PhysicsWorld::set_joint_position(int index, double position) {
   joints_[index].joint->setVelocity(0, 0);
 }
 
+void PhysicsWorld::set_joint_velocity(int index, double velocity) {
+  joints_[index].joint->setVelocity(0, velocity);
+}
+
+bool PhysicsWorld::set_model_velocity(const std::string& model, const Eigen::Vector3d& velocity) {
+  auto it = skeleton_by_model_.find(model);
+  if (it == skeleton_by_model_.end() || !it->second->isMobile()) return false;
+  dd::Skeleton& skel = *it->second;
+  skel.resetVelocities();
+  bool moved = false;
+  for (size_t t = 0; t < skel.getNumTrees(); ++t) {
+    if (auto* free = dynamic_cast<dd::FreeJoint*>(skel.getRootJoint(t))) {
+      free->setLinearVelocity(velocity);  // of the root body's origin, in the world frame
+      moved = true;
+    }
+  }
+  return moved;
+}
+
 int PhysicsWorld::link_index(const std::string& name) const {
   auto it = link_by_name_.find(name);
   return it == link_by_name_.end() ? -1 : it->second;

@@ -42,6 +42,12 @@ class PhysicsWorld {
   void set_joint_effort(int index, double effort);
   // Moves the joint (first axis) to `position`, at rest; for initial conditions.
   void set_joint_position(int index, double position);
+  // Sets the joint's (first axis) velocity; for initial conditions.
+  void set_joint_velocity(int index, double velocity);
+  // Sets every body of a moving model translating at `velocity` (m/s, world frame), not
+  // turning: the free joints of its roots move, its other joints rest. False if the model
+  // has no moving skeleton. For initial conditions.
+  bool set_model_velocity(const std::string& model, const Eigen::Vector3d& velocity);
 
   // Links by scoped name (model::link); -1 if unknown.
   int link_index(const std::string& name) const;

@@ -180,11 +180,14 @@ inline std::string class_of(const ModelDesc& m) {
 // (a road mesh on a ground plane). It has no ground truth and makes no collision records.
 bool is_ground(const ModelDesc& m);
 
-// A model added by the engine config (GazeboSDFModels).
+// A model added by the engine config (GazeboSDFModels, read by model_inserts.h).
 struct ModelInsert {
   std::string name;
   std::filesystem::path file;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  // m/s along the pose's x axis at the start (InitSpeed). Not part of the description:
+  // load_world and its cache ignore it; systems/initial_speeds.h sets the model moving.
+  double init_speed = 0;
 };
 
 // Loads the world file (plus extra models). `model://` URIs are looked up in

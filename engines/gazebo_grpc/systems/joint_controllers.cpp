@@ -71,13 +71,18 @@ void JointControllers::update(double dt) {
   }
 }
 
-// The SDF's targets again, no feed-forward, the PIDs from rest.
+// The initial targets again, no feed-forward, the PIDs from rest.
 void JointControllers::reset() {
   for (auto& c : controllers_) {
     c.target = c.initial_target;
     c.feed_forward = 0;
     c.pid.reset();
   }
+}
+
+void JointControllers::hold_velocity(int joint, double velocity) {
+  for (auto& c : controllers_)
+    if (c.joint == joint && c.velocity) c.target = c.initial_target = velocity;
 }
 
 double JointControllers::target(const std::string& name) const {

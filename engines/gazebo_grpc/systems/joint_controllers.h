@@ -34,6 +34,9 @@ class JointControllers final : public WorldSystem {
 
   // The target of the controller of datapack `name` (NaN: no such controller).
   double target(const std::string& name) const;
+  // The velocity controllers of physics joint `joint` hold `velocity` from now on and after a
+  // reset, in place of the SDF's Target (a wheel spinning from the start, initial_speeds.h).
+  void hold_velocity(int joint, double velocity);
 
  private:
   struct Controller {
@@ -42,7 +45,7 @@ class JointControllers final : public WorldSystem {
     double target;
     JointPid pid;
     double feed_forward;
-    double initial_target;  // the SDF's Target
+    double initial_target;  // the SDF's Target, or hold_velocity()'s
   };
   const WorldContext* ctx_ = nullptr;
   const Brakes* brakes_ = nullptr;  // null: no brakes system
