@@ -193,8 +193,9 @@ class LaneChangeMove:
         if self.param >= self.length - SMALL or abs(offset - self.goal) < SMALL:
             self.done = True
             st.h_rel = self.base
-        elif math.hypot(st.x - x0, st.y - y0) > SMALL:
-            # the heading of the step's path (its lateral part from the shape)
+        elif along > SMALL and math.hypot(st.x - x0, st.y - y0) > SMALL:
+            # the heading of the step's path (its lateral part from the shape); a step too
+            # slow to go forward (lateral only) keeps the heading: a car does not turn sideways
             lane_h = self.roads.lane_pose(st.road, st.lane, st.s, st.offset)[3]
             path_h = math.atan2(st.y - y0, st.x - x0) + (math.pi if st.speed < 0 else 0.0)
             st.h_rel = angle_diff(path_h, lane_h)

@@ -227,7 +227,9 @@ class _Reader(EntitiesReader, CatalogReader, PositionsReader, ActionsReader, Glo
         for name in overrides:
             if name not in declared:
                 raise ScenarioError("%s: parameter override %s: the file declares no global "
-                                    "parameter %s" % (os.path.basename(self.path), name, name))
+                                    "parameter %s (it declares: %s)" % (
+                                        os.path.basename(self.path), name, name,
+                                        ", ".join(sorted(n for n in declared if n)) or "none"))
         scope = self.declare(decls, Scope(), overrides)
         self.global_types = {k: t for k, (t, _) in scope.values.items()}
         self.global_scope = scope
