@@ -20,6 +20,7 @@ import math
 
 from . import geometry as g
 from . import model as m
+from .actions import shape_value
 
 BIG = 1e10
 SPRING = 0.4
@@ -48,17 +49,6 @@ def shape_duration(shape, span, acc):
     return math.sqrt(6.0 * abs(span) / acc)
 
 
-def _shape(shape, tau):
-    tau = max(0.0, min(1.0, tau))
-    if shape == "step":
-        return 1.0
-    if shape == "linear":
-        return tau
-    if shape == "cubic":
-        return tau * tau * (3.0 - 2.0 * tau)
-    return (1.0 - math.cos(math.pi * tau)) / 2.0
-
-
 class LaneOffsetMove:
     def __init__(self, spec, st, states, roads):
         self.spec, self.roads = spec, roads
@@ -83,10 +73,10 @@ class LaneOffsetMove:
         if not self.ok:
             return ()
         tau = 1.0 if self.duration <= 0 else self.elapsed / self.duration
-        value = self.start + (self.goal - self.start) * _shape(self.spec.shape, tau)
+        value = self.start + (self.goal - self.start) * shape_value(self.spec.shape, tau)
         slope = 0.0
         if 0 < self.duration and tau < 1.0:
-            nxt = self.start + (self.goal - self.start) * _shape(self.spec.shape, tau + dt / self.duration)
+            nxt = self.start + (self.goal - self.start) * shape_value(self.spec.shape, tau + dt / self.duration)
             slope = (nxt - value) / dt
         st.offset = value
         fwd = self.roads.lane_info(st.road, st.lane, st.s)["forward"]
