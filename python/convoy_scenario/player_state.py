@@ -16,6 +16,9 @@ PROBE_DS = 0.5      # m: probe for the distance per unit s at an offset
 PROBE_MARGIN = 1e-4  # m: probes stay this far inside a lane section
 END_EPS = 1e-6
 ENTRY_NUDGE = 1e-6  # m
+# lane types a vehicle may drive on (OffroadCondition: off these)
+ROAD_TYPES = ("driving", "entry", "exit", "onRamp", "offRamp", "connectingRamp", "bidirectional",
+              "stop", "parking", "shoulder", "bus", "taxi", "HOV", "restricted", "biking")
 
 
 def wrap(a):
@@ -59,6 +62,7 @@ class EntityState:
         self.vx = self.vy = 0.0
         self.ax = self.ay = 0.0
         self.road_t = 0.0
+        self.offroad = False
         self.odometer = 0.0
         self.end_of_road = False
         self.collisions = []      # entities whose boxes overlap this one's (after a step)
@@ -72,7 +76,7 @@ class EntityState:
              "length": self.length, "width": self.width, "length_offset": self.length_offset,
              "odometer": self.odometer, "end_of_road": self.end_of_road,
              "collisions": list(self.collisions),
-             "offroad": self.road is None}
+             "offroad": self.road is None or self.offroad}
         if self.road is not None:
             d.update(road=self.road, lane=self.lane, s=self.s, t=self.road_t)
         return d
@@ -111,9 +115,23 @@ class LaneMover:
             return
         x, y, z, heading, pitch = self.roads.lane_pose(st.road, st.lane, st.s, st.offset)
         st.x, st.y, st.z = x, y, z
-        st.road_t = self.roads.lane_info(st.road, st.lane, st.s)["centre_t"] + st.offset
+        info = self.roads.lane_info(st.road, st.lane, st.s)
+        st.road_t = info["centre_t"] + st.offset
         st.h = wrap(heading + st.h_rel)
         st.pitch = pitch
+        st.offroad = not self._on_road_surface(st, info)
+
+    def _on_road_surface(self, st, own):
+        """Whether the entity's reference point is on a lane of a road type (its own lane when
+        its offset keeps it there, else the lane of its road at its t): an OffroadCondition
+        holds while it is not (a LaneOffset beyond the road's edge)."""
+        if abs(st.offset) <= own["width"] / 2.0 + 1e-9:
+            return own["type"] in ROAD_TYPES
+        for lane in self.roads.lanes_at(st.road, st.s):
+            info = self.roads.lane_info(st.road, lane, st.s)
+            if abs(st.road_t - info["centre_t"]) <= info["width"] / 2.0 + 1e-9:
+                return info["type"] in ROAD_TYPES
+        return False
 
     def lane_forward(self, st):
         return self.roads.lane_info(st.road, st.lane, st.s)["forward"]
