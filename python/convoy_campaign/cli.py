@@ -10,19 +10,25 @@ command) is written to OUT/plan.json; the backend runs the tasks (local.py, slur
 OUT/campaign.json (state.py); then OUT/leaderboard.csv, OUT/results.json (results.py) and
 OUT/report.html (report.py) are written, and a line per failed task is printed.
 
+Restart: the same command with the same --out runs only what is missing (state.py, local.py,
+slurm.py). Every file the campaign keeps is written atomically (atomic.py); OUT/campaign.lock
+keeps a second campaign process off the same --out; SIGTERM is taken as Ctrl-C (exit 130)
+wherever the campaign is.
+
 Exit codes: 0 every task succeeded; 1 a task failed (the leaderboard and report are still
 written); 2 bad input (a missing suite folder or config, an unknown weather, no sbatch for
---backend slurm, ...: one message naming the file or option); 3 Slurm failed (sbatch refused
-the array, squeue/scontrol failing for 2 minutes); 130 interrupted (with --backend slurm the
-arrays keep running: the same command follows them again).
+--backend slurm, another campaign running in --out, ...: one message naming the file or
+option); 3 Slurm failed (sbatch refused the array, squeue/scontrol failing for 2 minutes); 130
+interrupted (with --backend slurm the arrays keep running: the same command follows them
+again).
 """
 
 import argparse
-import json
 import os
+import signal
 import sys
 
-from . import local, report, results, slurm, worker
+from . import atomic, local, report, results, slurm, worker
 from .state import CampaignState, StateError
 from .suite import DEFAULT_WEATHERS, SuiteError, load_suite, make_plan, parse_weathers
 
@@ -71,6 +77,23 @@ def _error(msg):
     return 2
 
 
+def _raise_interrupt(signum, _frame):
+    raise KeyboardInterrupt("signal %d" % signum)
+
+
+_lock_fd = None  # OUT/campaign.lock, held while this process runs the campaign
+
+
+def _lock_out(out):
+    global _lock_fd
+    path = os.path.join(out, "campaign.lock")
+    try:
+        _lock_fd = atomic.try_lock(path)
+    except atomic.Busy as e:
+        raise SuiteError("%s is in use by another campaign process (pid %s, %s); wait for it to "
+                         "end or stop it" % (out, e.args[0] or "unknown", path)) from None
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
     if args.task is not None or args.plan is not None:
@@ -79,6 +102,17 @@ def main(argv=None):
         return worker.main(args.plan, args.task)
     if args.suite is None:
         return _error("no SUITE_DIR given (see --help)")
+    old_term = signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        return _campaign(args)
+    except KeyboardInterrupt:
+        print("campaign: interrupted; run the same command to continue", file=sys.stderr)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, old_term)
+
+
+def _campaign(args):
     try:
         if args.seeds < 1:
             raise SuiteError("--seeds: must be at least 1, got %d" % args.seeds)
@@ -100,22 +134,20 @@ def main(argv=None):
             "campaigns", os.path.basename(os.path.normpath(os.path.abspath(args.suite)))))
         plan = make_plan(entries, args.seeds, weathers, out, convoy, args.seconds, args.record)
         os.makedirs(out, exist_ok=True)
+        _lock_out(out)
         state = CampaignState.open(out, plan, args.backend)
     except (SuiteError, StateError) as e:
         return _error(e)
     except OSError as e:
         return _error("%s: %s" % (e.filename or "--out", e.strerror))
 
-    plan_path = os.path.join(out, "plan.json")
-    with open(plan_path + ".tmp", "w") as f:
-        json.dump(plan, f, indent=1)
-        f.write("\n")
-    os.replace(plan_path + ".tmp", plan_path)
-    state.save()
+    plan_path = atomic.write_json(os.path.join(out, "plan.json"), plan, indent=1)
     n = len(plan["tasks"])
     print("campaign: %d tasks (%d entries x %d seeds x %d weathers), backend %s, output %s"
           % (n, len(entries), args.seeds, len(weathers), args.backend, out), flush=True)
     log = lambda msg: print(msg, flush=True)
+    state.check_done(plan, log=log)
+    state.save()
     try:
         if args.backend == "local":
             local.run(plan, state, args.workers, log=log)

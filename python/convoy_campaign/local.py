@@ -6,6 +6,13 @@ an earlier invocation with the same --out runs again) runs through worker.run_ta
 once. Tasks start in index order. campaign.json is saved as each task starts and ends. A
 failed task is not retried within the invocation.
 
+Restart after the campaign was killed (SIGKILL, a lost machine): a task left "running" whose
+run folder has the task.json of that attempt ended before the campaign stopped and is taken as
+it is (state.adopt_finished); any other is run again from an empty run folder (its partial one
+moved to OUT/previous/). Its `convoy run`, orphaned by the kill, got SIGTERM from the kernel
+(the worker's parent-death signal) and still holds the task's lock until it has ended; the new
+attempt waits for that (worker.py).
+
 Interrupted (Ctrl-C, or SIGTERM to the campaign alone), it starts no more tasks, passes the
 signal on to the runs in flight (each ends as `convoy run` does on Ctrl-C, its run folder
 kept), waits for them, and re-raises KeyboardInterrupt: the tasks not run stay pending for the
@@ -26,6 +33,8 @@ def _raise_interrupt(signum, _frame):
 def run(plan, state, workers, log=print):
     lock = threading.Lock()
     stop = threading.Event()
+    state.adopt_finished(plan, log=log)
+    state.save()
     todo = [t["index"] for t in state.tasks if t["state"] != "done"]
 
     def one(index):
@@ -36,8 +45,9 @@ def run(plan, state, workers, log=print):
             t["attempts"] += 1
             t["state"] = "running"
             t["job_id"] = "local"
+            attempt = t["attempts"]
             state.save()
-        record = worker.run_task(plan, index, job_id="local")
+        record = worker.run_task(plan, index, job_id="local", attempt=attempt)
         with lock:
             state.finish(index, record["exit_code"], record["wall_s"])
             state.save()

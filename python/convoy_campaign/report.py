@@ -29,6 +29,7 @@ import math
 import os
 import urllib.parse
 
+from . import atomic
 from .results import INFRACTION_KINDS, infraction_counts, parameters_label
 
 LOG_TAIL_LINES = 40
@@ -312,7 +313,5 @@ def _tail(path, lines=LOG_TAIL_LINES):
 
 
 def write(out_dir, records, plan, scorer_missing=None):
-    path = os.path.join(out_dir, "report.html")
-    with open(path, "w") as f:
-        f.write(render(records, plan, scorer_missing))
-    return path
+    return atomic.write_text(os.path.join(out_dir, "report.html"),
+                             render(records, plan, scorer_missing))

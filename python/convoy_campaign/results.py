@@ -24,8 +24,11 @@ results.json: the per-task records above, in the same order.
 """
 
 import csv
+import io
 import json
 import os
+
+from . import atomic
 
 INFRACTION_KINDS = ("collision_pedestrian", "collision_vehicle", "collision_static", "red_light",
                     "stop_sign", "scenario_timeout", "yield_emergency", "min_speed", "off_route",
@@ -126,17 +129,16 @@ def leaderboard_rows(records):
 
 
 def write(out_dir, records):
-    """Writes leaderboard.csv and results.json into out_dir; returns their paths."""
-    board = os.path.join(out_dir, "leaderboard.csv")
-    with open(board, "w", newline="") as f:
-        w = csv.writer(f, lineterminator="\n")
-        w.writerow(COLUMNS)
-        for row in leaderboard_rows(records):
-            w.writerow([_cell(row[c]) for c in COLUMNS])
-    results = os.path.join(out_dir, "results.json")
-    with open(results, "w") as f:
-        json.dump(records, f, indent=1, sort_keys=True, default=_json_default)
-        f.write("\n")
+    """Writes leaderboard.csv and results.json into out_dir (each atomically: the old file or
+    the new one, never half of one); returns their paths."""
+    text = io.StringIO()
+    w = csv.writer(text, lineterminator="\n")
+    w.writerow(COLUMNS)
+    for row in leaderboard_rows(records):
+        w.writerow([_cell(row[c]) for c in COLUMNS])
+    board = atomic.write_text(os.path.join(out_dir, "leaderboard.csv"), text.getvalue())
+    results = atomic.write_json(os.path.join(out_dir, "results.json"), records, indent=1,
+                                sort_keys=True, default=_json_default)
     return board, results
 
 

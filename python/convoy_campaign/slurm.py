@@ -3,10 +3,13 @@
 Submission. One batch script, OUT/slurm/campaign.sbatch, runs the worker entry point
 (`/usr/bin/python3 tools/campaign/campaign.py --task $SLURM_ARRAY_TASK_ID --plan
 OUT/plan.json`); array index = task index. The tasks not yet submitted go in one array,
-`sbatch --parsable --array=<indices>%<workers> --job-name convoy-campaign --output
-OUT/slurm/%A_%a.out --chdir OUT OUT/slurm/campaign.sbatch`, which runs at most `workers` of them
+`sbatch --parsable --array=<indices>%<workers> --job-name convoy-campaign --comment
+convoy-campaign:TOKEN --output OUT/slurm/%A_%a.out --chdir OUT OUT/slurm/campaign.sbatch`
+(TOKEN: see Restart), which runs at most `workers` of them
 at once. Once no array is active, the tasks that failed with fewer than MAX_ATTEMPTS (2)
-attempts go in a second array of only their indices: a failed task is resubmitted once.
+attempts in this invocation go in a second array of only their indices: a failed task is
+resubmitted once. A task that had failed before this invocation started counts as not yet
+submitted (the same command runs failed tasks again, as the local backend does).
 
 Following, every `poll_s` seconds, per active array: `squeue -h -r -j JOBID -o "%K %T"` lists
 its tasks still queued or running. A task that has left the queue has ended: its exit code and
@@ -22,20 +25,36 @@ at the next poll, up to `patience_s` seconds in a row, then raised as SlurmError
 Restart. All of this lives in OUT/campaign.json (state.py): job ids, each task's attempts and
 state, saved after every change, so that the same command with the same --out, after the
 driver was stopped, follows the arrays still active and submits only what has not been run.
-(The one gap: a driver stopped between sbatch's answer and the save resubmits that array's
-tasks.)
+A submission is recorded before sbatch runs: campaign.json's "submitting" holds a fresh token
+and the indices, and the array carries the token twice, as its comment (`sbatch --comment
+convoy-campaign:TOKEN`) and in its tasks' environment ($CONVOY_CAMPAIGN_SUBMISSION, which the
+worker writes into task.json). Once sbatch has answered, the array and the tasks' new state
+replace "submitting" in one save (SIGINT and SIGTERM wait from sbatch's start to that save).
+A driver stopped between the two (SIGKILL) finds "submitting" at its restart and looks for the
+array before it submits anything: `squeue -h -t all -o "%F %k"` (every job slurmctld still
+knows, with its comment), else a task.json of those tasks carrying the token (the array ran
+and Slurm forgot it). Found, it is followed as if the save had happened; not found, sbatch
+never took it, and it is submitted again. (What remains: sbatch still talking to slurmctld when the restarted driver
+looks, i.e. a restart within sbatch's own few milliseconds.)
 
 The commands run through a `runner` (subprocess.run by default) so that tests can fake Slurm.
 """
 
-import json
 import os
 import re
+import signal
 import subprocess
 import time
+import uuid
+from contextlib import contextmanager
+
+from . import atomic
+from .state import read_task_record
 
 MAX_ATTEMPTS = 2
 JOB_NAME = "convoy-campaign"
+COMMENT_PREFIX = "convoy-campaign:"
+TOKEN_ENV = "CONVOY_CAMPAIGN_SUBMISSION"
 
 
 class SlurmError(Exception):
@@ -61,23 +80,35 @@ class Slurm:
     def __init__(self, runner=subprocess.run):
         self.runner = runner
 
-    def _run(self, argv):
+    def _run(self, argv, env=None):
         try:
             return self.runner(argv, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, timeout=60)
+                               stderr=subprocess.PIPE, text=True, timeout=60, env=env)
         except (OSError, subprocess.TimeoutExpired) as e:
             raise SlurmError("%s: %s" % (argv[0], e)) from None
 
-    def submit(self, script, indices, throttle, out_dir):
+    def submit(self, script, indices, throttle, out_dir, token):
         argv = ["sbatch", "--parsable", "--array=%s%%%d" % (array_spec(indices), throttle),
-                "--job-name", JOB_NAME, "--output", os.path.join(out_dir, "slurm", "%A_%a.out"),
+                "--job-name", JOB_NAME, "--comment", COMMENT_PREFIX + token,
+                "--output", os.path.join(out_dir, "slurm", "%A_%a.out"),
                 "--chdir", out_dir, script]
-        r = self._run(argv)
+        r = self._run(argv, env=dict(os.environ, **{TOKEN_ENV: token}))
         job = r.stdout.strip().split(";")[0]
         if r.returncode != 0 or not job.isdigit():
             raise SlurmError("%s failed (exit %d): %s" % (" ".join(argv), r.returncode,
                                                           (r.stderr or r.stdout).strip()))
         return job
+
+    def find(self, token):
+        """The job id of the array submitted with `token` that slurmctld still knows, or None."""
+        r = self._run(["squeue", "-h", "-t", "all", "-o", "%F %k"])
+        if r.returncode != 0:
+            raise SlurmError("squeue failed (exit %d): %s" % (r.returncode, r.stderr.strip()))
+        for line in r.stdout.splitlines():
+            job, _, comment = line.strip().partition(" ")
+            if comment.strip() == COMMENT_PREFIX + token and job.isdigit():
+                return job
+        return None
 
     def queued(self, job_id):
         """{task index: Slurm state} of the array's tasks still in the queue."""
@@ -118,32 +149,80 @@ class Slurm:
 def write_script(plan, plan_path, campaign_py):
     path = os.path.join(plan["out"], "slurm", "campaign.sbatch")
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, "w") as f:
-        f.write("#!/bin/sh\n"
-                "# Written by tools/campaign/campaign.py: one task of the campaign in %s\n"
-                "#SBATCH --cpus-per-task=1\n"
-                "exec /usr/bin/python3 %s --task \"$SLURM_ARRAY_TASK_ID\" --plan %s\n" % (
-                    plan["out"], campaign_py, plan_path))
+    atomic.write_text(path, "#!/bin/sh\n"
+                      "# Written by tools/campaign/campaign.py: one task of the campaign in %s\n"
+                      "#SBATCH --cpus-per-task=1\n"
+                      "exec /usr/bin/python3 %s --task \"$SLURM_ARRAY_TASK_ID\" --plan %s\n" % (
+                          plan["out"], campaign_py, plan_path))
     os.chmod(path, 0o755)
     return path
 
 
 def _task_record(task, job_id):
+    rec = read_task_record(task)
+    return rec if rec is not None and str(rec.get("job_id")) == str(job_id) else None
+
+
+@contextmanager
+def _signals_held():
+    """SIGINT and SIGTERM wait until the block ends (a state change and its save go whole)."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
     try:
-        with open(os.path.join(task["run_dir"], "task.json")) as f:
-            rec = json.load(f)
-    except (OSError, ValueError):
-        return None
-    return rec if str(rec.get("job_id")) == str(job_id) else None
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _submitted(state, job, batch, attempt):
+    """The array `job` of `batch` into the state, replacing the intent, in one save."""
+    with _signals_held():
+        state.arrays.append({"job_id": job, "indices": batch, "attempt": attempt,
+                             "finished": False})
+        for i in batch:
+            t = state.tasks[i]
+            t.update(state="queued", job_id=job, exit_code=None, wall_s=None, reason=None)
+            t["attempts"] += 1
+        state.doc.pop("submitting", None)
+        state.save()
+
+
+def _resolve_intent(plan, state, slurm, log):
+    """A submission recorded but not saved as done (the driver stopped in between): find its
+    array (squeue by comment, else a task.json with its token) or drop it."""
+    intent = state.doc.get("submitting")
+    if not intent:
+        return
+    token, batch = intent["token"], intent["indices"]
+    job = slurm.find(token)
+    where = "squeue, comment %s%s" % (COMMENT_PREFIX, token)
+    if job is None:
+        for i in batch:
+            rec = read_task_record(plan["tasks"][i])
+            if rec is not None and rec.get("submission") == token and rec.get("job_id"):
+                job, where = str(rec["job_id"]), "task.json of %s" % rec.get("name")
+                break
+    if job is None:
+        with _signals_held():
+            state.doc.pop("submitting", None)
+            state.save()
+        log("campaign: the array being submitted when the campaign stopped is not in Slurm; "
+            "submitting its tasks again")
+        return
+    _submitted(state, job, batch, intent["attempt"])
+    log("campaign: found job array %s, submitted when the campaign stopped (%s): %s" % (
+        job, where, array_spec(batch)))
 
 
 def run(plan, state, workers, plan_path, campaign_py, slurm=None, poll_s=1.0, patience_s=120.0,
         log=print):
     slurm = slurm or Slurm()
     script = write_script(plan, plan_path, campaign_py)
+    before = {t["index"]: t["attempts"] for t in state.tasks}  # attempts of earlier invocations
     trouble_since = None
     while True:
         try:
+            _resolve_intent(plan, state, slurm, log)
             _follow(plan, state, slurm, log)
             trouble_since = None
         except SlurmError as e:
@@ -154,21 +233,21 @@ def run(plan, state, workers, plan_path, campaign_py, slurm=None, poll_s=1.0, pa
             time.sleep(poll_s)
             continue
         if not any(not a["finished"] for a in state.arrays):
-            pending = [t["index"] for t in state.tasks if t["state"] == "pending"]
-            retry = [t["index"] for t in state.tasks
-                     if t["state"] == "failed" and t["attempts"] < MAX_ATTEMPTS]
+            pending = [t["index"] for t in state.tasks if t["state"] == "pending" or (
+                t["state"] == "failed" and t["attempts"] == before[t["index"]])]
+            retry = [t["index"] for t in state.tasks if t["state"] == "failed"
+                     and t["attempts"] - before[t["index"]] < MAX_ATTEMPTS]
             batch = pending or retry
             if not batch:
                 return
-            job = slurm.submit(script, batch, workers, plan["out"])
             attempt = 1 + max(state.tasks[i]["attempts"] for i in batch)
-            state.arrays.append({"job_id": job, "indices": batch, "attempt": attempt,
-                                 "finished": False})
-            for i in batch:
-                t = state.tasks[i]
-                t.update(state="queued", job_id=job, exit_code=None, wall_s=None, reason=None)
-                t["attempts"] += 1
+            token = uuid.uuid4().hex
+            state.doc["submitting"] = {"token": token, "indices": batch, "attempt": attempt,
+                                       "time": time.strftime("%Y-%m-%dT%H:%M:%S")}
             state.save()
+            with _signals_held():  # Ctrl-C waits for sbatch's answer and its save
+                job = slurm.submit(script, batch, workers, plan["out"], token)
+                _submitted(state, job, batch, attempt)
             log("campaign: submitted job array %s (%s tasks%s): %s" % (
                 job, len(batch), ", resubmitted" if batch is retry else "", array_spec(batch)))
         time.sleep(poll_s)

@@ -11,14 +11,24 @@ A task's "state" is "pending" (not yet submitted), "queued" (submitted, waiting)
 why). "attempts" counts its submissions; "job_id" is the Slurm array (or "local") of the last
 one. "arrays" lists the Slurm job arrays submitted, in order (empty for the local backend).
 
-The file is rewritten whole (written to a temporary file, then renamed) after every change.
-A campaign.json written for another plan (other entries, seeds, weathers, --seconds or
-convoy) or another backend is refused with a message saying so.
+The file is rewritten whole after every change, atomically (atomic.py: a temporary file,
+fsync, rename): a campaign killed at any point leaves the last saved state. A campaign.json
+written for another plan (other entries, seeds, weathers, --seconds or convoy) or another
+backend is refused with a message saying so.
+
+On a restart, check_done() holds "done" to its proof: a task is done only when its run folder
+has a task.json with exit code 0 (the worker writes it last, after the run has ended); a task
+marked done without one (its folder removed or replaced by hand) is pending again. With the
+local backend, adopt_finished() takes a task that was running when the campaign stopped and
+whose task.json of that very attempt is there (the run ended, the campaign was stopped before
+it saved that): it is not run again.
 """
 
 import hashlib
 import json
 import os
+
+from . import atomic
 
 FINAL_STATES = ("done", "failed")
 
@@ -75,11 +85,32 @@ class CampaignState:
                           "arrays": [], "tasks": tasks})
 
     def save(self):
-        tmp = self.path + ".tmp"
-        with open(tmp, "w") as f:
-            json.dump(self.doc, f, indent=1, sort_keys=True)
-            f.write("\n")
-        os.replace(tmp, self.path)
+        atomic.write_json(self.path, self.doc, indent=1, sort_keys=True)
+
+    def check_done(self, plan, log=print):
+        """Done tasks without the task.json of a successful run become pending again."""
+        for t, task in zip(self.tasks, plan["tasks"]):
+            if t["state"] != "done":
+                continue
+            rec = read_task_record(task)
+            if rec is None or rec.get("exit_code") != 0:
+                log("campaign: %s: marked done, but %s is %s; it runs again" % (
+                    t["name"], os.path.join(task["run_dir"], "task.json"),
+                    "missing" if rec is None else "not a successful run's"))
+                t.update(state="pending", exit_code=None, wall_s=None, reason=None)
+
+    def adopt_finished(self, plan, log=print):
+        """Local backend: a task left "running" whose run folder holds the task.json of that
+        attempt ended; its record is taken instead of running it again."""
+        for t, task in zip(self.tasks, plan["tasks"]):
+            if t["state"] not in ("running", "queued"):
+                continue
+            rec = read_task_record(task)
+            if rec is None or rec.get("job_id") != "local" or rec.get("attempt") != t["attempts"]:
+                continue
+            self.finish(t["index"], rec.get("exit_code"), rec.get("wall_s"))
+            log("campaign: %s: ended before the campaign stopped (exit %s, %s)" % (
+                t["name"], rec.get("exit_code"), os.path.join(task["run_dir"], "task.json")))
 
     def finish(self, index, exit_code, wall_s=None, reason=None):
         t = self.tasks[index]
@@ -90,3 +121,13 @@ class CampaignState:
 
     def failed(self):
         return [t for t in self.tasks if t["state"] == "failed"]
+
+
+def read_task_record(task):
+    """The run folder's task.json (dict), None when missing or unreadable."""
+    try:
+        with open(os.path.join(task["run_dir"], "task.json")) as f:
+            rec = json.load(f)
+    except (OSError, ValueError):
+        return None
+    return rec if isinstance(rec, dict) else None

@@ -68,6 +68,7 @@ class CampaignTest(E2ETestCase):
 
     def tearDown(self):
         print("\n[%s: %.1f s]" % (self._testMethodName, time.monotonic() - self.t0), end=" ")
+        super().tearDown()  # its temp folder and any process left in it
 
     def assertExit(self, r, code):
         self.assertEqual(r.returncode, code, "exit %d\n--- stdout ---\n%s\n--- stderr ---\n%s" % (

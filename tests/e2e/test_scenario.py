@@ -299,7 +299,9 @@ class Campaign(ScenarioCase):
             with open(os.path.join(suite, name + ".xosc"), "w") as f:
                 f.write(text)
         out = os.path.join(self.dir, "campaign")
-        p = subprocess.run([CONVOY, "campaign", suite, "--seeds", "2", "--workers", "2", "--out", out],
+        # 10 simulated seconds a run: the campaign's plumbing, not the scenarios, is under test
+        p = subprocess.run([CONVOY, "campaign", suite, "--seeds", "2", "--workers", "2", "--out", out,
+                            "--seconds", "10"],
                            cwd=self.dir, capture_output=True, text=True, timeout=600)
         self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
         with open(os.path.join(out, "leaderboard.csv")) as f:
