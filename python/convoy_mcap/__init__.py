@@ -10,8 +10,11 @@
 `untag(value)` turns them into Python values), bytes for protobuf ones (with `schema_name`,
 the message's full type name, and `rec.schemas[...]` its FileDescriptorSet).
 
+A file cut short (a killed run, a full disk) reads up to its last whole chunk: `rec.complete`
+is False, `rec.incomplete` says where it ends, and a McapIncompleteWarning is issued.
+
     /usr/bin/python3 -m convoy_mcap FILE.mcap      # topics, counts, metadata
 """
-from .reader import McapError, Message, Recording, untag
+from .reader import McapError, McapIncompleteWarning, Message, Recording, untag
 
-__all__ = ["McapError", "Message", "Recording", "untag"]
+__all__ = ["McapError", "McapIncompleteWarning", "Message", "Recording", "untag"]

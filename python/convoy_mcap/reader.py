@@ -3,6 +3,7 @@ import base64
 import json
 import math
 import struct
+import warnings
 import zlib
 from collections import namedtuple
 
@@ -20,6 +21,10 @@ Message = namedtuple("Message", "topic channel sequence log_time publish_time en
 
 class McapError(Exception):
     """A malformed file; the message names the file and the byte offset."""
+
+
+class McapIncompleteWarning(UserWarning):
+    """A file cut short (a killed writer, a full disk): read up to its last whole record."""
 
 
 class _Fields:
@@ -78,23 +83,40 @@ def _zstd_decompress(data, size, fail):
         fail("zstd chunk does not decompress: %s" % e)
 
 
-def _records(buf, start, end, where):
+class _CutShort(Exception):
+    """The file ends inside a record of the data section (at byte `at`)."""
+
+    def __init__(self, what, at):
+        super().__init__(what)
+        self.what, self.at = what, at
+
+
+def _records(buf, start, end, where, file_end=False):
+    """(opcode, offset, content) of the records in buf[start:end]. A record running past the
+    end is malformed, or, with `file_end` (the end of the file), the file is cut short."""
     p = start
     while p < end:
         if p + 9 > end:
-            raise McapError("%s: record header cut short at byte %d" % (where, p))
+            what = "%s: record header cut short at byte %d" % (where, p)
+            raise _CutShort(what, p) if file_end else McapError(what)
         op = buf[p]
         (n,) = struct.unpack_from("<Q", buf, p + 1)
         if p + 9 + n > end:
-            raise McapError("%s: record %s of %d bytes at byte %d runs past the end"
-                            % (where, OP.get(op, hex(op)), n, p))
+            what = "%s: record %s of %d bytes at byte %d runs past the end" % (
+                where, OP.get(op, hex(op)), n, p)
+            raise _CutShort(what, p) if file_end else McapError(what)
         yield op, p, buf[p + 9:p + 9 + n]
         p += 9 + n
 
 
 class Recording:
     """An MCAP file read whole and checked: magic, every record's framing, the chunks', data
-    section's and summary's CRCs, the chunk indexes and message indexes (when present)."""
+    section's and summary's CRCs, the chunk indexes and message indexes (when present).
+
+    A file cut short (a killed writer, a full disk) is read up to its last whole record of the
+    data section, so every whole chunk's messages: `complete` is False, `incomplete` says why
+    and where, and a McapIncompleteWarning is issued. A file without its whole Header is not
+    read (McapError)."""
 
     def __init__(self, path):
         self.path = str(path)
@@ -104,9 +126,20 @@ class Recording:
         self.records = {}  # opcode name -> count (data section, chunk contents included)
         self.chunk_indexes, self.statistics, self.summary_offsets = [], None, []
         self.complete = False
+        self.incomplete = ""
         self.profile = self.library = ""
         self._messages = []  # (offset in buf of the record content)
-        self._check()
+        try:
+            self._check()
+        except _CutShort as e:
+            if self.library is None:
+                self._fail("Header record cut short", 8)
+            self.incomplete = "it is cut short at byte %d (a record starting at byte %d)" % (
+                len(self.buf), e.at)
+        if not self.complete:
+            warnings.warn("%s: incomplete recording: %s; read its %d messages up to there"
+                          % (self.path, self.incomplete, len(self._messages)),
+                          McapIncompleteWarning, stacklevel=2)
 
     def _fail(self, what, offset):
         raise McapError("%s: %s (at byte %d)" % (self.path, what, offset))
@@ -142,8 +175,9 @@ class Recording:
             self._fail("not an MCAP file (no magic)", 0)
         p = 8
         data_end = None
+        self.library = None  # until the Header is read
         chunks = {}  # offset -> (length, {channel: [(time, offset)]})
-        for op, off, body in _records(buf, 8, len(buf), self.path):
+        for op, off, body in _records(buf, 8, len(buf), self.path, file_end=True):
             if off == 8:
                 if op != 0x01:
                     self._fail("no Header after the magic", 8)
@@ -178,6 +212,8 @@ class Recording:
                 chunks[off] = (9 + len(body), recs)
             else:
                 self._parse(op, body, off)
+        if self.library is None:
+            self._fail("no Header record after the magic", 8)
         if data_end is None:
             self.incomplete = "no Data End record (the writer stopped)"
             return

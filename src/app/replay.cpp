@@ -248,12 +248,20 @@ namespace {
 
 // What the coordinator writes into summary.json; the rest is the functions' and engines'.
 bool coordinator_field(const std::string& key) {
-  static const std::set<std::string> kKeys = {"simulation",       "config",
-                                              "exit_code",        "error",
-                                              "wall_s",           "cycles",
-                                              "sim_time_s",       "loop_wall_s",
-                                              "real_time_factor", "status_function_done",
-                                              "frame_copies",     "replay"};
+  static const std::set<std::string> kKeys = {"simulation",
+                                              "config",
+                                              "exit_code",
+                                              "error",
+                                              "wall_s",
+                                              "cycles",
+                                              "sim_time_s",
+                                              "loop_wall_s",
+                                              "real_time_factor",
+                                              "status_function_done",
+                                              "frame_copies",
+                                              "replay",
+                                              "state",
+                                              "pid"};
   return kKeys.count(key) > 0;
 }
 

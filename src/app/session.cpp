@@ -1,7 +1,9 @@
 #include "app/session.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -145,7 +147,8 @@ void Session::initialize(bool keep_observations) {
   if (!taps_.empty()) loop_->set_tap(taps_.single_or_this());
   loop_->set_gate(gate_);
   csv_.reset(std::fopen((run_dir_ / "steps.csv").c_str(), "w"));
-  if (csv_) std::setvbuf(csv_.get(), nullptr, _IOFBF, 1 << 20);
+  // A row at a time (one write each), so that a run killed at any point keeps every whole row.
+  if (csv_) std::setvbuf(csv_.get(), nullptr, _IOLBF, 1 << 16);
   loop_->set_step_log(csv_.get());
   if (!quiet_) {
     auto start = SteadyClock::now();
@@ -270,7 +273,13 @@ std::string Session::shut_down(bool clean) {
   if (recorder_) python::set_live_publisher(nullptr, python::PublisherSlot::kRecording);
   recorder_.reset();  // finished already, unless the run ended by an exception of its own
   std::string error = engines_.shut_down(clean, log_);
-  if (csv_) std::fflush(csv_.get());
+  if (csv_ && (std::fflush(csv_.get()) != 0 || std::ferror(csv_.get()))) {
+    const int err = errno;
+    const std::string file = (run_dir_ / "steps.csv").string();
+    output_error_ = err == ENOSPC || err == EDQUOT
+                        ? "no space left writing " + file
+                        : "cannot write " + file + " (a row could not be written)";
+  }
   return error;
 }
 

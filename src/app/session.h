@@ -109,6 +109,8 @@ class Session {
 
   // Shuts the engines down (see EngineSet::shut_down); returns the first error, or "".
   std::string shut_down(bool clean);
+  // After shut_down: "" or what the run could not write of its own files (steps.csv).
+  const std::string& output_error() const { return output_error_; }
 
  private:
   template <typename F>
@@ -128,6 +130,7 @@ class Session {
   LoopFigures figures_;
   StartupFigures startup_;
   bool shut_down_ = false;
+  std::string output_error_;
   std::unique_ptr<record::Recorder> recorder_;
   ChannelFactory replay_channel_;
   loop::DataPackTap* replay_tap_ = nullptr;

@@ -1,13 +1,16 @@
 #include "app/simulation.h"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <memory>
@@ -122,13 +125,47 @@ nlohmann::json startup_json(const StartupFigures& s) {
           {"prime_s", r(s.prime_s)},     {"engines", engines}};
 }
 
+// What a failed write of `file` says: a full disk by name, else the system's reason.
+std::string write_error(const fs::path& file, int err) {
+  if (err == ENOSPC || err == EDQUOT) return "no space left writing " + file.string();
+  return "cannot write " + file.string() + ": " + std::strerror(err);
+}
+
+// A temporary file beside it, synced, then renamed over it: a reader, or a run killed at any
+// point, sees the old file or the new one, never half of one. Returns "" or what failed (the
+// old file, if any, stays).
+std::string write_file_atomically(const fs::path& file, const std::string& text) {
+  const fs::path tmp = file.string() + ".tmp-" + std::to_string(getpid());
+  const int fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return write_error(file, errno);
+  size_t done = 0;
+  int err = 0;
+  while (done < text.size() && err == 0) {
+    const ssize_t n = write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0)
+      err = n < 0 ? errno : ENOSPC;
+    else
+      done += static_cast<size_t>(n);
+  }
+  if (err == 0 && fsync(fd) != 0) err = errno;
+  close(fd);
+  std::error_code ec;
+  if (err == 0) {
+    fs::rename(tmp, file, ec);
+    if (ec) err = ec.value();
+  }
+  if (err != 0) fs::remove(tmp, ec);
+  return err == 0 ? "" : write_error(file, err);
+}
+
 }  // namespace
 
 // summary.json: what an engine or function of the run wrote there (a JSON object, e.g. an
 // experiment's own figures), with the coordinator's fields on top.
-void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
-                   const LoopFigures& loop, double wall_s, const Outcome& outcome,
-                   const StartupFigures* startup, const nlohmann::json* extra) {
+std::string write_summary(const fs::path& file, const config::SimulationConfig& cfg,
+                          const LoopFigures& loop, double wall_s, const Outcome& outcome,
+                          const StartupFigures* startup, const nlohmann::json* extra) {
   nlohmann::json j = nlohmann::json::object();
   if (std::ifstream in(file); in) {
     j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
@@ -136,6 +173,7 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   }
   j["simulation"] = cfg.name;
   j["config"] = cfg.file.string();
+  j["state"] = "ended";
   j["exit_code"] = outcome.code;
   j["error"] = outcome.error;
   j["wall_s"] = wall_s;
@@ -154,7 +192,7 @@ void write_summary(const fs::path& file, const config::SimulationConfig& cfg,
   j["frame_copies"] = frame_copies(cfg, file.parent_path());
   if (extra)
     for (const auto& [key, value] : extra->items()) j[key] = value;
-  std::ofstream(file) << j.dump(2) << "\n";
+  return write_file_atomically(file, j.dump(2) + "\n");
 }
 
 namespace {
@@ -200,9 +238,23 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   log.open(*run_dir / "logs" / "coordinator.log");
   log.info("run folder: " + run_dir->string());
   for (const auto& w : cfg->warnings) log.info("warning: " + w);
-  std::ofstream(*run_dir / "config.json") << redacted(cfg->json).dump(2) << "\n";
-  std::error_code stale;
-  fs::remove(*run_dir / "summary.json", stale);  // a reused folder's; the run writes its own
+  if (std::string e =
+          write_file_atomically(*run_dir / "config.json", redacted(cfg->json).dump(2) + "\n");
+      !e.empty()) {
+    log.error(e);
+    return kExitUserError;
+  }
+  // From the start, so that a run killed on the way still says what it was: replaced (a reused
+  // folder's too) at the end.
+  const nlohmann::json running = {{"simulation", cfg->name},
+                                  {"config", cfg->file.string()},
+                                  {"state", "running"},
+                                  {"pid", getpid()}};
+  if (std::string e = write_file_atomically(*run_dir / "summary.json", running.dump(2) + "\n");
+      !e.empty()) {
+    log.error(e);
+    return kExitUserError;
+  }
   if (cfg->loop != "FTILoop")
     log.info("warning: SimulationLoop " + cfg->loop + " is not available yet; running FTILoop");
   if (cfg->datapack_processor != "tf")
@@ -275,14 +327,21 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
     if (outcome.code == kExitOk) outcome.code = kExitEngineError;
     if (outcome.error.empty()) outcome.error = shutdown_error;
   }
+  if (outcome.code == kExitOk && !session.output_error().empty()) {
+    outcome = {kExitUserError, session.output_error()};
+    log.error(outcome.error);
+  }
   return outcome;
 }
 
-// summary.json and the last lines of the log.
-void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog& log,
-            const LoopFigures& figures, double wall_s, const Outcome& outcome,
-            const StartupFigures* startup = nullptr, const nlohmann::json* extra = nullptr) {
-  write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome, startup, extra);
+// summary.json and the last lines of the log; returns the exit code: the outcome's, or 2 when a
+// run that went well cannot write its summary (a full disk).
+int report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog& log,
+           const LoopFigures& figures, double wall_s, const Outcome& outcome,
+           const StartupFigures* startup = nullptr, const nlohmann::json* extra = nullptr) {
+  const std::string failed =
+      write_summary(run_dir / "summary.json", cfg, figures, wall_s, outcome, startup, extra);
+  if (!failed.empty()) log.error(failed);
   if (startup && startup->total_s >= 0) {
     std::ostringstream s;
     s.precision(3);
@@ -301,6 +360,7 @@ void report(const config::SimulationConfig& cfg, const fs::path& run_dir, RunLog
     if (entry.is_regular_file()) listing += "\n  " + entry.path().filename().string();
   }
   log.info("run folder: " + run_dir.string() + listing);
+  return failed.empty() || outcome.code != kExitOk ? outcome.code : kExitUserError;
 }
 
 }  // namespace
@@ -325,8 +385,7 @@ int run_simulation(const RunOptions& options) {
     } catch (const UserError& e) {
       const Outcome refused{kExitUserError, e.what()};
       log.error(refused.error);
-      report(cfg, run_dir, log, figures, 0, refused);
-      return refused.code;
+      return report(cfg, run_dir, log, figures, 0, refused);
     }
   }
   Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup,
@@ -334,8 +393,8 @@ int run_simulation(const RunOptions& options) {
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
   nlohmann::json live_fields;
   if (live) live_fields = {{"live", live->finish()}};
-  report(cfg, run_dir, log, figures, wall_s, outcome, &startup, live ? &live_fields : nullptr);
-  return outcome.code;
+  return report(cfg, run_dir, log, figures, wall_s, outcome, &startup,
+                live ? &live_fields : nullptr);
 }
 
 int serve_simulation(const RunOptions& options) {
@@ -373,8 +432,7 @@ int serve_simulation(const RunOptions& options) {
     if (outcome.code == kExitOk && interrupted()) outcome = {kExitInterrupted, interrupted_text()};
   }
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
-  report(cfg, run_dir, log, figures, wall_s, outcome);
-  return outcome.code;
+  return report(cfg, run_dir, log, figures, wall_s, outcome);
 }
 
 }  // namespace convoy::app

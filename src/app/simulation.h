@@ -61,10 +61,11 @@ void install_signal_handlers(bool ignore_sigint = false);
 void export_run_environment(const std::filesystem::path& run_dir);
 // summary.json: what the run's engines and functions wrote there, with the coordinator's
 // fields on top (and the start-up figures, when given: a live run's; and `extra`'s fields,
-// e.g. the live server's "live").
-void write_summary(const std::filesystem::path& file, const config::SimulationConfig& cfg,
-                   const LoopFigures& loop, double wall_s, const Outcome& outcome,
-                   const StartupFigures* startup = nullptr, const nlohmann::json* extra = nullptr);
+// e.g. the live server's "live"). Returns "" or what failed ("no space left writing ...").
+std::string write_summary(const std::filesystem::path& file, const config::SimulationConfig& cfg,
+                          const LoopFigures& loop, double wall_s, const Outcome& outcome,
+                          const StartupFigures* startup = nullptr,
+                          const nlohmann::json* extra = nullptr);
 // The `convoy` metadata of a recording: the effective config (tokens redacted), version.
 record::StringMap recording_metadata(const config::SimulationConfig& cfg);
 

@@ -1,5 +1,7 @@
 #include "record/mcap_writer.h"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <zlib.h>
 #include <zstd.h>
 
@@ -73,7 +75,7 @@ McapWriter::~McapWriter() { close(); }
 
 void McapWriter::open(const std::filesystem::path& path, const std::string& library,
                       const McapWriterOptions& options) {
-  if (file_) throw std::logic_error("McapWriter: already open");
+  if (fd_ >= 0) throw std::logic_error("McapWriter: already open");
   path_ = path;
   options_ = options;
   if (options_.compression == McapCompression::kZstd && !zstd_) {
@@ -81,8 +83,8 @@ void McapWriter::open(const std::filesystem::path& path, const std::string& libr
     zstd_->cctx = ZSTD_createCCtx();
     if (!zstd_->cctx) throw std::runtime_error(path.string() + ": cannot create a zstd context");
   }
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) {
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
     throw std::runtime_error("cannot create " + path.string() + ": " + std::strerror(errno));
   }
   std::string header;
@@ -90,19 +92,48 @@ void McapWriter::open(const std::filesystem::path& path, const std::string& libr
   put_string(&header, library);
   write_raw(kMcapMagic);
   write_raw(record(kOpHeader, header));
+  commit();
   check_io();
 }
 
 void McapWriter::write_raw(std::string_view bytes) {
-  if (!file_) return;
-  if (!io_error_ && std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size())
-    io_error_ = true;
+  if (fd_ < 0) return;
+  pending_.append(bytes);
   data_crc_ = crc32(bytes, data_crc_);
   pos_ += bytes.size();
 }
 
+bool McapWriter::commit() {
+  if (fd_ < 0 || io_error_) {
+    pending_.clear();
+    return false;
+  }
+  size_t done = 0;
+  while (done < pending_.size()) {
+    const ssize_t n = ::write(fd_, pending_.data() + done, pending_.size() - done);
+    if (n > 0) {
+      done += static_cast<size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    const int err = n < 0 ? errno : EIO;
+    io_error_ = true;
+    error_ = err == ENOSPC || err == EDQUOT
+                 ? "no space left writing " + path_.string()
+                 : "cannot write " + path_.string() + ": " + std::strerror(err);
+    // A partial record would stand between the last whole one and anything written later:
+    // the file ends at its last whole record instead (and gives the space back).
+    if (::ftruncate(fd_, static_cast<off_t>(file_pos_)) != 0) error_ += " (and cannot cut it back)";
+    pending_.clear();
+    return false;
+  }
+  file_pos_ += pending_.size();
+  pending_.clear();
+  return true;
+}
+
 void McapWriter::check_io() {
-  if (io_error_) throw std::runtime_error("cannot write " + path_.string() + ": disk full?");
+  if (io_error_) throw std::runtime_error(error_);
 }
 
 uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding,
@@ -140,7 +171,8 @@ uint16_t McapWriter::add_channel(const std::string& topic, const std::string& me
 
 void McapWriter::write_message(uint16_t channel, uint32_t sequence, uint64_t log_time,
                                uint64_t publish_time, std::string_view data) {
-  if (!file_) return;
+  if (fd_ < 0 || io_error_) return;
+  if (!chunk_has_messages_) chunk_opened_ = std::chrono::steady_clock::now();
   chunk_index_[channel].emplace_back(log_time, chunk_.size());
   put_u8(&chunk_, kOpMessage);
   put_u64(&chunk_, 2 + 4 + 8 + 8 + data.size());
@@ -154,9 +186,15 @@ void McapWriter::write_message(uint16_t channel, uint32_t sequence, uint64_t log
   if (message_count_ == 0 || log_time < start_time_) start_time_ = log_time;
   if (message_count_ == 0 || log_time > end_time_) end_time_ = log_time;
   chunk_has_messages_ = true;
+  ++chunk_messages_;
   ++message_count_;
   ++channel_counts_[channel];
-  if (chunk_.size() >= options_.chunk_bytes) flush_chunk();
+  // Full, or open long enough: what a crash would lose is what the open chunk holds.
+  if (chunk_.size() >= options_.chunk_bytes ||
+      (options_.chunk_seconds > 0 &&
+       std::chrono::duration<double>(std::chrono::steady_clock::now() - chunk_opened_).count() >=
+           options_.chunk_seconds))
+    flush_chunk();
 }
 
 std::string_view McapWriter::compressed_chunk(const char** compression) {
@@ -174,7 +212,7 @@ std::string_view McapWriter::compressed_chunk(const char** compression) {
 }
 
 void McapWriter::flush_chunk() {
-  if (!file_ || chunk_.empty()) return;
+  if (fd_ < 0 || chunk_.empty() || io_error_) return;
   const uint64_t chunk_offset = pos_;
   const char* compression = "";
   const std::string_view records = compressed_chunk(&compression);
@@ -227,14 +265,16 @@ void McapWriter::flush_chunk() {
   chunk_index_records_.push_back(record(kOpChunkIndex, ci));
 
   ++chunk_count_;
+  // The chunk and its message indexes in one write: in the kernel's hands from now on.
+  if (commit()) file_messages_ += chunk_messages_;
   chunk_.clear();
   chunk_index_.clear();
   chunk_has_messages_ = false;
-  std::fflush(file_);
+  chunk_messages_ = 0;
 }
 
 void McapWriter::write_metadata(const std::string& name, const StringMap& metadata) {
-  if (!file_) return;
+  if (fd_ < 0) return;
   flush_chunk();
   std::string body;
   put_string(&body, name);
@@ -248,12 +288,17 @@ void McapWriter::write_metadata(const std::string& name, const StringMap& metada
   put_string(&index, name);
   metadata_index_records_.push_back(record(kOpMetadataIndex, index));
   ++metadata_count_;
-  std::fflush(file_);
+  commit();
 }
 
 std::string McapWriter::close() {
-  if (!file_) return "";
+  if (fd_ < 0) return "";
   flush_chunk();
+  if (io_error_) {  // the file stays as it was cut: no summary after a lost chunk
+    ::close(fd_);
+    fd_ = -1;
+    return error_;
+  }
   std::string data_end;
   put_u32(&data_end, data_crc_);
   write_raw(record(kOpDataEnd, data_end));
@@ -305,12 +350,16 @@ std::string McapWriter::close() {
   const uint32_t summary_crc = crc32(summary);
   put_u32(&summary, summary_crc);
   summary.append(kMcapMagic);
-  if (!io_error_ && std::fwrite(summary.data(), 1, summary.size(), file_) != summary.size())
-    io_error_ = true;
+  // Data End and the summary in one write (Data End went into pending_ by write_raw).
+  pending_ += summary;
   pos_ += summary.size();
-  if (std::fclose(file_) != 0) io_error_ = true;
-  file_ = nullptr;
-  return io_error_ ? "cannot write " + path_.string() + " (disk full?)" : "";
+  commit();
+  if (::close(fd_) != 0 && !io_error_) {
+    io_error_ = true;
+    error_ = "cannot write " + path_.string() + ": " + std::strerror(errno);
+  }
+  fd_ = -1;
+  return error_;
 }
 
 }  // namespace convoy::record

@@ -8,14 +8,20 @@
 // magic. CRC32s (zlib) everywhere the format has one; a chunk's CRC is that of its
 // uncompressed records, as the specification asks.
 //
-// The file is written as it goes: a chunk goes to disk (and is flushed) once its records
-// hold about `chunk_bytes` (uncompressed), so memory stays bounded and a killed process
-// leaves every finished chunk readable by a streaming reader: it loses the open chunk only.
-// close() writes the summary and footer.
+// The file is written as it goes: a chunk goes to the kernel (one write(2), no stdio buffer)
+// once its records hold about `chunk_bytes` (uncompressed) or once it has been open for
+// `chunk_seconds` of wall time, so memory stays bounded and a killed process leaves every
+// finished chunk readable by a streaming reader: it loses the open chunk only (at most about a
+// second of the run). close() writes the summary and footer.
+//
+// A write that fails (no space left, quota, I/O error) is not thrown from write_message():
+// the writer stops writing, cuts the file back to the end of its last whole record (so the
+// file stays a readable prefix and the space of the partial chunk is given back), and says
+// why in error(); the owner checks error() and ends the run.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -54,7 +60,8 @@ enum class McapCompression { kNone, kZstd };
 struct McapWriterOptions {
   size_t chunk_bytes = size_t{1} << 20;  // uncompressed records per chunk, about
   McapCompression compression = McapCompression::kZstd;
-  int zstd_level = 3;  // zstd's default: ~10x on Convoy's JSON for little CPU
+  int zstd_level = 3;          // zstd's default: ~10x on Convoy's JSON for little CPU
+  double chunk_seconds = 1.0;  // wall time a chunk with messages stays open, at most (0: any)
 };
 
 class McapWriter {
@@ -68,7 +75,7 @@ class McapWriter {
   // Throws std::runtime_error naming the file.
   void open(const std::filesystem::path& path, const std::string& library,
             const McapWriterOptions& options = {});
-  bool is_open() const { return file_ != nullptr; }
+  bool is_open() const { return fd_ >= 0; }
   const std::filesystem::path& path() const { return path_; }
 
   // A schema (id from 1). Written into the current chunk and the summary.
@@ -82,16 +89,27 @@ class McapWriter {
   void write_metadata(const std::string& name, const StringMap& metadata);
 
   // Finishes the file: the last chunk, Data End, summary, footer, magic. Never throws (a
-  // write error is returned, "" when all went well). Idempotent.
+  // write error is returned, "" when all went well). Idempotent. After a write error the
+  // file is left as it was cut (no summary): a prefix that readers read up to its end.
   std::string close();
+
+  // The first write error ("no space left writing PATH", "cannot write PATH: ..."), or "".
+  const std::string& error() const { return error_; }
 
   uint64_t message_count() const { return message_count_; }
   uint64_t bytes_written() const { return pos_; }
+  // What the file holds: bytes, and messages in whole chunks (less than the above after a
+  // write error, or before close()).
+  uint64_t file_bytes() const { return file_pos_; }
+  uint64_t file_messages() const { return file_messages_; }
   // The chunks' records before compression (what an uncompressed file would hold).
   uint64_t uncompressed_chunk_bytes() const { return uncompressed_bytes_; }
 
  private:
   void write_raw(std::string_view bytes);  // to the data section (counts its CRC)
+  // Writes what write_raw() gathered to the file; on failure, cuts the file back and sets
+  // error_. True when written.
+  bool commit();
   void flush_chunk();
   void check_io();
   // The chunk's records as the file holds them, and their `compression` ("zstd" or "").
@@ -103,9 +121,12 @@ class McapWriter {
   };
 
   std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
+  int fd_ = -1;
   bool io_error_ = false;
-  uint64_t pos_ = 0;
+  std::string error_;
+  std::string pending_;  // gathered by write_raw(), written by commit()
+  uint64_t pos_ = 0;     // where the next record goes (as if every write succeeded)
+  uint64_t file_pos_ = 0, file_messages_ = 0;  // what the file holds
   uint32_t data_crc_ = 0;
   McapWriterOptions options_;
   std::unique_ptr<ZstdContext, ZstdContextDeleter> zstd_;
@@ -116,6 +137,8 @@ class McapWriter {
   std::string chunk_;
   uint64_t chunk_start_ = 0, chunk_end_ = 0;
   bool chunk_has_messages_ = false;
+  uint64_t chunk_messages_ = 0;
+  std::chrono::steady_clock::time_point chunk_opened_;  // its first message
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunk_index_;
 
   // For the summary.

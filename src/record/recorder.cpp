@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/error.h"
 #include "datapack/camera.h"
 #include "datapack/registry.h"
 #include "record/datapack_codec.h"
@@ -162,15 +163,26 @@ void Recorder::scene(const std::string& engine, const engine::DataPack& dp,
   scene_.ingest(engine, datapack::View(dp, blobs), time_ns);
 }
 
+void Recorder::check_writer() {
+  if (writer_.error().empty() || write_error_thrown_) return;
+  write_error_thrown_ = true;
+  throw UserError(writer_.error() + ": the run stops here; the recording keeps its first " +
+                  std::to_string(writer_.file_messages()) + " messages (" +
+                  std::to_string(writer_.file_bytes()) +
+                  " bytes, up to its last whole chunk, without its summary)");
+}
+
 void Recorder::from_engine(const std::string& engine, const engine::DataPack& dp,
                            const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns) {
   write(engine, dp, blobs, false, "", cycle, time_ns);
+  check_writer();
 }
 
 void Recorder::to_engine(const std::string& engine, const engine::DataPack& dp,
                          const datapack::BlobReader& blobs, const loop::LoadedFunction& fn,
                          uint64_t cycle, int64_t time_ns) {
   write(engine, dp, blobs, true, fn.name, cycle, time_ns);
+  check_writer();
 }
 
 bool Recorder::viewer_json(const std::string& topic, const std::string& json, int64_t time_ns) {
@@ -199,7 +211,8 @@ bool Recorder::viewer_json(const std::string& topic, const std::string& json, in
 std::string Recorder::finish(const StringMap& end) {
   if (!writer_.is_open()) return "";
   writer_.write_metadata("convoy_end", end);
-  return writer_.close();
+  const std::string error = writer_.close();
+  return write_error_thrown_ ? "" : error;
 }
 
 }  // namespace convoy::record

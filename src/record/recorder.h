@@ -19,6 +19,10 @@
 // `/convoy/scene` and `/convoy/transforms` at `scene_hz` per simulated second from the road
 // users, signals and route of the datapacks taken from engines, so that a viewer's 3D panel
 // shows the run.
+//
+// A write that fails (disk full) ends the run: the next datapack the loop hands over throws
+// convoy::UserError ("no space left writing PATH: ..."; exit 2); the file keeps its whole
+// chunks.
 #pragma once
 
 #include <filesystem>
@@ -69,10 +73,12 @@ class Recorder final : public loop::DataPackTap {
   // leaves them out. Returns false for another topic or a message that is not a JSON object.
   bool viewer_json(const std::string& topic, const std::string& json, int64_t time_ns);
 
-  // Writes the `convoy_end` metadata and finishes the file. Returns a write error, or "".
+  // Writes the `convoy_end` metadata and finishes the file. Returns a write error not
+  // thrown already, or "".
   std::string finish(const StringMap& end);
-  uint64_t messages() const { return writer_.message_count(); }
-  uint64_t bytes() const { return writer_.bytes_written(); }
+  // What the file holds: messages in whole chunks, bytes.
+  uint64_t messages() const { return writer_.file_messages(); }
+  uint64_t bytes() const { return writer_.file_bytes(); }
   const std::filesystem::path& path() const { return writer_.path(); }
   // Datapacks that could not be encoded (left out), and why the first one could not.
   uint64_t skipped() const { return skipped_; }
@@ -89,6 +95,8 @@ class Recorder final : public loop::DataPackTap {
   void camera(const std::string& topic, const engine::DataPack& dp,
               const datapack::BlobReader& blobs, uint64_t cycle, int64_t time_ns);
   uint16_t foxglove_schema(const FoxgloveSchema& schema);
+  // Throws convoy::UserError once, when the writer has failed.
+  void check_writer();
   // The scene before a datapack of `time_ns` is taken in (when an update is due), then the
   // datapack.
   void scene(const std::string& engine, const engine::DataPack& dp,
@@ -100,6 +108,7 @@ class Recorder final : public loop::DataPackTap {
   };
 
   McapWriter writer_;
+  bool write_error_thrown_ = false;
   bool record_blobs_;
   RecorderOptions options_;
   std::map<std::string, Camera> cameras_;  // by topic

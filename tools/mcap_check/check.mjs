@@ -5,14 +5,21 @@
 // compressed with zstd are decompressed by fzstd (pure JavaScript, from npm).
 //
 //   node tools/mcap_check/check.mjs FILE.mcap
+//
+// With --partial, each file may be cut short (a killed run, a full disk): only the streaming
+// reader reads it, fed the bytes in pieces as from a pipe, every CRC checked; it stops where
+// the file ends (inside the open chunk). Prints a line {file, done, messages, topics: {topic:
+// count}, records} per file; exits 0 when every byte up to there was read, 1 when the reader
+// refused a record (a CRC, a malformed record).
+//
+//   node tools/mcap_check/check.mjs --partial FILE.mcap...  (tests/e2e/test_recording_faults.py)
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
 import { readFileSync } from "node:fs";
 import zlib from "node:zlib";
 import { decompress as zstdDecompress } from "fzstd";
 
-const file = process.argv[2];
-const bytes = new Uint8Array(readFileSync(file));
-const out = { file, stream: {}, indexed: {} };
+const partial = process.argv[2] === "--partial";
+const file = process.argv[partial ? 3 : 2];
 const decompressHandlers = {
   zstd: (data, size) => {
     const raw = zstdDecompress(data, new Uint8Array(Number(size)));
@@ -20,6 +27,57 @@ const decompressHandlers = {
     return raw;
   },
 };
+
+// One file cut short, read by the streaming reader: {file, done, messages, topics, records}
+// (and `error` when the reader refused a record).
+function readPartial(file) {
+  let bytes;
+  try {
+    bytes = new Uint8Array(readFileSync(file));
+  } catch (e) {
+    return { file, done: false, messages: 0, topics: {}, records: {}, error: String(e) };
+  }
+  const reader = new McapStreamReader({ validateCrcs: true, decompressHandlers });
+  const channels = new Map();
+  const topics = {};
+  const records = {};
+  let messages = 0;
+  try {
+    for (let at = 0; at === 0 || at < bytes.length; at += 65536) {
+      reader.append(bytes.subarray(at, at + 65536));
+      for (let rec; (rec = reader.nextRecord()); ) {
+        records[rec.type] = (records[rec.type] ?? 0) + 1;
+        if (rec.type === "Channel") channels.set(rec.id, rec.topic);
+        if (rec.type === "Message") {
+          const topic = channels.get(rec.channelId);
+          if (topic === undefined) throw new Error(`message on unknown channel ${rec.channelId}`);
+          topics[topic] = (topics[topic] ?? 0) + 1;
+          messages++;
+        }
+      }
+    }
+  } catch (e) {
+    return { file, done: false, messages, topics, records, error: String(e) };
+  }
+  return { file, done: reader.done(), messages, topics, records };
+}
+
+if (partial) {
+  // Several files: one line of JSON each.
+  let refused = false;
+  for (const f of process.argv.slice(3)) {
+    const got = readPartial(f);
+    console.log(JSON.stringify(got));
+    if (got.error) {
+      console.error(`${f}: @mcap/core refused it after ${got.messages} messages: ${got.error}`);
+      refused = true;
+    }
+  }
+  process.exit(refused ? 1 : 0);
+}
+
+const bytes = new Uint8Array(readFileSync(file));
+const out = { file, stream: {}, indexed: {} };
 
 // Streaming: every record, chunk and data-section CRCs validated.
 const stream = new McapStreamReader({ validateCrcs: true, decompressHandlers });
