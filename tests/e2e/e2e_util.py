@@ -299,3 +299,22 @@ class E2ETestCase(unittest.TestCase):
     def read_log(self, name):
         with open(os.path.join(self.run_dir, "logs", name + ".log")) as f:
             return f.read()
+
+
+def start_local_slurm(cls, prefix):
+    """A one-node Slurm cluster for a test class (tools/campaign/slurm_local.sh in a temp
+    folder, stopped and removed when the class is done): the environment that reaches it, or
+    SkipTest without sbatch."""
+    if shutil.which("sbatch") is None:
+        raise unittest.SkipTest("sbatch is not installed (scripts/setup.sh installs Slurm)")
+    script = os.path.join(REPO, "tools", "campaign", "slurm_local.sh")
+    cls.scratch = tempfile.mkdtemp(prefix=prefix)
+    cls.addClassCleanup(shutil.rmtree, cls.scratch, True)
+    cls.addClassCleanup(subprocess.run, [script, "stop", cls.scratch],
+                        stdin=subprocess.DEVNULL, capture_output=True, timeout=60)
+    for _ in range(2):  # the second start finds it running
+        r = subprocess.run([script, "start", cls.scratch], stdin=subprocess.DEVNULL,
+                           capture_output=True, text=True, timeout=90)
+        if r.returncode != 0:
+            raise AssertionError("slurm_local.sh start failed:\n%s%s" % (r.stdout, r.stderr))
+    return {"SLURM_CONF": os.path.join(cls.scratch, "slurm.conf")}

@@ -25,10 +25,9 @@ import tempfile
 import time
 import unittest
 
-from e2e_util import BIN_DIR, REPO, E2ETestCase
+from e2e_util import BIN_DIR, REPO, E2ETestCase, start_local_slurm
 
 CAMPAIGN = os.path.join(REPO, "tools", "campaign", "campaign.py")
-SLURM_LOCAL = os.path.join(REPO, "tools", "campaign", "slurm_local.sh")
 CUT_IN = os.path.join(REPO, "experiments", "cut_in", "simulation_config.json")
 MISSING_MAP = 'EngineConfigs/0/Map="missing_world.xodr"'
 sys.path.insert(0, os.path.join(REPO, "python"))
@@ -159,18 +158,7 @@ class Slurm(CampaignTest):
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
-        if shutil.which("sbatch") is None:
-            raise unittest.SkipTest("sbatch is not installed (scripts/setup.sh installs Slurm)")
-        cls.scratch = tempfile.mkdtemp(prefix="convoy-e2e-slurm-")
-        cls.addClassCleanup(shutil.rmtree, cls.scratch, True)
-        cls.addClassCleanup(subprocess.run, [SLURM_LOCAL, "stop", cls.scratch],
-                            stdin=subprocess.DEVNULL, capture_output=True, timeout=60)
-        for _ in range(2):  # the second start finds it running
-            r = subprocess.run([SLURM_LOCAL, "start", cls.scratch], stdin=subprocess.DEVNULL,
-                               capture_output=True, text=True, timeout=90)
-            if r.returncode != 0:
-                raise AssertionError("slurm_local.sh start failed:\n%s%s" % (r.stdout, r.stderr))
-        cls.env = {"SLURM_CONF": os.path.join(cls.scratch, "slurm.conf")}
+        cls.env = start_local_slurm(cls, "convoy-e2e-slurm-")
 
     def run_slurm(self, suite, out, *extra):
         return campaign(suite, "--backend", "slurm", "--out", out, "--poll", 0.3, *extra, env=self.env)

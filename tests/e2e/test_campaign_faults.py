@@ -27,14 +27,12 @@ import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 import unittest
 
-from e2e_util import BIN_DIR, REPO, E2ETestCase
+from e2e_util import BIN_DIR, REPO, E2ETestCase, start_local_slurm
 
 CAMPAIGN = os.path.join(REPO, "tools", "campaign", "campaign.py")
-SLURM_LOCAL = os.path.join(REPO, "tools", "campaign", "slurm_local.sh")
 CUT_IN = os.path.join(REPO, "experiments", "cut_in", "simulation_config.json")
 SEED = int(os.environ.get("CONVOY_FAULTS_SEED") or random.SystemRandom().randrange(1 << 30))
 COMPARED = "every column but wall_s"
@@ -429,17 +427,7 @@ class Slurm(FaultTest):
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
-        if shutil.which("sbatch") is None:
-            raise unittest.SkipTest("sbatch is not installed (scripts/setup.sh installs Slurm)")
-        cls.scratch = tempfile.mkdtemp(prefix="convoy-e2e-slurm-faults-")
-        cls.addClassCleanup(shutil.rmtree, cls.scratch, True)
-        cls.addClassCleanup(subprocess.run, [SLURM_LOCAL, "stop", cls.scratch],
-                            stdin=subprocess.DEVNULL, capture_output=True, timeout=60)
-        r = subprocess.run([SLURM_LOCAL, "start", cls.scratch], stdin=subprocess.DEVNULL,
-                           capture_output=True, text=True, timeout=90)
-        if r.returncode != 0:
-            raise AssertionError("slurm_local.sh start failed:\n%s%s" % (r.stdout, r.stderr))
-        cls.env = {"SLURM_CONF": os.path.join(cls.scratch, "slurm.conf")}
+        cls.env = start_local_slurm(cls, "convoy-e2e-slurm-faults-")
 
     def test_sigkill_driver(self):
         """Two SIGKILLs of the driver at random points (the array keeps running): the restart
