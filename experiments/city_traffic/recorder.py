@@ -29,6 +29,14 @@ FPS = 30
 COLOURS = {"car": (40, 40, 220), "truck": (0, 120, 200), "bus": (0, 160, 255),
            "pedestrian": (200, 60, 200), "cyclist": (0, 170, 0)}  # BGR
 EGO = "smart_car"
+# birds_eye.png's extent (m) and scale: the tracks are drawn onto it as the run goes, so that
+# the recorder's memory stays flat however long the run (no list of every point)
+X0, X1, Y0, Y1 = -260.0, 460.0, -160.0, 160.0
+SCALE = 2.0  # px per m
+
+
+def px(x, y):
+    return int(round((x - X0) * SCALE)), int(round((Y1 - y) * SCALE))
 
 
 def load_obj(path):
@@ -48,7 +56,10 @@ class Script(EngineScript):
         self._registerDataPack("observation")
         self.dir = os.environ.get("CONVOY_RUN_DIR", ".")
         self.map = city_map.CityMap(os.path.join(HERE, make_config.MAP))
-        self.tracks = {}          # id -> (class, [(x, y)])
+        self.seen = set()         # every road user's id
+        self.last_px = {}         # id -> its last drawn pixel
+        self.ego_px = []          # the ego's track (drawn last, thick), a point per metre
+        self.tracks_img = None    # the other road users' tracks, drawn as they move
         self.tracks_file = open(os.path.join(self.dir, "tracks.jsonl"), "w")
         self.digest = hashlib.sha1()
         self.prev_ahead = {}      # (id, line id) -> distance before the line at the last step
@@ -74,7 +85,7 @@ class Script(EngineScript):
         self.tracks_file.write(line + "\n")
         self.digest.update(line.encode())
         for uid, cls, x, y, yaw, speed, length, loff in users:
-            self.tracks.setdefault(uid, (cls, []))[1].append((x, y))
+            self._track(uid, cls, x, y)
             if uid.startswith("sumo/"):
                 self.sumo_ids.add(uid)
             if cls == "pedestrian":
@@ -108,6 +119,21 @@ class Script(EngineScript):
             ttc = float(tgt["ttc_s"])
             if math.isfinite(ttc) and (self.min_ttc is None or ttc < self.min_ttc):
                 self.min_ttc = ttc
+
+    def _track(self, uid, cls, x, y):
+        self.seen.add(uid)
+        p = px(x, y)
+        last = self.last_px.get(uid)
+        if last is not None and max(abs(p[0] - last[0]), abs(p[1] - last[1])) < 2:
+            return  # less than 1 m from the last point drawn (or a standing road user's jitter)
+        self.last_px[uid] = p
+        if uid == EGO:
+            self.ego_px.append(p)
+            return
+        if self.tracks_img is None:
+            self.tracks_img = self._background()
+        if last is not None:
+            cv2.line(self.tracks_img, last, p, COLOURS.get(cls, (200, 200, 200)), 1, cv2.LINE_AA)
 
     def _frame(self, obs):
         frame = obs.get("frame")
@@ -152,21 +178,16 @@ class Script(EngineScript):
                 self.collisions = obs["collisions"]
         if self._time_ns % 10_000_000_000 == 0:
             print("t=%5.1f s  road users %d  frames %d  collisions %d  red-light violations %d" % (
-                t, len(self.tracks), self.frames, len(self.collisions), len(self.violations)), flush=True)
+                t, len(self.seen), self.frames, len(self.collisions), len(self.violations)), flush=True)
 
-    def _birds_eye(self):
+    def _background(self):
         share = os.environ.get("CONVOY_SHARE_DIR", "")
         obj = os.path.join(share, "models", "city_road", "road.obj")
-        x0, x1, y0, y1 = -260.0, 460.0, -160.0, 160.0
-        scale = 2.0  # px per m
-        W, H = int((x1 - x0) * scale), int((y1 - y0) * scale)
+        W, H = int((X1 - X0) * SCALE), int((Y1 - Y0) * SCALE)
         img = np.full((H, W, 3), (70, 110, 70), np.uint8)
-
-        def px(x, y):
-            return int(round((x - x0) * scale)), int(round((y1 - y) * scale))
         if os.path.exists(obj):
             v, faces = load_obj(obj)
-            pts = np.stack([(v[:, 0] - x0) * scale, (y1 - v[:, 1]) * scale], axis=1).astype(np.int32)
+            pts = np.stack([(v[:, 0] - X0) * SCALE, (Y1 - v[:, 1]) * SCALE], axis=1).astype(np.int32)
             for f in faces:
                 cv2.fillConvexPoly(img, pts[f], (105, 105, 105))
         for sl in self.map.stop_lines:
@@ -174,15 +195,12 @@ class Script(EngineScript):
             a = (sl.x - sl.t_min * s, sl.y + sl.t_min * c)
             b = (sl.x - sl.t_max * s, sl.y + sl.t_max * c)
             cv2.line(img, px(*a), px(*b), (255, 255, 255), 1)
-        for uid in sorted(self.tracks):
-            cls, pts = self.tracks[uid]
-            if uid == EGO:
-                continue
-            p = np.array([px(x, y) for x, y in pts], np.int32)
-            cv2.polylines(img, [p], False, COLOURS.get(cls, (200, 200, 200)), 1, cv2.LINE_AA)
-        if EGO in self.tracks:
-            p = np.array([px(x, y) for x, y in self.tracks[EGO][1]], np.int32)
-            cv2.polylines(img, [p], False, (0, 255, 255), 3, cv2.LINE_AA)
+        return img
+
+    def _birds_eye(self):
+        img = self.tracks_img if self.tracks_img is not None else self._background()
+        if len(self.ego_px) > 1:
+            cv2.polylines(img, [np.array(self.ego_px, np.int32)], False, (0, 255, 255), 3, cv2.LINE_AA)
         legend = [("ego", (0, 255, 255))] + [(k, c) for k, c in COLOURS.items()]
         for i, (name, col) in enumerate(legend):
             cv2.line(img, (10, 14 + 16 * i), (30, 14 + 16 * i), col, 3)
@@ -222,7 +240,7 @@ class Script(EngineScript):
             "red_light_violation_list": self.violations,
             "ego_stops_for_pedestrians": planner.get("ego_stops_for_pedestrians"),
             "ego_input": planner.get("input_label"),
-            "road_users_seen": len(self.tracks),
+            "road_users_seen": len(self.seen),
             "tracks_sha1": self.digest.hexdigest(),
             "camera_frames": self.frames,
             "camera_frames_per_s": self.frames / wall if wall > 0 else None,
@@ -241,5 +259,5 @@ class Script(EngineScript):
             json.dump(summary, f, indent=1)
         print("recorder: %d road users, %d collisions, %d red-light violations, min TTC %s, "
               "ego stops for pedestrians %s, %d camera frames; %s" % (
-                  len(self.tracks), len(self.collisions), len(self.violations), self.min_ttc,
+                  len(self.seen), len(self.collisions), len(self.violations), self.min_ttc,
                   summary["ego_stops_for_pedestrians"], self.frames, path), flush=True)

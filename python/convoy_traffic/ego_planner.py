@@ -17,7 +17,9 @@ Used by experiments/ego_planner (ego_planner_engine.py, planner_input_*_tf.py); 
 docs/architecture.md, "Ego planner".
 """
 
+import json
 import math
+import tempfile
 
 SOURCES = ("ground_truth", "detections")
 SOURCE_LABELS = {"ground_truth": "ground-truth objects (the world's RoadUsers, not perception)",
@@ -222,7 +224,9 @@ class Planner:
         self.min_gap = None
         self.aeb_active_s = 0.0
         self.max_decel = 0.0
-        self.trace = []
+        # The speed trace goes to an unlinked temporary file, a JSON line per sample, so that the
+        # planner's memory stays flat however long the run; result() reads it back.
+        self._trace = tempfile.TemporaryFile(mode="w+", prefix="convoy-planner-trace-")
         self._last_trace_t = None
         self._prev_speed = None
 
@@ -322,12 +326,13 @@ class Planner:
         self._prev_speed = v
         if self._last_trace_t is None or t - self._last_trace_t >= 1.0 / p["TraceRate"] - 1e-9:
             self._last_trace_t = t
-            self.trace.append({"t": round(t, 3), "speed_mps": round(v, 3),
-                               "target_mps": round(self.v_cmd, 3), "mode": mode,
-                               "lead": lead["id"] if lead else None,
-                               "lead_class": lead["class"] if lead else None,
-                               "gap_m": round(lead_gap, 3) if lead else None,
-                               "lead_speed_mps": round(lead["v_lon"], 3) if lead else None})
+            self._trace.write(json.dumps(
+                {"t": round(t, 3), "speed_mps": round(v, 3),
+                 "target_mps": round(self.v_cmd, 3), "mode": mode,
+                 "lead": lead["id"] if lead else None,
+                 "lead_class": lead["class"] if lead else None,
+                 "gap_m": round(lead_gap, 3) if lead else None,
+                 "lead_speed_mps": round(lead["v_lon"], 3) if lead else None}) + "\n")
         return {"speed": self.v_cmd, "mode": mode, "lead": lead["id"] if lead else None,
                 "gap_m": lead_gap, "ttc_s": ttc}
 
@@ -344,3 +349,11 @@ class Planner:
                 "max_deceleration_mps2": round(self.max_decel, 3),
                 "parameters": {k: self.p[k] for k in sorted(PARAMETERS)},
                 "speed_trace": self.trace}
+
+    @property
+    def trace(self):
+        """The speed trace so far: a dict per sample."""
+        self._trace.seek(0)
+        rows = [json.loads(line) for line in self._trace]
+        self._trace.seek(0, 2)
+        return rows

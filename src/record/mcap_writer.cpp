@@ -262,7 +262,7 @@ void McapWriter::flush_chunk() {
   put_string(&ci, compression);
   put_u64(&ci, records.size());  // compressed_size
   put_u64(&ci, chunk_.size());   // uncompressed_size
-  chunk_index_records_.push_back(record(kOpChunkIndex, ci));
+  keep_chunk_index(record(kOpChunkIndex, ci));
 
   ++chunk_count_;
   // The chunk and its message indexes in one write: in the kernel's hands from now on.
@@ -271,6 +271,35 @@ void McapWriter::flush_chunk() {
   chunk_index_.clear();
   chunk_has_messages_ = false;
   chunk_messages_ = 0;
+}
+
+void McapWriter::keep_chunk_index(std::string rec) {
+  if (!chunk_index_spill_ && !chunk_index_spill_failed_) {
+    chunk_index_spill_.reset(std::tmpfile());  // unlinked at once: nothing left by a crash
+    chunk_index_spill_failed_ = !chunk_index_spill_;
+  }
+  if (chunk_index_spill_ && chunk_index_records_.empty()) {
+    if (std::fwrite(rec.data(), 1, rec.size(), chunk_index_spill_.get()) == rec.size()) {
+      chunk_index_spilled_ += rec.size();
+      return;
+    }
+    // The file takes no more (a full /tmp): what it holds up to here stays valid, the rest is
+    // kept in memory.
+  }
+  chunk_index_records_.push_back(std::move(rec));
+}
+
+// Every chunk index kept, in the order written (the spilled ones, then any kept in memory).
+std::string McapWriter::chunk_indexes() {
+  std::string out;
+  if (std::FILE* f = chunk_index_spill_.get(); f && chunk_index_spilled_ > 0) {
+    std::fflush(f);
+    std::rewind(f);
+    out.resize(chunk_index_spilled_);
+    out.resize(std::fread(out.data(), 1, out.size(), f));
+  }
+  for (const auto& r : chunk_index_records_) out += r;
+  return out;
 }
 
 void McapWriter::write_metadata(const std::string& name, const StringMap& metadata) {
@@ -331,7 +360,8 @@ std::string McapWriter::close() {
   }
   put_string(&stats, counts);
   group(kOpStatistics, {record(kOpStatistics, stats)});
-  group(kOpChunkIndex, chunk_index_records_);
+  if (std::string indexes = chunk_indexes(); !indexes.empty())
+    group(kOpChunkIndex, {std::move(indexes)});
   group(kOpMetadataIndex, metadata_index_records_);
   const uint64_t offsets_start = summary_start + summary.size();
   for (const auto& [op, start, length] : groups) {

@@ -22,6 +22,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -141,9 +142,16 @@ class McapWriter {
   std::chrono::steady_clock::time_point chunk_opened_;  // its first message
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunk_index_;
 
-  // For the summary.
+  // For the summary. The chunk indexes (one per chunk, about 1.5 KB with a hundred channels)
+  // wait in an unlinked temporary file, so that the writer's memory stays flat over a long run
+  // (in memory if no temporary file can be made).
+  void keep_chunk_index(std::string record);
+  std::string chunk_indexes();
   std::vector<std::string> schema_records_, channel_records_, chunk_index_records_,
       metadata_index_records_;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> chunk_index_spill_{nullptr, &std::fclose};
+  bool chunk_index_spill_failed_ = false;
+  uint64_t chunk_index_spilled_ = 0;  // bytes in the file
   std::map<uint16_t, uint64_t> channel_counts_;
   uint64_t message_count_ = 0, start_time_ = 0, end_time_ = 0;
   uint32_t chunk_count_ = 0, metadata_count_ = 0;
