@@ -1,10 +1,9 @@
 // convoy: the coordinator's command line. Also installed as NRPCoreSim, which behaves like
 // `convoy run` and takes NRP-Core's options.
 #include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -19,8 +18,6 @@
 #include "core/memory.h"
 #include "live/address.h"
 #include "python/interpreter.h"
-
-extern char** environ;
 
 namespace {
 
@@ -192,20 +189,6 @@ bool redirect_output(const std::string& mode, const std::string& file) {
   return true;
 }
 
-// Runs argv (argv[0] a path) and waits; its exit status, or -1 when it cannot start.
-int run_program(const std::vector<std::string>& args) {
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid;
-  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return -1;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
 std::string python_exe() {
   if (const char* p = std::getenv("CONVOY_PYTHON"); p && *p) return p;
   return "/usr/bin/python3";
@@ -223,12 +206,16 @@ int campaign(int argc, char** argv) {
       has_build = true;
   }
   if (!has_build) setenv("CONVOY_BIN_DIR", convoy::app::bin_dir().c_str(), 0);
-  const int rc = run_program(args);
-  if (rc < 0) {
-    std::fprintf(stderr, "error: cannot run %s %s\n", args[0].c_str(), args[1].c_str());
-    return 2;
-  }
-  return rc;
+  // The campaign replaces this process, so that a signal to `convoy campaign` (Ctrl-C,
+  // SIGTERM, SIGKILL) reaches the campaign itself.
+  std::vector<char*> argv_exec;
+  for (auto& a : args) argv_exec.push_back(a.data());
+  argv_exec.push_back(nullptr);
+  std::fflush(nullptr);
+  execv(args[0].c_str(), argv_exec.data());
+  std::fprintf(stderr, "error: cannot run %s %s: %s\n", args[0].c_str(), args[1].c_str(),
+               std::strerror(errno));
+  return 2;
 }
 
 }  // namespace

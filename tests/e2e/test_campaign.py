@@ -241,7 +241,7 @@ class Slurm(CampaignTest):
 
 
 class Interrupt(CampaignTest):
-    def interrupt(self, signum):
+    def interrupt(self, signum, command=("/usr/bin/python3", CAMPAIGN)):
         """A local campaign of four 600 s runs (about 40 s each), one at a time, sent `signum` (to the campaign
         alone) while its first run is going: it stops within seconds, exit 130, passing the
         signal on to that run (which ends as convoy run does), starting no other, leaving no
@@ -249,7 +249,7 @@ class Interrupt(CampaignTest):
         suite = self.cut_in_suite()
         out = os.path.join(self.dir, "out")
         e = dict(os.environ, CONVOY_BIN_DIR=BIN_DIR)
-        p = subprocess.Popen(["/usr/bin/python3", CAMPAIGN, suite, "--seeds", "4", "--workers", "1",
+        p = subprocess.Popen(list(command) + [suite, "--seeds", "4", "--workers", "1",
                               "--seconds", "600", "--out", out], env=e, stdin=subprocess.DEVNULL,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
@@ -280,6 +280,10 @@ class Interrupt(CampaignTest):
 
     def test_sigterm(self):
         self.interrupt(signal.SIGTERM)
+
+    def test_sigterm_to_convoy_campaign(self):
+        # `convoy campaign` becomes the campaign (exec): the signal reaches it
+        self.interrupt(signal.SIGTERM, (os.path.join(BIN_DIR, "convoy"), "campaign"))
 
 
 class RecordingLinks(unittest.TestCase):
