@@ -26,7 +26,7 @@ from nrp_core import *  # noqa: F401,F403
 from convoy_bench.live import LiveScore, summary_fields
 from convoy_bench.run_files import INFRACTIONS_TOPIC, load_config, publish_live, update_summary
 
-WRITE_EVERY = 100   # samples (5 s at 20 Hz): scoring the drive so far costs ~0.1 s
+WRITE_EVERY = 100   # samples (5 s at 20 Hz) between two scores of the drive so far in summary.json
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 

@@ -6,6 +6,8 @@ the live score against score_drive, the campaign's .xosc entry type, the suite's
 Run: cd tests/unit && PYTHONPATH=../../python /usr/bin/python3 -m unittest -v test_scenario_run
 (convoy-odr from $CONVOY_BIN_DIR or build/bin; tests needing it are skipped without it)."""
 
+import array
+import collections
 import contextlib
 import copy
 import json
@@ -220,9 +222,9 @@ class LiveScoreTest(unittest.TestCase):
                                            "class_b": "car", "relative_speed_mps": 2.0}])
         return route, ego, others, cols
 
-    def run_live(self):
+    def run_live(self, cls=None):
         route, ego, others, cols = self.drive()
-        ls = live.LiveScore(route, CITY)
+        ls = (cls or live.LiveScore)(route, CITY)
         for k in range(len(ego)):
             ls.add(0.05 * k, ego[k], others[k], cols[k], {})
         return ls
@@ -230,9 +232,10 @@ class LiveScoreTest(unittest.TestCase):
     def test_matches_score_drive(self):
         ls = self.run_live()
         r = ls.result(final=True, timed_out=True)
-        again = score.score_drive(copy.deepcopy(ls.samples), {"points": ls.route["points"]},
+        samples = self.run_live(ReferenceLiveScore).samples
+        again = score.score_drive(copy.deepcopy(samples), {"points": ls.route["points"]},
                                   copy.deepcopy(ls.events) + ([] if r["route_finished"] else
-                                                              [{"t": ls.samples[-1]["t"], "kind": "scenario_timeout",
+                                                              [{"t": samples[-1]["t"], "kind": "scenario_timeout",
                                                                 "other": None}]))
         self.assertEqual(r["driving_score"], again["driving_score"])
         kinds = [i["kind"] for i in r["infractions"]]
@@ -252,6 +255,233 @@ class LiveScoreTest(unittest.TestCase):
         a = self.run_live().result(final=True, timed_out=True)
         b = self.run_live().result(final=True, timed_out=True)
         self.assertEqual(json.dumps(a, sort_keys=True, default=str), json.dumps(b, sort_keys=True, default=str))
+
+
+# --- issue 30: LiveScore in bounded memory, the same scores -----------------------------------
+
+from convoy_bench import geometry, nuplan, road_map  # noqa: E402
+from convoy_bench.runs import EGO_WIDTH, VEHICLE_CLASSES, WRONG_WAY_ANGLE  # noqa: E402
+
+
+class ReferenceLiveScore:
+    """LiveScore before issue 30 (every sample kept, the whole drive rescored): the
+    reference the bounded LiveScore must match bit for bit."""
+
+    def __init__(self, route_points, map_path, stop_lines=(), ego="smart_car", ego_width=EGO_WIDTH):
+        self.route = {"points": [[float(p[0]), float(p[1])] for p in route_points]}
+        self.map = road_map.load(map_path)
+        self.stop_lines = list(stop_lines)
+        self.ego = ego
+        self.ego_width = ego_width
+        self.samples = []
+        self.events = []
+        self.collided = {}         # other -> time of its first collision with the ego
+        self.seen_collisions = 0
+        self.prev_ahead = {}
+        self.crossed_on_red = {}
+        self.last_t = None
+
+    def _flags(self, s):
+        corners = geometry.box_corners([s["x"]], [s["y"]], [s["yaw"]], [s["length"]], self.ego_width,
+                                       [s["length_offset"]])
+        xs = [s["x"]] + [float(corners[0, k, 0]) for k in range(4)]
+        ys = [s["y"]] + [float(corners[0, k, 1]) for k in range(4)]
+        where, *cw = road_map.locate(self.map, xs, ys, [s["yaw"]] * 5)
+        lanes = {(c["road"], c["lane"]) for c in cw}
+        in_junction = where["junction"] or any(c["junction"] for c in cw)
+        wrong = (where["lane_type"] == "driving" and not where["junction"] and where["heading"] is not None
+                 and math.cos(where["heading"] - s["yaw"]) < math.cos(WRONG_WAY_ANGLE))
+        s.update({"road": where["road"], "lane": where["lane"], "on_road": where["on_road"],
+                  "wrong_way": wrong, "in_junction": in_junction,
+                  "multiple_lanes": len(lanes) > 1 and not in_junction,
+                  "speed_limit": where["speed_limit"]})
+
+    def _red_lights(self, t, s, signals):
+        fx = s["x"] + (s["length_offset"] + 0.5 * s["length"]) * math.cos(s["yaw"])
+        fy = s["y"] + (s["length_offset"] + 0.5 * s["length"]) * math.sin(s["yaw"])
+        for sl in self.stop_lines:
+            a = sl.ahead(fx, fy, s["yaw"], at_entry=True)
+            prev = self.prev_ahead.get(sl.id)
+            if a is None:
+                self.prev_ahead.pop(sl.id, None)
+                continue
+            self.prev_ahead[sl.id] = a
+            b = sl.ahead(fx, fy, s["yaw"])
+            pb = self.prev_ahead.get((sl.id, "line"))
+            self.prev_ahead[(sl.id, "line")] = b
+            if pb is not None and b is not None and pb > 0 >= b:
+                self.crossed_on_red[sl.id] = signals.get(sl.id) == "red"
+            if prev is not None and prev > 0 >= a and signals.get(sl.id) == "red" and \
+                    self.crossed_on_red.get(sl.id, True):
+                self.events.append({"t": t, "kind": "red_light", "other": sl.id})
+
+    def add(self, t, ego, others, collisions=(), signals=None):
+        """One step: ego {"x", "y", "yaw", "speed", "length", "length_offset"}; others {id:
+        {"class", "x", "y", "yaw", "speed", "length", "length_offset"}}; collisions the world's
+        cumulative list; signals {id: state}."""
+        t = float(t)
+        if self.last_t is not None and t <= self.last_t:
+            return
+        self.last_t = t
+        s = {"t": t, "x": float(ego["x"]), "y": float(ego["y"]), "yaw": float(ego["yaw"]),
+             "speed": float(ego["speed"]), "length": float(ego.get("length") or 2.5),
+             "width": self.ego_width, "length_offset": float(ego.get("length_offset") or 0.0)}
+        self._flags(s)
+        for c in list(collisions)[self.seen_collisions:]:
+            a, b = c.get("a"), c.get("b")
+            if self.ego not in (a, b) or a == b:
+                continue
+            other, cls = (b, c.get("class_b")) if a == self.ego else (a, c.get("class_a"))
+            kind = ("collision_pedestrian" if cls == "pedestrian" else
+                    "collision_vehicle" if cls in VEHICLE_CLASSES else "collision_static")
+            e = {"t": float(c["t"]), "kind": kind, "other": other, "other_class": cls}
+            if other in others:
+                e["other_state"] = dict(others[other])
+            self.events.append(e)
+            self.collided.setdefault(other, float(c["t"]))
+        self.seen_collisions = len(list(collisions))
+        if signals:
+            self._red_lights(t, s, signals)
+        active = [o for oid, o in sorted(others.items())
+                  if not (oid in self.collided and self.collided[oid] < t)]
+        wide = s["multiple_lanes"] or s["in_junction"] or not s["on_road"]
+        s["ttc"] = nuplan.ttc_at(s, active, wide=wide)
+        vehicles = [o["speed"] for _, o in sorted(others.items()) if o["class"] in VEHICLE_CLASSES]
+        s["traffic_speed"] = math.fsum(vehicles) / len(vehicles) if vehicles else None
+        self.samples.append(s)
+
+    def result(self, final=False, timed_out=False):
+        """score.score_drive's result for the drive so far (None with fewer than 2 samples).
+        final and timed_out: the run ended before the ego finished its route -> one
+        scenario_timeout infraction (at the last sample's time)."""
+        if len(self.samples) < 2 or len(self.route["points"]) < 2:
+            return None
+        events = list(self.events)
+        r = score.score_drive(self.samples, self.route, events)
+        if final and timed_out and not r["route_finished"]:
+            events.append({"t": self.samples[-1]["t"], "kind": "scenario_timeout", "other": None})
+            r = score.score_drive(self.samples, self.route, events)
+        return r
+
+
+class _StopLine:
+    """A stop line across the road at x = line_x, the junction's entry 2 m further (the
+    interface of convoy_scenario.stop_lines for an ego driving +x)."""
+    id = "sl_1"
+
+    def __init__(self, line_x):
+        self.line_x = line_x
+
+    def ahead(self, fx, fy, yaw, at_entry=False):
+        d = self.line_x + (2.0 if at_entry else 0.0) - fx
+        return d if -5.0 < d < 40.0 else None
+
+
+class BoundedLiveScoreTest(unittest.TestCase):
+    """LiveScore keeps bounded state and gives ReferenceLiveScore's results, bit for bit."""
+    ROUTE = [[-220.0 + 2 * k, -1.75] for k in range(76)]          # 150 m along +x
+
+    # (until s, ego speed m/s, y): stops, wrong way (y 1.75), off road (y -12), a crawl above
+    # the blocked speed, overspeed (16 > 13.9 m/s) through a red light, the route's end, then
+    # stopped until blocked (180 s)
+    PHASES = ((3.0, 8.0, -1.75), (63.0, 0.0, -1.75), (66.0, 8.0, 1.75), (69.0, 8.0, -12.0),
+              (300.0, 0.12, -1.75), (302.0, 16.0, -1.75), (400.0, 0.0, -1.75), (403.0, 6.0, -1.75),
+              (1200.0, 0.0, -1.75))
+    COLLISIONS = (  # (reported from t, collision)
+        (10.0, {"t": 10.0, "a": "ped_1", "b": "smart_car", "class_a": "pedestrian", "class_b": "car"}),
+        (20.0, {"t": 20.0, "a": "smart_car", "b": "pole_7", "class_a": "car", "class_b": "static"}),
+        (64.5, {"t": 64.0, "a": "car_2", "b": "smart_car", "class_a": "car", "class_b": "car"}),
+        (300.4, {"t": 300.5, "a": "smart_car", "b": "car_1", "class_a": "car", "class_b": "car"}),
+        (301.0, {"t": 301.0, "a": "smart_car", "b": "car_1", "class_a": "car", "class_b": "car"}),
+        (301.0, {"t": 301.0, "a": "car_1", "b": "car_2", "class_a": "car", "class_b": "car"}),
+    )
+
+    def stream(self, seconds):
+        """Steps (t, ego, others, collisions, signals) at 20 Hz, as the transceiver gives them
+        (time_ns * 1e-9; a repeated time now and then)."""
+        x, y, steps = -220.0, -1.75, []
+        for k in range(int(seconds * 20) + 1):
+            t = (k * 50000000) * 1e-9
+            v, yy = next((v, yy) for end, v, yy in self.PHASES if t < end or end == self.PHASES[-1][0])
+            if k:
+                x += v * 0.05
+            y = yy
+            yaw = 0.02 * math.sin(0.7 * t)
+            ego = {"x": x, "y": y, "yaw": yaw, "speed": v, "length": 2.5, "length_offset": 0.9}
+            others = {"car_1": {"class": "car", "x": x + 25.0 + 3.0 * math.sin(0.05 * t), "y": -5.25,
+                                "yaw": 0.0, "speed": 9.0 + math.sin(0.1 * t), "length": 4.5,
+                                "length_offset": 1.4},
+                      "car_2": {"class": "car", "x": x + 7.0, "y": y, "yaw": 0.0,
+                                "speed": 0.5 if 300.0 <= t < 302.0 else v, "length": 4.5, "length_offset": 1.4},
+                      "ped_1": {"class": "pedestrian", "x": x + 4.0, "y": y + 1.5, "yaw": 1.5, "speed": 1.2}}
+            cols = [c for since, c in self.COLLISIONS if t >= since]
+            signals = {"sl_1": "red" if 295.0 <= t < 310.0 else "green"}
+            if k % 13 == 7:
+                continue                                            # a dropped step: uneven time steps
+            steps.append((t, ego, others, cols, signals))
+            if k % 997 == 500:
+                steps.append((t, ego, others, cols, signals))      # not after the last: ignored
+        return steps
+
+    def assert_same(self, a, b, where):
+        ra, rb = a, b
+        self.assertEqual(repr(ra), repr(rb), where)                 # every float's bits, key order
+
+    def test_long_drive_matches_reference(self):
+        steps = self.stream(1200.0)                                 # 20 simulated minutes
+        ref = ReferenceLiveScore(self.ROUTE, CITY, [_StopLine(-110.0)])
+        new = live.LiveScore(self.ROUTE, CITY, [_StopLine(-110.0)])
+        checked = 0
+        for k, (t, ego, others, cols, signals) in enumerate(steps):
+            ref.add(t, ego, others, cols, signals)
+            new.add(t, ego, others, cols, signals)
+            if k in (0, 1, 2, 3, 4, 5, 6, 40) or k % 4000 == 0 or 5990 <= k <= 6010 and k % 10 == 0:
+                self.assert_same(ref.result(), new.result(), "step %d" % k)
+                self.assert_same(ref.result(final=True, timed_out=True), new.result(final=True, timed_out=True),
+                                 "step %d, final" % k)
+                checked += 1
+            self.assert_bounded(new)
+        self.assert_same(ref.result(final=True, timed_out=True), new.result(final=True, timed_out=True), "end")
+        self.assertEqual(len(ref.events), len(new.events))
+        r = new.result(final=True, timed_out=True)
+        kinds = {i["kind"] for i in r["infractions"]}
+        # the stream covers what the aggregates do
+        self.assertTrue({"collision_pedestrian", "collision_static", "collision_vehicle", "red_light",
+                         "wrong_way", "off_road", "min_speed", "agent_blocked"} <= kinds, kinds)
+        self.assertTrue(r["route_finished"])
+        self.assertEqual(r["route_ended_at"], 583.0)
+        self.assertFalse(all(i["counted"] for i in r["infractions"]))
+        self.assertEqual(new.unresolved_states, 0)
+        self.assertGreater(checked, 12)
+
+    def test_unfinished_and_short(self):
+        """A drive that never finishes (scenario_timeout), result() from its first samples."""
+        steps = self.stream(80.0)
+        ref = ReferenceLiveScore(self.ROUTE, CITY)
+        new = live.LiveScore(self.ROUTE, CITY)
+        for k, (t, ego, others, cols, signals) in enumerate(steps):
+            ref.add(t, ego, others, cols, signals)
+            new.add(t, ego, others, cols, signals)
+            if k < 12 or k % 97 == 0:
+                self.assert_same(ref.result(), new.result(), "step %d" % k)
+                self.assert_same(ref.result(True, True), new.result(True, True), "step %d" % k)
+        self.assertIn("scenario_timeout", [i["kind"] for i in new.result(True, True)["infractions"]])
+
+    def assert_bounded(self, ls):
+        """Per-sample storage: only the four 8-byte arrays grow with the samples; every other
+        container is bounded (the state window) or grows with events."""
+        for name, v in vars(ls).items():
+            if isinstance(v, array.array):
+                self.assertIn(name, ("_t", "_speed", "_yaw", "_prog"))
+                self.assertEqual(v.itemsize, 8)
+                self.assertLessEqual(len(v), ls.n)
+            elif isinstance(v, (list, dict, set, tuple, collections.deque)) and name not in ("route", "map"):
+                self.assertLessEqual(len(v), live.STATE_WINDOW, name)
+        self.assertLessEqual(len(ls._window), live.STATE_WINDOW)
+        self.assertLessEqual(len(ls._stretches) + len(ls._ms_events), 16)
+        for st in ls._stretches:
+            self.assertLessEqual(len(st["sum"].partials), 64)
+        self.assertLessEqual(len(ls._over.partials) + len(ls._off.partials), 128)
 
 
 class CampaignEntryTest(unittest.TestCase):
