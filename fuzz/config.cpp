@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -21,6 +22,10 @@ fs::path config_file;
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   fs::path dir = fs::temp_directory_path() / ("convoy-fuzz-config-" + std::to_string(getpid()));
   fs::create_directories(dir);
+  std::atexit([] {  // the folder goes when the fuzzer ends (libFuzzer exits through exit())
+    std::error_code ec;
+    fs::remove_all(config_file.parent_path(), ec);
+  });
   config_file = dir / "simulation_config.json";
   return 0;
 }

@@ -24,6 +24,10 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   setenv("CONVOY_MODEL_PATH", CONVOY_FUZZ_MODEL_PATH, 1);
   fs::path dir = fs::temp_directory_path() / ("convoy-fuzz-sdf-" + std::to_string(getpid()));
   fs::create_directories(dir);
+  std::atexit([] {  // the folder goes when the fuzzer ends (libFuzzer exits through exit())
+    std::error_code ec;
+    fs::remove_all(world_file.parent_path(), ec);
+  });
   world_file = dir / "world.sdf";
   return 0;
 }

@@ -7,6 +7,7 @@ and record what arrives (python3-paho-mqtt and mosquitto-clients are not needed)
 """
 
 import os
+import shutil
 import socket
 import struct
 import subprocess
@@ -58,6 +59,7 @@ class Broker:
             self.proc.kill()
         self.proc.wait()
         self.log.close()
+        shutil.rmtree(self.dir, ignore_errors=True)
 
 
 def _remaining_length(n):

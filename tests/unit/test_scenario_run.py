@@ -14,6 +14,7 @@ import json
 import math
 import os
 import sys
+import shutil
 import tempfile
 import types
 import unittest
@@ -117,6 +118,7 @@ class CommanderTest(unittest.TestCase):
 class MakeConfigTest(unittest.TestCase):
     def setUp(self):
         self.tmp = tempfile.mkdtemp(prefix="convoy-makeconfig-")
+        self.addCleanup(shutil.rmtree, self.tmp, True)
 
     def test_suite_cut_in(self):
         out = os.path.join(self.tmp, "c.json")
