@@ -147,8 +147,9 @@ void Session::initialize(bool keep_observations) {
   if (!taps_.empty()) loop_->set_tap(taps_.single_or_this());
   loop_->set_gate(gate_);
   csv_.reset(std::fopen((run_dir_ / "steps.csv").c_str(), "w"));
-  // A row at a time (one write each), so that a run killed at any point keeps every whole row.
-  if (csv_) std::setvbuf(csv_.get(), nullptr, _IOLBF, 1 << 16);
+  // Unbuffered: the loop writes whole rows, 50 ms of them at a time (FtiLoop::flush_rows), so
+  // that a run killed at any point keeps every whole row written.
+  if (csv_) std::setvbuf(csv_.get(), nullptr, _IONBF, 0);
   loop_->set_step_log(csv_.get());
   if (!quiet_) {
     auto start = SteadyClock::now();

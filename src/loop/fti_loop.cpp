@@ -79,6 +79,7 @@ void FtiLoop::set_step_log(std::FILE* csv) {
     std::fprintf(csv_, ",%s_step_us,%s_roundtrip_us", e->name().c_str(), e->name().c_str());
   }
   std::fprintf(csv_, "\n");
+  std::fflush(csv_);
 }
 
 void FtiLoop::keep_observation(const engine::DataPack& dp, const std::string& engine) {
@@ -210,9 +211,17 @@ void append_us(std::string* row, int64_t ns) {
 }
 }  // namespace
 
+FtiLoop::~FtiLoop() { flush_rows(); }
+
+void FtiLoop::flush_rows() {
+  if (!csv_ || row_.empty()) return;
+  std::fwrite(row_.data(), 1, row_.size(), csv_);
+  std::fflush(csv_);
+  row_.clear();
+}
+
 void FtiLoop::write_row(int64_t cycle_wall_ns) {
   if (!csv_) return;
-  row_.clear();
   char buf[32];
   row_.append(buf, std::to_chars(buf, buf + sizeof buf, cycles_).ptr);
   row_ += ',';
@@ -234,7 +243,11 @@ void FtiLoop::write_row(int64_t cycle_wall_ns) {
     }
   }
   row_ += '\n';
-  std::fwrite(row_.data(), 1, row_.size(), csv_);
+  const int64_t now = now_ns();
+  if (now - rows_flushed_ns_ >= 50'000'000 || row_.size() >= (1 << 16)) {
+    flush_rows();
+    rows_flushed_ns_ = now;
+  }
 }
 
 bool FtiLoop::cycle(int64_t next, int64_t bound_ns, bool stop_on_done) {

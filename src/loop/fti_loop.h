@@ -34,6 +34,8 @@ class FtiLoop {
   // status function, or null. All must outlive the loop.
   FtiLoop(std::vector<EngineHandle*> engines, FunctionRunner& runner,
           const std::vector<LoadedFunction>& functions, const LoadedFunction* status = nullptr);
+  // Writes the steps.csv rows not written yet.
+  ~FtiLoop();
 
   // Writes one CSV row per cycle (wall times per engine) to `csv` (may be null).
   void set_step_log(std::FILE* csv);
@@ -101,6 +103,9 @@ class FtiLoop {
   void keep_observation(const engine::DataPack& dp, const std::string& engine);
   void route(std::vector<engine::DataPack>& outputs, const LoadedFunction& fn);
   void write_row(int64_t cycle_wall_ns);
+  // steps.csv: the rows of the last 50 ms (or 64 KiB) go out in one write, whole rows only,
+  // so that a run killed at any point keeps every row but those of its last 50 ms.
+  void flush_rows();
   // Waits at the gate; false on an interrupt.
   bool pass_gate();
 
@@ -108,7 +113,8 @@ class FtiLoop {
   std::unordered_map<std::string, EngineHandle*> by_name_;
   std::vector<char> due_mask_;           // by engine index: due this cycle
   std::vector<size_t> function_engine_;  // by function: index of its engine
-  std::string row_;
+  std::string row_;                      // the rows not written yet
+  int64_t rows_flushed_ns_ = 0;
   FunctionRunner& runner_;
   const std::vector<LoadedFunction>& functions_;
   const LoadedFunction* status_;
