@@ -286,6 +286,7 @@ int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls,
   model_classes_.push_back(cls);
   const auto label = static_cast<uint32_t>(model_names_.size());
   Actor actor;
+  actor.label = label;
   auto add = [&](const ModelDesc& m, int pose) {
     for (const auto& link : m.links) {
       Tracked tracked{-1, {}, {}};
@@ -319,6 +320,10 @@ void CameraSensors::set_actor_visible(int actor, bool visible) {
   Actor& a = actors_[actor];
   a.visible = visible;
   for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
+}
+
+void CameraSensors::set_actor_name(int actor, const std::string& name) {
+  if (actor >= 0) model_names_[actors_[actor].label - 1] = name;
 }
 
 void CameraSensors::set_actor_shown(int actor, int pose) {

@@ -51,6 +51,8 @@ class CameraSensors {
   void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
   void set_actor_visible(int actor, bool visible);
   void set_actor_shown(int actor, int pose);
+  // The model name its ground truth gives (an actor taken over by another road user).
+  void set_actor_name(int actor, const std::string& name);
 
   // The scene instances that draw visual `visual` of link `link` (scoped: model::link) of a
   // world model, in the order added (a mesh file's parts each have one); empty for an
@@ -128,6 +130,7 @@ class CameraSensors {
     std::vector<Eigen::Isometry3d> link_poses;  // its link in the actor's frame
     std::vector<int> pose_of;                   // each instance's pose (-1: not animated)
     int shown = 0;                              // the pose shown
+    uint32_t label = 0;                         // its model_id in the ground truth
   };
   bool shows(const Actor& a, size_t instance) const {
     return a.visible && (a.pose_of[instance] < 0 || a.pose_of[instance] == a.shown);

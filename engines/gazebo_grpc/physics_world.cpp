@@ -542,6 +542,12 @@ void PhysicsWorld::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
   skel->getRootJoint()->setPositions(dd::FreeJoint::convertToPositions(pose));
 }
 
+void PhysicsWorld::set_actor_name(int actor, const std::string& name) {
+  auto& skel = actors_[actor].skeleton;
+  skel->setName("actor:" + name);
+  skel->getRootJoint()->setName("actor:" + name);
+}
+
 void PhysicsWorld::set_actor_present(int actor, bool present) {
   Actor& a = actors_[actor];
   if (a.present == present) return;

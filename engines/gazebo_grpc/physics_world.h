@@ -82,6 +82,8 @@ class PhysicsWorld {
   // simulated models collide with it; it does not move in response. Returns its index.
   int add_actor(const std::string& name, const ModelDesc& model);
   void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
+  // Its skeleton's name becomes "actor:NAME" (an actor taken over by another road user).
+  void set_actor_name(int actor, const std::string& name);
   // In the world (colliding) or not.
   void set_actor_present(int actor, bool present);
 

@@ -34,7 +34,12 @@ void Contacts::add_world_models() {
   }
 }
 
-void Contacts::add_entity(const void* key, Entity entity) { entity_[key] = std::move(entity); }
+void Contacts::add_entity(const void* key, Entity entity) {
+  entity_[key] = std::move(entity);
+  // A key given again is a new entity (an actor taken over): it has touched nothing yet.
+  std::erase_if(last_touched_,
+                [key](const auto& kv) { return kv.first.first == key || kv.first.second == key; });
+}
 
 Eigen::Vector3d Contacts::velocity_of(const Entity& e) const {
   if (e.velocity) return *e.velocity;

@@ -1,5 +1,6 @@
 #include "systems/road_user_actors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -78,12 +79,18 @@ RoadUserActors::Actor& RoadUserActors::actor_for(const std::string& dp_name,
                                "': an id cannot change its category");
     return a;
   }
+  return add_actor(dp_name, u);
+}
+
+// A new road user's actor: a removed one of the same shape taken over, or a new one.
+RoadUserActors::Actor& RoadUserActors::add_actor(const std::string& dp_name,
+                                                 const data::RoadUser& u) {
   if (!library_) library_ = std::make_unique<ActorLibrary>(table_);
   const ActorModel* am;
   try {
     am = &library_->find(u.model(), u.category());
   } catch (const std::exception& e) {
-    throw std::runtime_error(where() + e.what());
+    throw std::runtime_error(ctx_->where(dp_name) + "road user '" + u.id() + "': " + e.what());
   }
   if (!u.model().empty() && am->key != u.model() && warned_models_.insert(u.model()).second) {
     std::fprintf(stderr,
@@ -92,14 +99,21 @@ RoadUserActors::Actor& RoadUserActors::actor_for(const std::string& dp_name,
                  ctx_->engine.c_str(), dp_name.c_str(), u.model().c_str(),
                  library_->table().string().c_str(), u.category().c_str(), am->key.c_str());
   }
-  Actor a;
-  a.id = u.id();
-  a.created_ns = ctx_->time_ns;
-  a.category = u.category().empty() ? am->cls : u.category();
-  a.cls = a.category;
+  const std::string category = u.category().empty() ? am->cls : u.category();
   Eigen::Vector3d scale(u.length() > 0 ? u.length() / am->size.x() : 1,
                         u.width() > 0 ? u.width() / am->size.y() : 1,
                         u.height() > 0 ? u.height() / am->size.z() : 1);
+  char size[96];
+  std::snprintf(size, sizeof size, " %a %a %a", scale.x(), scale.y(), scale.z());
+  const std::string shape = am->key + " " + category + size;
+  if (Actor* reused = reuse_actor(shape, u)) return *reused;
+
+  Actor a;
+  a.id = u.id();
+  a.created_ns = ctx_->time_ns;
+  a.category = category;
+  a.cls = a.category;
+  a.shape = shape;
   ModelDesc model = scaled(am->desc, scale);
   model.name = u.id();
   a.half = 0.5 * am->size.cwiseProduct(scale);
@@ -124,9 +138,39 @@ RoadUserActors::Actor& RoadUserActors::actor_for(const std::string& dp_name,
   return added;
 }
 
+// The oldest removed actor of `shape`, now road user u's (its old id forgotten), or null.
+RoadUserActors::Actor* RoadUserActors::reuse_actor(const std::string& shape,
+                                                   const data::RoadUser& u) {
+  auto it = free_.find(shape);
+  if (it == free_.end() || it->second.empty()) return nullptr;
+  const size_t index = it->second.front();
+  it->second.pop_front();
+  Actor& a = actors_[index];
+  a.free = false;
+  by_id_.erase(a.id);
+  by_id_[u.id()] = index;
+  a.id = u.id();
+  a.created_ns = ctx_->time_ns;
+  a.velocity.setZero();
+  ctx_->physics->set_actor_name(a.physics, u.id());
+  ctx_->cameras->set_actor_name(a.camera, u.id());
+  if (contacts_)
+    contacts_->add_entity(ctx_->physics->actor_skeleton(a.physics),
+                          {u.id(), a.cls, nullptr, &a.velocity});
+  return &a;
+}
+
 void RoadUserActors::set_present(Actor& a, bool present) {
   if (a.present == present) return;
   a.present = present;
+  auto& free = free_[a.shape];
+  if (!present) {
+    free.push_back(static_cast<size_t>(by_id_.at(a.id)));
+    a.free = true;
+  } else if (a.free) {  // back before another road user took it
+    free.erase(std::find(free.begin(), free.end(), by_id_.at(a.id)));
+    a.free = false;
+  }
   ctx_->physics->set_actor_present(a.physics, present);
   ctx_->cameras->set_actor_visible(a.camera, present);
 }
@@ -215,6 +259,7 @@ bool RoadUserActors::boxes_overlap(const Actor& a, const Actor& b) {
 void RoadUserActors::reset() {
   actors_.clear();
   by_id_.clear();
+  free_.clear();
   pending_.clear();
 }
 

@@ -46,6 +46,8 @@ class RoadUserActors final : public WorldSystem {
     double length_offset = 0;  // its box centre ahead of the reference point (library's)
     int walk_poses = 0;        // an animated walker's walking cycle poses (then the camera's
     bool stand = false;        // pose walk_poses is its standing model, if it has one)
+    std::string shape;         // its model and size: the key under which it can be reused
+    bool free = false;         // removed, waiting in free_ for a new id of its shape
   };
 
   const char* name() const override { return "actors"; }
@@ -57,9 +59,13 @@ class RoadUserActors final : public WorldSystem {
 
   // The actor of road-user `id`, or null if it never came.
   const Actor* actor(const std::string& id) const;
+  // How many actors the world holds (present or kept for reuse).
+  size_t actor_count() const { return actors_.size(); }
 
  private:
   Actor& actor_for(const std::string& dp_name, const data::RoadUser& u);
+  Actor& add_actor(const std::string& dp_name, const data::RoadUser& u);
+  Actor* reuse_actor(const std::string& shape, const data::RoadUser& u);
   void set_present(Actor& a, bool present);
   static bool boxes_overlap(const Actor& a, const Actor& b);
 
@@ -71,6 +77,7 @@ class RoadUserActors final : public WorldSystem {
   std::vector<std::pair<std::string, data::RoadUser>> pending_;  // datapack name, state
   std::deque<Actor> actors_;  // a deque: the contacts system keeps pointers to velocities
   std::unordered_map<std::string, size_t> by_id_;
+  std::unordered_map<std::string, std::deque<size_t>> free_;  // by shape, oldest removed first
   std::set<std::string> warned_models_;
 };
 

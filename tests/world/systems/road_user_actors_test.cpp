@@ -3,6 +3,8 @@
 // it; bad road users are errors naming engine, datapack and road user.
 #include "systems/road_user_actors.h"
 
+#include <algorithm>
+
 #include "systems/camera_datapacks.h"
 #include "systems/contacts.h"
 #include "test_world.h"
@@ -54,6 +56,61 @@ TEST_F(WorldActors, AnActorAppearsLeavesWhenAbsentAndComesBack) {
   send_json(*world_, "traffic", car);
   world_->step(20 * kMs);
   EXPECT_TRUE(present("car1"));
+}
+
+TEST_F(WorldActors, ANewRoadUserTakesOverARemovedActorOfItsShape) {
+  start();
+  const nlohmann::json car = {{"id", "car1"}, {"category", "car"}, {"x", 10.0}, {"y", 0.0}};
+  send_json(*world_, "traffic", car);
+  world_->step(20 * kMs);
+  nlohmann::json gone = car;
+  gone["absent"] = true;
+  send_json(*world_, "traffic", gone);
+  world_->step(20 * kMs);
+  // A bus (another shape) cannot take it; car2 (the same model and size) does.
+  send_json(*world_, "traffic",
+            {{"users",
+              {{{"id", "bus1"}, {"category", "bus"}, {"x", 30.0}, {"y", 6.0}},
+               {{"id", "car2"}, {"category", "car"}, {"x", 12.0}, {"y", 0.0}}}}});
+  world_->step(20 * kMs);
+  EXPECT_EQ(actors_->actor_count(), 2u);
+  EXPECT_EQ(actors_->actor("car1"), nullptr);
+  ASSERT_TRUE(present("car2"));
+  EXPECT_TRUE(present("bus1"));
+  world_->step(40 * kMs);  // the camera's next frame names the new road user
+  auto seen = boxes();
+  std::sort(seen.begin(), seen.end());
+  EXPECT_EQ(seen, (std::vector<std::string>{"bus1", "car2"}));
+  // car1 comes back: every actor of its shape is taken, so it gets a new one.
+  send_json(*world_, "traffic", car);
+  world_->step(20 * kMs);
+  EXPECT_EQ(actors_->actor_count(), 3u);
+  EXPECT_TRUE(present("car1"));
+  EXPECT_TRUE(present("car2"));
+  // A car of another size is another shape.
+  send_json(*world_, "traffic", gone);
+  world_->step(20 * kMs);
+  send_json(*world_, "traffic",
+            {{"id", "long"}, {"category", "car"}, {"length", 7.5}, {"x", -20.0}, {"y", 8.0}});
+  world_->step(20 * kMs);
+  EXPECT_EQ(actors_->actor_count(), 4u);
+}
+
+TEST_F(WorldActors, AnActorBackBeforeItIsTakenOverKeepsIt) {
+  start({{"ActorTimeout", 0.3}});
+  send_json(*world_, "traffic", {{"id", "bike"}, {"category", "cyclist"}, {"x", 12.0}});
+  world_->step(20 * kMs);
+  world_->step(400 * kMs);
+  EXPECT_FALSE(present("bike"));
+  send_json(*world_, "traffic", {{"id", "bike"}, {"category", "cyclist"}, {"x", 13.0}});
+  world_->step(20 * kMs);
+  EXPECT_TRUE(present("bike"));
+  // Its actor is no longer free: another cyclist gets a new one.
+  send_json(*world_, "traffic", {{"id", "bike2"}, {"category", "cyclist"}, {"x", 30.0}});
+  world_->step(20 * kMs);
+  EXPECT_TRUE(present("bike"));
+  EXPECT_TRUE(present("bike2"));
+  EXPECT_EQ(actors_->actor_count(), 2u);
 }
 
 TEST_F(WorldActors, AnActorNotHeardOfForActorTimeoutLeaves) {
