@@ -10,6 +10,7 @@
 # target crashed, timed out or ran out of memory. Logs: build-fuzz/logs/TARGET.log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}  # (setup.sh)
 
 TARGETS=(config opendrive datapack proto python_codec sdf)
 BUILD=build-fuzz

@@ -37,26 +37,47 @@ if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
   fi
 fi
 
+# ccache keys paths relative to the clone, so that a fresh clone elsewhere finds the objects
+# an earlier clone compiled (a warm cache is a quick build).
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
+
 echo "== building (Release) into build/"
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build -j"$(nproc)"
 echo "== built: build/bin/convoy, build/bin/NRPCoreSim"
 
+# npm ci DIR: installs DIR's packages from its package-lock.json, unless the installed ones are
+# already those (a stamp in node_modules records the lock file's hash).
+npm_ci() {
+  local sum stamp="$1/node_modules/.convoy-lock.sha1"
+  sum=$(sha1sum <"$1/package-lock.json")
+  [[ -f $stamp && $(cat "$stamp") == "$sum" ]] && return 0
+  (cd "$1" && npm ci --no-audit --no-fund --loglevel=error) && echo "$sum" >"$stamp"
+}
+# The dashboard's build, unless dist/ was built from the same sources (a stamp in dist/).
+dashboard_build() {
+  local sum stamp=web/dashboard/dist/.convoy-sources.sha1
+  sum=$(cd web/dashboard && find . -path ./node_modules -prune -o -path ./dist -prune -o \
+    -type f -print | LC_ALL=C sort | xargs sha1sum | sha1sum)
+  [[ -f $stamp && $(cat "$stamp") == "$sum" ]] && return 0
+  (cd web/dashboard && npm run build) && echo "$sum" >"$stamp"
+}
+
 # Test instruments: the official MCAP library reads Convoy's recordings
 # (tests/e2e/test_recording.py; skipped when it is not installed). With the machine's own
 # Node.js and npm (Debian's npm package conflicts with a Node.js that bundles npm).
 if command -v npm >/dev/null; then
-  (cd tools/mcap_check && npm ci --no-audit --no-fund --loglevel=error) ||
+  npm_ci tools/mcap_check ||
     echo "warning: npm ci in tools/mcap_check failed; the @mcap/core test will be skipped"
   # Foxglove's own protocol client watches a live run (tests/e2e/test_live.py).
-  (cd tools/live_check && npm ci --no-audit --no-fund --loglevel=error) ||
+  npm_ci tools/live_check ||
     echo "warning: npm ci in tools/live_check failed; the @foxglove/ws-protocol test will be skipped"
   # puppeteer-core drives Debian's chromium (above), headless, through the web dashboard
   # (tests/e2e/test_dashboard.py); it downloads no browser.
-  (cd tools/dashboard_check && npm ci --no-audit --no-fund --loglevel=error) ||
+  npm_ci tools/dashboard_check ||
     echo "warning: npm ci in tools/dashboard_check failed; the dashboard test will be skipped"
   # The web dashboard that `convoy run --live` and `convoy view` serve at / (web/dashboard/dist,
   # linked as build/share/convoy/dashboard).
-  (cd web/dashboard && npm ci --no-audit --no-fund --loglevel=error && npm run build) ||
+  { npm_ci web/dashboard && dashboard_build; } ||
     echo "warning: the web dashboard did not build; convoy run --live and convoy view show a text page at / instead"
 fi

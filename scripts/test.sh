@@ -6,6 +6,7 @@
 # ports the system picks, and the Slurm ones take turns (ctest RESOURCE_LOCK).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}" CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}  # (setup.sh)
 if [[ ! -x build/bin/convoy ]] || [[ "${CONVOY_REBUILD:-1}" == 1 ]]; then
   CONVOY_SKIP_APT=${CONVOY_SKIP_APT:-1} scripts/setup.sh >/dev/null
 fi
