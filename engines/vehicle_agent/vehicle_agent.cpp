@@ -6,6 +6,9 @@
 // moved as a kinematic bicycle (reference point: the rear axle). Lane changes: MOBIL
 // (politeness, threshold, b_safe) into a lane the lane graph allows a change to. Inputs are
 // acted on ReactionTime late. Deterministic: no wall clock, the only randomness is Seed's.
+// The models themselves (IDM, MOBIL's decision, pure pursuit, the bicycle, paths on the lane
+// graph, arrival times) are in src/road_users; this engine finds the neighbours, plans the
+// routes and talks datapacks.
 //
 // Config keys (schema.json): Map, Route {from, to} ("ROAD:LANE") or Seed, StartS, Position,
 // StartPose, InitialSpeed, Model, Category, Length, Width, Height, Wheelbase, v0,
@@ -41,7 +44,6 @@
 //                    up to 30 % more and its speed is capped so that it stops within V (1.5 s
 //                    of reaction plus braking at 0.5 mu g).
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -61,9 +63,16 @@
 #include "engine/engine.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
+#include "road_users/bicycle.h"
+#include "road_users/eta.h"
+#include "road_users/idm.h"
+#include "road_users/mobil.h"
+#include "road_users/path.h"
+#include "road_users/pure_pursuit.h"
 
 namespace convoy::engines::vehicle_agent {
 namespace odr = convoy::opendrive;
+namespace ru = convoy::road_users;
 using nlohmann::json;
 
 namespace {
@@ -72,83 +81,15 @@ constexpr double kSampleDs = 0.5;      // m between the path's poses
 constexpr double kOnwardLength = 600;  // m of lane graph planned ahead when following it onward
 constexpr double kHeadingTolerance = 60.0 * M_PI / 180.0;  // localising: lane direction vs yaw
 
-struct Idm {
-  double v0 = 13.9, T = 1.5, s0 = 2.0, a = 1.5, b = 2.0, delta = 4.0;
-  // Acceleration at speed v with a leader `gap` m ahead (bumper to bumper) at speed vl;
-  // gap = +inf: free road.
-  double accel(double v, double gap, double vl, double v0_here) const {
-    const double v0e = std::max(v0_here, 0.1);
-    double acc = a * (1.0 - std::pow(std::max(v, 0.0) / v0e, delta));
-    if (std::isfinite(gap)) {
-      const double dv = v - vl;
-      const double s_star = s0 + std::max(0.0, v * T + v * dv / (2.0 * std::sqrt(a * b)));
-      const double g = std::max(gap, 0.01);
-      acc -= a * (s_star / g) * (s_star / g);
-    }
-    return acc;
-  }
-};
-
-struct Path {
-  std::vector<odr::Pose2> poses;
-  std::vector<double> arc;  // arc length at each pose
-  odr::LaneRoute route;
-  std::vector<std::pair<double, std::string>> stops;  // (arc of stop line, signal id)
-  struct Crossing {
-    std::string junction;
-    double enter = 0, exit = 0;  // arcs
-  };
-  std::vector<Crossing> crossings;  // junctions crossed, in order
-  double length() const { return arc.empty() ? 0 : arc.back(); }
-  // Pose at arc length a (clamped).
-  odr::Pose2 at(double a) const {
-    if (poses.empty()) return {};
-    if (a <= 0) return poses.front();
-    if (a >= arc.back()) return poses.back();
-    size_t i = std::upper_bound(arc.begin(), arc.end(), a) - arc.begin();
-    const odr::Pose2& p = poses[i - 1];
-    const odr::Pose2& q = poses[i];
-    const double f = (a - arc[i - 1]) / std::max(arc[i] - arc[i - 1], 1e-9);
-    odr::Pose2 r = p;
-    r.x = p.x + f * (q.x - p.x);
-    r.y = p.y + f * (q.y - p.y);
-    r.heading = p.heading + f * std::remainder(q.heading - p.heading, 2 * M_PI);
-    return r;
-  }
-  // Projection of (x, y) onto the path among poses [lo, hi): (arc, signed lateral offset,
-  // squared distance to the nearest pose).
-  struct Proj {
-    double arc = 0, lateral = 0, d2 = INFINITY;
-    size_t index = 0;
-  };
-  Proj project(double x, double y, size_t lo = 0, size_t hi = SIZE_MAX) const {
-    Proj best;
-    hi = std::min(hi, poses.size());
-    for (size_t i = lo; i < hi; ++i) {
-      const double dx = x - poses[i].x, dy = y - poses[i].y;
-      const double d2 = dx * dx + dy * dy;
-      if (d2 < best.d2) {
-        best.d2 = d2;
-        best.index = i;
-      }
-    }
-    if (!std::isfinite(best.d2)) return best;
-    const odr::Pose2& p = poses[best.index];
-    const double c = std::cos(p.heading), s = std::sin(p.heading);
-    const double dx = x - p.x, dy = y - p.y;
-    best.arc = arc[best.index] + dx * c + dy * s;
-    best.lateral = -dx * s + dy * c;
-    return best;
-  }
-};
+using ru::Idm;
+using ru::Path;
+using Points = ru::Points;
 
 struct Snapshot {
   int64_t time_ns = 0;
   std::shared_ptr<const data::RoadUsers> neighbours;
   std::shared_ptr<const json> lights;
 };
-
-using Points = std::vector<std::array<double, 2>>;
 
 // One step's command from the scenario engine (docs/road_users.md, "Commands").
 struct Command {
@@ -214,7 +155,9 @@ class VehicleAgent final : public Engine {
   }
   std::pair<std::string, int> parse_lane(const std::string& key, const json& v) const;
   odr::LaneRoute pick_route(const json& config, uint64_t seed) const;
-  Path make_path(const odr::LaneRoute& route) const;
+  Path make_path(const odr::LaneRoute& route) const {
+    return ru::make_path(*graph_, route, kSampleDs);
+  }
   void start();
   // Respawn: back at its start once its route has ended, RespawnDelay has passed and the
   // start is free (nobody within its length + 6 m of it in its latest view).
@@ -266,7 +209,8 @@ class VehicleAgent final : public Engine {
   std::unique_ptr<odr::Network> net_;
   std::unique_ptr<odr::LaneGraph> graph_;
   Idm idm_;
-  double limit_factor_ = 0, max_decel_ = 9, politeness_ = 0.3, threshold_ = 0.2, b_safe_ = 4;
+  ru::Mobil mobil_;
+  double limit_factor_ = 0, max_decel_ = 9;
   bool lane_changes_ = true, yielding_ = true;
   double reaction_s_ = 0, radius_ = 100, start_s_ = 0, initial_speed_ = 0;
   double length_ = 4.5, width_ = 1.8, height_ = 1.5, wheelbase_ = 2.7, rear_overhang_ = 0.9;
@@ -433,50 +377,6 @@ odr::LaneRoute VehicleAgent::pick_route(const json& config, uint64_t seed) const
                     std::to_string(seed) + " on " + net_->source);
 }
 
-Path VehicleAgent::make_path(const odr::LaneRoute& route) const {
-  Path p;
-  p.route = route;
-  p.poses = graph_->sample(route, kSampleDs);
-  p.arc.resize(p.poses.size());
-  for (size_t i = 1; i < p.poses.size(); ++i) {
-    p.arc[i] =
-        p.arc[i - 1] + std::hypot(p.poses[i].x - p.poses[i - 1].x, p.poses[i].y - p.poses[i - 1].y);
-  }
-  // Stop lines: each traffic light that applies to a lane of the route, where the route
-  // passes its s.
-  for (const auto& sig : graph_->signals()) {
-    if (!sig.traffic_light || !sig.signal) continue;
-    for (const auto& seg : route.segments) {
-      if (seg.road_id != sig.road_id) continue;
-      if (std::find(sig.lanes.begin(), sig.lanes.end(), seg.lane) == sig.lanes.end()) continue;
-      const double lo = std::min(seg.s_from, seg.s_to), hi = std::max(seg.s_from, seg.s_to);
-      const double s = sig.signal->s;
-      if (s < lo - 1e-6 || s > hi + 1e-6) continue;
-      const odr::WorldPose w = graph_->world_pose(seg.road_id, seg.lane_id, s);
-      const auto pr = p.project(w.x, w.y);
-      if (pr.d2 < 4.0) p.stops.emplace_back(pr.arc, sig.signal->id);
-    }
-  }
-  std::sort(p.stops.begin(), p.stops.end());
-  // Junction crossings: runs of segments in one junction, from the first one's start to the
-  // last one's end.
-  const auto& segs = route.segments;
-  for (size_t i = 0; i < segs.size();) {
-    if (segs[i].junction == "-1") {
-      ++i;
-      continue;
-    }
-    size_t j = i;
-    while (j + 1 < segs.size() && segs[j + 1].junction == segs[i].junction) ++j;
-    const odr::WorldPose a = graph_->world_pose(segs[i].road_id, segs[i].lane_id, segs[i].s_from);
-    const odr::WorldPose b = graph_->world_pose(segs[j].road_id, segs[j].lane_id, segs[j].s_to);
-    const auto pa = p.project(a.x, a.y), pb = p.project(b.x, b.y);
-    p.crossings.push_back({segs[i].junction, std::max(0.0, pa.arc), pb.arc});
-    i = j + 1;
-  }
-  return p;
-}
-
 std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name,
                                                          const json& config, int64_t timestep_ns) {
   name_ = name;
@@ -497,9 +397,9 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   idm_.delta = config.at("delta").get<double>();
   limit_factor_ = config.at("SpeedLimitFactor").get<double>();
   max_decel_ = config.at("MaxDeceleration").get<double>();
-  politeness_ = config.at("politeness").get<double>();
-  threshold_ = config.at("threshold").get<double>();
-  b_safe_ = config.at("b_safe").get<double>();
+  mobil_.politeness = config.at("politeness").get<double>();
+  mobil_.threshold = config.at("threshold").get<double>();
+  mobil_.b_safe = config.at("b_safe").get<double>();
   lane_changes_ = config.at("LaneChanges").get<bool>();
   yielding_ = config.at("JunctionYielding").get<bool>();
   reaction_s_ = config.at("ReactionTime").get<double>();
@@ -768,15 +668,8 @@ void VehicleAgent::consider_lane_change() {
   const double my_front = 0.5 * length_ + (0.5 * length_ - rear_overhang_);
   const double my_rear = -rear_overhang_;
   const double v0 = desired_speed();
-  struct Near {
-    double gap = INFINITY;
-    double speed = 0;
-    double gap_to_next = INFINITY;  // follower: its gap to my leader position (filled later)
-    bool found = false;
-    double lon = 0;
-  };
   // Leader / follower in the band with centre offset `centre` (lateral, m) and half width hw.
-  auto scan = [&](double centre, double hw, Near& lead, Near& follow) {
+  auto scan = [&](double centre, double hw, ru::LaneNeighbours& near) {
     if (!snap || !snap->neighbours) return;
     for (const auto& u : snap->neighbours->users()) {
       if (u.absent() || u.id() == name_) continue;
@@ -787,10 +680,10 @@ void VehicleAgent::consider_lane_change() {
       const double u_rear = lon + u.length_offset() - 0.5 * u.length();
       if (u_front > my_front && u_rear > my_rear) {
         const double g = u_rear - my_front;
-        if (g < lead.gap) lead = {g, u.speed(), INFINITY, true, lon};
+        if (g < near.leader.gap) near.leader = {true, g, u.speed()};
       } else {
         const double g = my_rear - u_front;
-        if (g < follow.gap) follow = {g, u.speed(), INFINITY, true, lon};
+        if (g < near.follower.gap) near.follower = {true, g, u.speed()};
       }
     }
   };
@@ -807,30 +700,11 @@ void VehicleAgent::consider_lane_change() {
     const double own = -(wc.x - x_) * s + (wc.y - y_) * c;
     const double w = std::abs(centre - own);
     if (w < 1.0) continue;
-    Near cl, cf, nl, nf;
-    scan(own, 0.5 * w, cl, cf);
-    scan(centre, 0.5 * w, nl, nf);
-    if (nl.found && nl.gap < 0) continue;  // someone beside me
-    if (nf.found && nf.gap < 0) continue;
-    const double a_c = idm_.accel(v_, cl.gap, cl.speed, v0);
-    const double a_c2 = idm_.accel(v_, nl.gap, nl.speed, v0);
-    // New follower: now behind the new leader, then behind me.
-    double a_n = 0, a_n2 = 0;
-    if (nf.found) {
-      const double gap_now =
-          nl.found ? nl.gap + nf.gap + length_ : INFINITY;  // its gap to the new leader
-      a_n = idm_.accel(nf.speed, gap_now, nl.speed, idm_.v0);
-      a_n2 = idm_.accel(nf.speed, nf.gap, v_, idm_.v0);
-      if (a_n2 < -b_safe_) continue;  // unsafe for the new follower
-    }
-    double a_o = 0, a_o2 = 0;
-    if (cf.found) {
-      a_o = idm_.accel(cf.speed, cf.gap, v_, idm_.v0);
-      a_o2 =
-          idm_.accel(cf.speed, cl.found ? cl.gap + cf.gap + length_ : INFINITY, cl.speed, idm_.v0);
-    }
-    const double incentive = a_c2 - a_c + politeness_ * ((a_n2 - a_n) + (a_o2 - a_o));
-    if (incentive <= threshold_) continue;
+    ru::LaneNeighbours here, there;
+    scan(own, 0.5 * w, here);
+    scan(centre, 0.5 * w, there);
+    const ru::MobilDecision d = ru::decide_lane_change(idm_, mobil_, v_, v0, length_, here, there);
+    if (d.outcome != ru::LaneChange::kChange) continue;
     // The route on from the target lane: keep that lane to the destination road if it can,
     // else any route there.
     const std::optional<odr::LaneRoute> route =
@@ -852,16 +726,6 @@ void VehicleAgent::consider_lane_change() {
 namespace {
 constexpr double kCommitReaction = 1.0;  // s
 constexpr double kCommitDecel = 2.0;     // m/s^2
-
-// Time to cover d m from speed v accelerating at a up to v0.
-double eta(double d, double v, double a, double v0) {
-  if (d <= 0) return 0;
-  v = std::max(v, 0.0);
-  const double t_up = std::max(v0 - v, 0.0) / a;
-  const double d_up = v * t_up + 0.5 * a * t_up * t_up;
-  if (d <= d_up) return (-v + std::sqrt(v * v + 2 * a * d)) / a;
-  return t_up + (d - d_up) / std::max({v0, v, 0.1});  // one faster than v0 keeps its speed
-}
 }  // namespace
 
 bool VehicleAgent::red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const {
@@ -894,9 +758,9 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
   if (g < 0 || g > radius_) return INFINITY;            // inside already, or far
   if (g < v_ * v_ / (2 * max_decel_)) return INFINITY;  // cannot stop before it: committed
   if (!snap || !snap->neighbours) return INFINITY;
-  const double my_eta = eta(g, v_, idm_.a, idm_.v0);
+  const double my_eta = ru::eta(g, v_, idm_.a, idm_.v0);
   // Until my rear has left the junction.
-  const double my_clear = eta(g + (next->exit - next->enter) + length_, v_, idm_.a, idm_.v0);
+  const double my_clear = ru::eta(g + (next->exit - next->enter) + length_, v_, idm_.a, idm_.v0);
   const size_t lo = cursor_ > 40 ? cursor_ - 40 : 0;
   for (const auto& u : snap->neighbours->users()) {
     if (u.absent() || u.id() == name_) continue;
@@ -924,7 +788,7 @@ double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const 
     if (red_for(loc->lane, front_s, snap)) continue;  // it waits at its light
     const double remaining = (ln.forward ? ln.s1 - loc->s : loc->s - ln.s0) - u_front;
     if (remaining < 0) return std::max(g, 0.0);  // its front is in
-    const double other_eta = eta(remaining, u.speed(), idm_.a, idm_.v0);
+    const double other_eta = ru::eta(remaining, u.speed(), idm_.a, idm_.v0);
     if (other_eta < my_eta - 0.05 || (other_eta <= my_eta + 0.05 && u.id() < name_))
       return std::max(g, 0.0);
     // I would be first, but one that cannot stop comfortably before the junction any more
@@ -1340,35 +1204,7 @@ void VehicleAgent::begin_lane(const Command::Lane& c) {
 void VehicleAgent::set_polyline(const Points& points) {
   if (points == polyline_) return;
   polyline_ = points;
-  traj_path_ = Path{};
-  for (size_t i = 0; i + 1 < points.size(); ++i) {
-    const auto [ax, ay] = points[i];
-    const auto [bx, by] = points[i + 1];
-    const double len = std::hypot(bx - ax, by - ay);
-    if (len < 1e-9) continue;
-    const double h = std::atan2(by - ay, bx - ax);
-    const int n = std::max(1, static_cast<int>(std::ceil(len / kSampleDs)));
-    for (int k = traj_path_.poses.empty() ? 0 : 1; k <= n; ++k) {
-      odr::Pose2 p;
-      p.x = ax + (bx - ax) * k / n;
-      p.y = ay + (by - ay) * k / n;
-      p.heading = h;
-      const double a = traj_path_.poses.empty()
-                           ? 0.0
-                           : traj_path_.arc.back() + std::hypot(p.x - traj_path_.poses.back().x,
-                                                                p.y - traj_path_.poses.back().y);
-      traj_path_.poses.push_back(p);
-      traj_path_.arc.push_back(a);
-    }
-  }
-  if (traj_path_.poses.empty()) {  // one point (or all the same): towards it
-    odr::Pose2 p;
-    p.x = points[0][0];
-    p.y = points[0][1];
-    p.heading = std::atan2(p.y - y_, p.x - x_);
-    traj_path_.poses = {p};
-    traj_path_.arc = {0.0};
-  }
+  traj_path_ = ru::polyline_path(points, kSampleDs, x_, y_);
 }
 
 void VehicleAgent::extend() {
@@ -1566,24 +1402,14 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
     y_ += v_new * std::sin(yaw_) * dt;
     yaw_rate_ = 0;
   } else {
-    const double lookahead = std::max(4.0, 0.8 * v_ + 2.0);
-    const double a_t = darc + wheelbase_ + lookahead;
-    odr::Pose2 target = drive.at(a_t);
-    if (on_poly && a_t > drive.length()) {  // past its end: straight on
-      target.x += (a_t - drive.length()) * std::cos(target.heading);
-      target.y += (a_t - drive.length()) * std::sin(target.heading);
-    }
-    const double dx = target.x - x_, dy = target.y - y_;
-    const double alpha = std::atan2(dy, dx) - yaw_;
-    const double ld = std::max(std::hypot(dx, dy), 1.0);
-    double steer = std::atan2(2.0 * wheelbase_ * std::sin(alpha), ld);
-    steer = std::clamp(steer, -0.6, 0.6);
-    // Kinematic bicycle (rear axle), semi-implicit Euler.
-    yaw_rate_ = v_new * std::tan(steer) / wheelbase_;
-    const double yaw_mid = yaw_ + 0.5 * yaw_rate_ * dt;
-    x_ += v_new * std::cos(yaw_mid) * dt;
-    y_ += v_new * std::sin(yaw_mid) * dt;
-    yaw_ = std::remainder(yaw_ + yaw_rate_ * dt, 2 * M_PI);
+    const ru::KinematicBicycle bicycle{wheelbase_};
+    const ru::PlanarPose pose{x_, y_, yaw_};
+    const double steer = ru::pursue(ru::PurePursuit{}, bicycle, drive, darc, pose, v_, on_poly);
+    const ru::BicycleMotion moved = ru::step_bicycle(bicycle, pose, v_new, steer, dt);
+    x_ = moved.pose.x;
+    y_ = moved.pose.y;
+    yaw_ = moved.pose.yaw;
+    yaw_rate_ = moved.yaw_rate;
   }
   v_ = v_new;
   acc_ = acc;
