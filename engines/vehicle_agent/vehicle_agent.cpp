@@ -6,9 +6,10 @@
 // moved as a kinematic bicycle (reference point: the rear axle). Lane changes: MOBIL
 // (politeness, threshold, b_safe) into a lane the lane graph allows a change to. Inputs are
 // acted on ReactionTime late. Deterministic: no wall clock, the only randomness is Seed's.
-// The models themselves (IDM, MOBIL's decision, pure pursuit, the bicycle, paths on the lane
-// graph, arrival times) are in src/road_users; this engine finds the neighbours, plans the
-// routes and talks datapacks.
+// The models themselves (IDM, MOBIL, pure pursuit, the bicycle, paths on the lane graph, the
+// leader and the lane neighbours, lights, junction yielding, the weather) are in
+// src/road_users; this engine turns its datapacks into their inputs, plans the routes and
+// carries out commands.
 //
 // Config keys (schema.json): Map, Route {from, to} ("ROAD:LANE") or Seed, StartS, Position,
 // StartPose, InitialSpeed, Model, Category, Length, Width, Height, Wheelbase, v0,
@@ -64,11 +65,14 @@
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
 #include "road_users/bicycle.h"
-#include "road_users/eta.h"
 #include "road_users/idm.h"
+#include "road_users/junction.h"
+#include "road_users/lights.h"
 #include "road_users/mobil.h"
+#include "road_users/neighbours.h"
 #include "road_users/path.h"
 #include "road_users/pure_pursuit.h"
+#include "road_users/weather.h"
 
 namespace convoy::engines::vehicle_agent {
 namespace odr = convoy::opendrive;
@@ -87,9 +91,40 @@ using Points = ru::Points;
 
 struct Snapshot {
   int64_t time_ns = 0;
-  std::shared_ptr<const data::RoadUsers> neighbours;
-  std::shared_ptr<const json> lights;
+  std::shared_ptr<const ru::Neighbours> neighbours;  // null: none received yet
+  std::shared_ptr<const ru::LightStates> lights;
 };
+
+// The road users in a neighbours datapack but `self` and the absent, in the order received.
+ru::Neighbours neighbours_of(const data::RoadUsers& users, const std::string& self) {
+  ru::Neighbours out;
+  out.reserve(users.users_size());
+  for (const data::RoadUser& u : users.users()) {
+    if (u.absent() || u.id() == self) continue;
+    out.push_back(
+        {u.id(), u.x(), u.y(), u.yaw(), u.speed(), u.length(), u.width(), u.length_offset()});
+  }
+  return out;
+}
+
+// The signals' states of the lights datapack ({"signals": {id: state}}, or the map itself);
+// a state that is not a string is left out (green).
+ru::LightStates light_states(const json& j) {
+  ru::LightStates out;
+  const json& sig = j.contains("signals") ? j["signals"] : j;
+  if (!sig.is_object()) return out;
+  for (const auto& [id, v] : sig.items()) {
+    if (!v.is_string()) continue;
+    const std::string& st = v.get_ref<const std::string&>();
+    const ru::Light light = st == "red"          ? ru::Light::kRed
+                            : st == "red_yellow" ? ru::Light::kRedYellow
+                            : st == "yellow"     ? ru::Light::kYellow
+                            : st == "green"      ? ru::Light::kGreen
+                                                 : ru::Light::kOff;
+    out.emplace(id, light);
+  }
+  return out;
+}
 
 // One step's command from the scenario engine (docs/road_users.md, "Commands").
 struct Command {
@@ -161,19 +196,21 @@ class VehicleAgent final : public Engine {
   void start();
   // Respawn: back at its start once its route has ended, RespawnDelay has passed and the
   // start is free (nobody within its length + 6 m of it in its latest view).
-  bool start_free() const;
+  bool start_free() const {
+    const Snapshot* snap = perceived();
+    return snap && snap->neighbours &&
+           ru::start_free(*snap->neighbours, initial_path_start_.x, initial_path_start_.y,
+                          length_ + 6.0);
+  }
   void restart();
   void publish();
   double desired_speed() const;
-  // The leader ahead on `path` from arc `me` (my front bumper's arc): (gap, speed).
-  std::pair<double, double> leader_on(const Path& path, double my_arc, size_t cursor) const;
+  ru::Observer observer() const { return {name_, x_, y_, yaw_, v_, radius_}; }
+  // The gap to where it must stop on `drive` (cursor, front: its front bumper's arc there)
+  // and the speed of what it stops behind: the leader, a red light, a junction to wait at.
+  std::pair<double, double> stop_ahead(const Path& drive, size_t cursor, double front,
+                                       bool on_poly) const;
   void consider_lane_change();
-  // Gap to the entry of the next junction when it must wait there (first come by arrival
-  // time, ties by id; anyone inside blocks), else +inf.
-  double junction_wait(double my_front, const Snapshot* snap) const;
-  // Whether one whose front is at front_s on `lane` waits at a red light: the lane's light
-  // is red and its front has not passed the light's stop line.
-  bool red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const;
   const Snapshot* perceived() const;
   // Commands and localisation (docs/road_users.md, "Commands").
   Command parse_command(const std::string& dp, const json& j) const;
@@ -208,7 +245,6 @@ class VehicleAgent final : public Engine {
   std::string name_;
   std::unique_ptr<odr::Network> net_;
   std::unique_ptr<odr::LaneGraph> graph_;
-  Idm idm_;
   ru::Mobil mobil_;
   double limit_factor_ = 0, max_decel_ = 9;
   bool lane_changes_ = true, yielding_ = true;
@@ -216,11 +252,10 @@ class VehicleAgent final : public Engine {
   double length_ = 4.5, width_ = 1.8, height_ = 1.5, wheelbase_ = 2.7, rear_overhang_ = 0.9;
   std::string model_, category_;
   std::string state_dp_, neighbours_dp_, lights_dp_, weather_dp_;
-  // Weather: the configured IDM, and the factors the weather applies to it (see the header).
+  // Weather: the configured IDM, and what the weather makes of it (see the header).
   bool weather_adaptation_ = true;
   Idm base_idm_;
-  double speed_factor_ = 1.0, visibility_speed_ = INFINITY;
-  void adapt_to_weather(double mu, double visibility_m);
+  ru::Driving driving_;  // the IDM it drives with
   odr::LaneRoute initial_route_;
   std::vector<Goal> initial_goals_;
   bool initial_onward_ = false;
@@ -243,8 +278,8 @@ class VehicleAgent final : public Engine {
   int changing_ = 0;  // +1 left, -1 right while a lane change is under way
   int64_t next_mobil_ns_ = 0;
   std::deque<Snapshot> inputs_;
-  std::shared_ptr<const data::RoadUsers> last_neighbours_;
-  std::shared_ptr<const json> last_lights_;
+  std::shared_ptr<const ru::Neighbours> last_neighbours_;
+  std::shared_ptr<const ru::LightStates> last_lights_;
   data::RoadUser state_;
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
@@ -389,12 +424,13 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   } catch (const std::exception& e) {
     fail("Map", e.what());
   }
-  idm_.v0 = config.at("v0").get<double>();
-  idm_.T = config.at("T").get<double>();
-  idm_.s0 = config.at("s0").get<double>();
-  idm_.a = config.at("a").get<double>();
-  idm_.b = config.at("b").get<double>();
-  idm_.delta = config.at("delta").get<double>();
+  base_idm_.v0 = config.at("v0").get<double>();
+  base_idm_.T = config.at("T").get<double>();
+  base_idm_.s0 = config.at("s0").get<double>();
+  base_idm_.a = config.at("a").get<double>();
+  base_idm_.b = config.at("b").get<double>();
+  base_idm_.delta = config.at("delta").get<double>();
+  driving_ = ru::Driving{base_idm_};
   limit_factor_ = config.at("SpeedLimitFactor").get<double>();
   max_decel_ = config.at("MaxDeceleration").get<double>();
   mobil_.politeness = config.at("politeness").get<double>();
@@ -422,7 +458,6 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   weather_dp_ = config.at("WeatherDataPack").get<std::string>();
   weather_adaptation_ = config.at("WeatherAdaptation").get<bool>();
   command_dp_ = config.at("CommandDataPack").get<std::string>();
-  base_idm_ = idm_;
   seed_ = config.at("Seed").get<uint64_t>();
   rng_.seed(seed_ * 0x9E3779B97F4A7C15ull + 0x0A7Eull);
 
@@ -510,17 +545,6 @@ std::vector<engine::DataPackId> VehicleAgent::initialize(const std::string& name
   return ids;
 }
 
-bool VehicleAgent::start_free() const {
-  const Snapshot* snap = perceived();
-  if (!snap || !snap->neighbours) return false;
-  const odr::Pose2 p = initial_path_start_;
-  for (const auto& u : snap->neighbours->users()) {
-    if (u.absent() || u.id() == name_) continue;
-    if (std::hypot(u.x() - p.x, u.y() - p.y) < length_ + 6.0) return false;
-  }
-  return true;
-}
-
 void VehicleAgent::restart() {
   path_ = make_path(initial_route_);
   goals_ = initial_goals_;
@@ -590,34 +614,14 @@ void VehicleAgent::start() {
 }
 
 double VehicleAgent::desired_speed() const {
-  double v = idm_.v0;
+  std::optional<double> limit;
   if (limit_factor_ > 0 && !path_.route.segments.empty()) {
     if (const auto loc = graph_->locate(x_, y_, yaw_)) {
       const odr::SpeedLimit lim = graph_->speed_limit(loc->lane, loc->s);
-      if (lim.known && std::isfinite(lim.mps)) v = limit_factor_ * lim.mps * speed_factor_;
+      if (lim.known) limit = lim.mps;
     }
   }
-  return std::min(v, visibility_speed_);
-}
-
-void VehicleAgent::adapt_to_weather(double mu, double visibility_m) {
-  idm_ = base_idm_;
-  speed_factor_ = 1.0;
-  visibility_speed_ = INFINITY;
-  if (!weather_adaptation_) return;
-  const double loss = std::clamp(1.0 - mu / 0.8, 0.0, 1.0);  // 0 dry .. 1 no grip
-  const double grip = std::max(0.5 * mu * 9.81, 0.3);        // comfortable use of the grip
-  speed_factor_ = 1.0 - 0.4 * loss;
-  idm_.v0 = base_idm_.v0 * speed_factor_;
-  idm_.T = base_idm_.T * (1.0 + 0.5 * loss);
-  idm_.a = std::min(base_idm_.a, grip);
-  idm_.b = std::min(base_idm_.b, grip);
-  if (visibility_m < 1000.0) {
-    idm_.T *= 1.0 + 0.3 * std::clamp((1000.0 - visibility_m) / 900.0, 0.0, 1.0);
-    // Stop within the visibility: 1.5 s v + v^2 / (2 grip) = V.
-    const double tr = 1.5;
-    visibility_speed_ = grip * (-tr + std::sqrt(tr * tr + 2.0 * visibility_m / grip));
-  }
+  return ru::desired_speed(driving_, limit_factor_, limit);
 }
 
 const Snapshot* VehicleAgent::perceived() const {
@@ -630,30 +634,33 @@ const Snapshot* VehicleAgent::perceived() const {
   return best;
 }
 
-std::pair<double, double> VehicleAgent::leader_on(const Path& path, double my_front,
-                                                  size_t cursor) const {
-  double gap = INFINITY, speed = 0;
+std::pair<double, double> VehicleAgent::stop_ahead(const Path& drive, size_t cursor, double front,
+                                                   bool on_poly) const {
   const Snapshot* snap = perceived();
-  if (!snap || !snap->neighbours) return {gap, speed};
-  const size_t hi = cursor + static_cast<size_t>(radius_ / kSampleDs) + 2;
-  const size_t lo = cursor > 10 ? cursor - 10 : 0;
-  for (const auto& u : snap->neighbours->users()) {
-    if (u.absent() || u.id() == name_) continue;
-    if (std::hypot(u.x() - x_, u.y() - y_) > radius_) continue;
-    const auto pr = path.project(u.x(), u.y(), lo, hi);
-    if (!std::isfinite(pr.d2)) continue;
-    const double half_w = 0.5 * (u.width() > 0 ? u.width() : 1.8);
-    if (std::abs(pr.lateral) > 1.0 + half_w) continue;  // not in my lane
-    const double rear = pr.arc + u.length_offset() - 0.5 * u.length();
-    const double front = pr.arc + u.length_offset() + 0.5 * u.length();
-    if (front <= my_front) continue;  // behind (or beside) me
-    const double g = rear - my_front;
+  if (!snap) return {INFINITY, 0};
+  const ru::Observer me = observer();
+  const Idm& idm = driving_.idm;
+  ru::LaneNeighbour leader;
+  if (snap->neighbours)
+    leader = ru::leader_on(drive, cursor, front, kSampleDs, me, *snap->neighbours);
+  double gap = leader.gap, vl = leader.speed;
+  // Red lights: a standing virtual leader at the stop line.
+  if (!on_poly && snap->lights) {
+    const double g = ru::stop_line_gap(path_, *snap->lights, front, v_, idm.b, radius_);
     if (g < gap) {
-      gap = g;
-      speed = u.speed();
+      gap = std::max(g, 0.0);
+      vl = 0;
     }
   }
-  return {gap, speed};
+  if (yielding_ && !on_poly && snap->neighbours) {
+    const ru::Approach at{&path_, cursor_, front, length_, max_decel_, idm};
+    const double g = ru::junction_wait(*graph_, at, me, *snap->neighbours, snap->lights.get());
+    if (g < gap) {
+      gap = g;
+      vl = 0;
+    }
+  }
+  return {gap, vl};
 }
 
 void VehicleAgent::consider_lane_change() {
@@ -664,29 +671,13 @@ void VehicleAgent::consider_lane_change() {
   const odr::LaneNode& lane = graph_->lane(loc->lane);
   if (lane.junction != "-1") return;
   const Snapshot* snap = perceived();
+  const ru::Neighbours none;
+  const ru::Neighbours& around = snap && snap->neighbours ? *snap->neighbours : none;
+  const ru::Observer me = observer();
   const double c = std::cos(yaw_), s = std::sin(yaw_);
   const double my_front = 0.5 * length_ + (0.5 * length_ - rear_overhang_);
   const double my_rear = -rear_overhang_;
   const double v0 = desired_speed();
-  // Leader / follower in the band with centre offset `centre` (lateral, m) and half width hw.
-  auto scan = [&](double centre, double hw, ru::LaneNeighbours& near) {
-    if (!snap || !snap->neighbours) return;
-    for (const auto& u : snap->neighbours->users()) {
-      if (u.absent() || u.id() == name_) continue;
-      const double dx = u.x() - x_, dy = u.y() - y_;
-      const double lon = dx * c + dy * s, lat = -dx * s + dy * c;
-      if (std::abs(lon) > radius_ || std::abs(lat - centre) > hw) continue;
-      const double u_front = lon + u.length_offset() + 0.5 * u.length();
-      const double u_rear = lon + u.length_offset() - 0.5 * u.length();
-      if (u_front > my_front && u_rear > my_rear) {
-        const double g = u_rear - my_front;
-        if (g < near.leader.gap) near.leader = {true, g, u.speed()};
-      } else {
-        const double g = my_rear - u_front;
-        if (g < near.follower.gap) near.follower = {true, g, u.speed()};
-      }
-    }
-  };
   const bool open_before = open_end_;  // (planning a change that is not taken sets it)
   for (int side : {+1, -1}) {
     const odr::LaneIndex target = side > 0 ? lane.left() : lane.right();
@@ -700,10 +691,12 @@ void VehicleAgent::consider_lane_change() {
     const double own = -(wc.x - x_) * s + (wc.y - y_) * c;
     const double w = std::abs(centre - own);
     if (w < 1.0) continue;
-    ru::LaneNeighbours here, there;
-    scan(own, 0.5 * w, here);
-    scan(centre, 0.5 * w, there);
-    const ru::MobilDecision d = ru::decide_lane_change(idm_, mobil_, v_, v0, length_, here, there);
+    const ru::LaneNeighbours here =
+        ru::lane_neighbours(me, around, own, 0.5 * w, my_front, my_rear);
+    const ru::LaneNeighbours there =
+        ru::lane_neighbours(me, around, centre, 0.5 * w, my_front, my_rear);
+    const ru::MobilDecision d =
+        ru::decide_lane_change(driving_.idm, mobil_, v_, v0, length_, here, there);
     if (d.outcome != ru::LaneChange::kChange) continue;
     // The route on from the target lane: keep that lane to the destination road if it can,
     // else any route there.
@@ -721,84 +714,6 @@ void VehicleAgent::consider_lane_change() {
     return;
   }
   open_end_ = open_before;
-}
-
-namespace {
-constexpr double kCommitReaction = 1.0;  // s
-constexpr double kCommitDecel = 2.0;     // m/s^2
-}  // namespace
-
-bool VehicleAgent::red_for(odr::LaneIndex lane, double front_s, const Snapshot* snap) const {
-  if (!snap || !snap->lights) return false;
-  const json& sig = snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
-  const bool forward = graph_->lane(lane).forward;
-  for (const auto& info : graph_->signals()) {
-    if (!info.traffic_light || !info.signal) continue;
-    if (std::find(info.lanes.begin(), info.lanes.end(), lane) == info.lanes.end()) continue;
-    auto it = sig.find(info.signal->id);
-    if (it == sig.end() || !it->is_string() || (*it != "red" && *it != "red_yellow")) continue;
-    // Past its stop line (it went on yellow, or waits for the junction): not held by it.
-    const double stop_s = info.signal->s;
-    if (forward ? front_s > stop_s + 0.5 : front_s < stop_s - 0.5) continue;
-    return true;
-  }
-  return false;
-}
-
-double VehicleAgent::junction_wait(double my_front, const Snapshot* snap) const {
-  const Path::Crossing* next = nullptr;
-  for (const auto& c : path_.crossings) {
-    if (c.exit > my_front - length_) {
-      next = &c;
-      break;
-    }
-  }
-  if (!next) return INFINITY;
-  const double g = next->enter - my_front;
-  if (g < 0 || g > radius_) return INFINITY;            // inside already, or far
-  if (g < v_ * v_ / (2 * max_decel_)) return INFINITY;  // cannot stop before it: committed
-  if (!snap || !snap->neighbours) return INFINITY;
-  const double my_eta = ru::eta(g, v_, idm_.a, idm_.v0);
-  // Until my rear has left the junction.
-  const double my_clear = ru::eta(g + (next->exit - next->enter) + length_, v_, idm_.a, idm_.v0);
-  const size_t lo = cursor_ > 40 ? cursor_ - 40 : 0;
-  for (const auto& u : snap->neighbours->users()) {
-    if (u.absent() || u.id() == name_) continue;
-    if (std::hypot(u.x() - x_, u.y() - y_) > radius_) continue;
-    // On my own path (a leader or follower): IDM's business.
-    const auto pr = path_.project(u.x(), u.y(), lo);
-    if (std::isfinite(pr.d2) && std::abs(pr.lateral) < 1.2 &&
-        std::abs(std::remainder(u.yaw() - path_.at(pr.arc).heading, 2 * M_PI)) < 0.5)
-      continue;
-    const auto loc = graph_->locate(u.x(), u.y(), u.yaw());
-    if (!loc) continue;
-    const odr::LaneNode& ln = graph_->lane(loc->lane);
-    const double u_front = u.length_offset() + 0.5 * u.length();
-    if (ln.junction == next->junction) {
-      // Inside; blocking unless its back has nearly left (it is leaving).
-      return std::max(g, 0.0);
-    }
-    // Approaching: its lane leads into the junction.
-    bool leads = false;
-    for (odr::LaneIndex nx : graph_->successors(loc->lane)) {
-      if (graph_->lane(nx).junction == next->junction) leads = true;
-    }
-    if (!leads) continue;
-    const double front_s = ln.forward ? loc->s + u_front : loc->s - u_front;
-    if (red_for(loc->lane, front_s, snap)) continue;  // it waits at its light
-    const double remaining = (ln.forward ? ln.s1 - loc->s : loc->s - ln.s0) - u_front;
-    if (remaining < 0) return std::max(g, 0.0);  // its front is in
-    const double other_eta = ru::eta(remaining, u.speed(), idm_.a, idm_.v0);
-    if (other_eta < my_eta - 0.05 || (other_eta <= my_eta + 0.05 && u.id() < name_))
-      return std::max(g, 0.0);
-    // I would be first, but one that cannot stop comfortably before the junction any more
-    // (1 s to react, then 2 m/s^2) and arrives before I have cleared it does not yield,
-    // whoever drives it (SUMO's vehicles keep their right of way): wait for it.
-    const double v = std::max(u.speed(), 0.0);
-    if (remaining < v * kCommitReaction + v * v / (2 * kCommitDecel) && other_eta < my_clear + 0.5)
-      return std::max(g, 0.0);
-  }
-  return INFINITY;
 }
 
 Points VehicleAgent::parse_points(const std::string& key, const json& v, size_t min_points) const {
@@ -1336,42 +1251,14 @@ int64_t VehicleAgent::step(int64_t duration_ns) {
     acc = cmd->speed->acceleration ? *cmd->speed->acceleration : (v_new - v_) / dt;
     commanded_acc_ = acc;
   } else if (lost_) {
-    acc = -std::min(idm_.b, v_ / dt);
+    acc = -std::min(driving_.idm.b, v_ / dt);
     v_new = std::max(0.0, v_ + acc * dt);
   } else {
     const double my_front = darc + my_front_off;
     const double v0 = desired_speed();
-    auto [gap, vl] = leader_on(drive, my_front, dcursor);
-    // Red lights: a standing virtual leader at the stop line.
-    const Snapshot* snap = perceived();
-    if (!on_poly && snap && snap->lights) {
-      const json& sig =
-          snap->lights->contains("signals") ? (*snap->lights)["signals"] : *snap->lights;
-      for (const auto& [stop_arc, id] : path_.stops) {
-        const double g = stop_arc - my_front;
-        if (g < -0.5) continue;  // passed
-        if (g > radius_) break;
-        auto it = sig.find(id);
-        if (it == sig.end() || !it->is_string()) break;  // green (or unknown): the next one counts
-        const std::string st = it->get<std::string>();
-        bool stop = st == "red" || st == "red_yellow";
-        if (st == "yellow") stop = g > v_ * v_ / (2 * idm_.b);  // stop only if it comfortably can
-        if (stop && g < gap) {
-          gap = std::max(g, 0.0);
-          vl = 0;
-        }
-        break;  // only the next light counts
-      }
-    }
-    if (yielding_ && !on_poly) {
-      const double g = junction_wait(my_front, snap);
-      if (g < gap) {
-        gap = g;
-        vl = 0;
-      }
-    }
-    acc = idm_.accel(v_, gap, vl, v0);
-    acc = std::clamp(acc, -max_decel_, idm_.a);
+    const auto [gap, vl] = stop_ahead(drive, dcursor, my_front, on_poly);
+    acc = driving_.idm.accel(v_, gap, vl, v0);
+    acc = std::clamp(acc, -max_decel_, driving_.idm.a);
     v_new = v_ + acc * dt;
     if (v_new < 0) {
       v_new = 0;
@@ -1483,16 +1370,16 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
   if (dp.empty()) return;
   const std::string& name = dp.id().name();
   if (name == neighbours_dp_) {
-    auto users = std::make_shared<data::RoadUsers>();
+    data::RoadUsers users;
     if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
-      datapack::read_proto(dp, users.get());
+      datapack::read_proto(dp, &users);
     } else if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUser>()) {
-      datapack::read_proto(dp, users->add_users());
+      datapack::read_proto(dp, users.add_users());
     } else {
       fail(name, std::string("expected convoy.data.RoadUsers or RoadUser, got ") +
                      (dp.is_proto() ? dp.proto_type() : std::string("JSON")));
     }
-    last_neighbours_ = std::move(users);
+    last_neighbours_ = std::make_shared<const ru::Neighbours>(neighbours_of(users, name_));
   } else if (name == weather_dp_) {
     if (!dp.is_json()) fail(name, "expected the weather engine's JSON datapack");
     const json w = datapack::read_json(dp);
@@ -1504,7 +1391,8 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
     const double mu = num("mu", 0.8), visibility = num("visibility_m", INFINITY);
     if (!(mu >= 0)) fail(name, "mu: must be >= 0");
     if (!(visibility > 0)) fail(name, "visibility_m: must be > 0");
-    adapt_to_weather(mu, visibility);
+    driving_ = weather_adaptation_ ? ru::adapt_to_weather(base_idm_, {mu, visibility})
+                                   : ru::Driving{base_idm_};
     return;
   } else if (name == command_dp_) {
     if (!dp.is_json()) fail(name, "expected a JSON datapack of commands");
@@ -1517,9 +1405,9 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
     return;
   } else if (name == lights_dp_) {
     if (!dp.is_json()) fail(name, "expected a JSON datapack {\"signals\": {id: state}}");
-    auto j = std::make_shared<json>(datapack::read_json(dp));
-    if (!j->is_object()) fail(name, "expected a JSON object {\"signals\": {id: state}}");
-    last_lights_ = std::move(j);
+    const json j = datapack::read_json(dp);
+    if (!j.is_object()) fail(name, "expected a JSON object {\"signals\": {id: state}}");
+    last_lights_ = std::make_shared<const ru::LightStates>(light_states(j));
   } else {
     warn_once("dp:" + name, "datapack '" + name + "' is not one it reads (" + neighbours_dp_ +
                                 ", " + lights_dp_ + ", " + weather_dp_ + ", " + command_dp_ +

@@ -5,10 +5,10 @@ namespace convoy::road_users {
 MobilDecision decide_lane_change(const Idm& idm, const Mobil& mobil, double v, double v0_here,
                                  double length, const LaneNeighbours& current,
                                  const LaneNeighbours& target) {
-  const Neighbour& cl = current.leader;
-  const Neighbour& cf = current.follower;
-  const Neighbour& nl = target.leader;
-  const Neighbour& nf = target.follower;
+  const LaneNeighbour& cl = current.leader;
+  const LaneNeighbour& cf = current.follower;
+  const LaneNeighbour& nl = target.leader;
+  const LaneNeighbour& nf = target.follower;
   if (nl.found && nl.gap < 0) return {LaneChange::kBlocked, 0};
   if (nf.found && nf.gap < 0) return {LaneChange::kBlocked, 0};
   const double a_c = idm.accel(v, cl.gap, cl.speed, v0_here);

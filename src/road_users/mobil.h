@@ -19,7 +19,7 @@ struct Mobil {
 
 // The nearest road user ahead (or behind) in one lane: gap bumper to bumper (m; negative: it
 // overlaps, beside the driver) and its speed. Not found: free, gap +inf.
-struct Neighbour {
+struct LaneNeighbour {
   bool found = false;
   double gap = INFINITY;
   double speed = 0;
@@ -27,7 +27,7 @@ struct Neighbour {
 
 // The leader and the follower in one lane, around the driver.
 struct LaneNeighbours {
-  Neighbour leader, follower;
+  LaneNeighbour leader, follower;
 };
 
 enum class LaneChange {

@@ -14,7 +14,7 @@ const Idm kIdm{.v0 = 20};
 const Mobil kMobil;  // politeness 0.3, threshold 0.2, b_safe 4
 constexpr double kLength = 4.5;
 
-Neighbour at(double gap, double speed) { return {true, gap, speed}; }
+LaneNeighbour at(double gap, double speed) { return {true, gap, speed}; }
 
 TEST(Mobil, ChangesAwayFromASlowLeaderIntoAnEmptyLane) {
   // 15 m/s (v0 20) 20 m behind one at 5 m/s; the other lane empty.
