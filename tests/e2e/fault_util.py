@@ -16,6 +16,8 @@ both sides at once). Afterwards it collects what it finds:
   and the experiment folder, and new entries of the temp folder named after a pid of the run.
 
 Kill steps are drawn from random.Random(seed) with the seed printed (CONVOY_FAULT_SEED sets it).
+The default test run tries the first step drawn for each fault; the full set (test_faults.py's
+*Full groups, label `long`) tries all of them.
 """
 
 import glob
@@ -50,9 +52,11 @@ CHUNK_S_MAX = 2.0
 TEMP_PATTERNS = ("*.tmp", "*.tmp-*", "*.tmp.*", "*.*.tmp", "*.partial*", "*~", ".nfs*")
 
 
-def kill_steps(what, n, low=3, high=40):
-    """n distinct steps in [low, high) for `what`, from the printed seed."""
-    return sorted(random.Random("%d-%s" % (SEED, what)).sample(range(low, high), n))
+def kill_steps(what, n, low=3, high=40, take=None):
+    """n distinct steps in [low, high) for `what`, from the printed seed; with `take`, only
+    the first `take` of those n as drawn (the default test run's subset of the full set)."""
+    drawn = random.Random("%d-%s" % (SEED, what)).sample(range(low, high), n)
+    return sorted(drawn[:take] if take else drawn)
 
 
 def pid_alive(pid):

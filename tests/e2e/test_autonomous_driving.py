@@ -103,7 +103,7 @@ class Both(unittest.TestCase):
         with open(os.path.join(EXP, "simulation_config_both.json")) as f:
             det = [e["EngineName"] for e in json.load(f)["EngineConfigs"]].index("yolo_detector")
         r = subprocess.run([CONVOY, "run", "-q", "-c", os.path.join(EXP, "simulation_config_both.json"),
-                            "--run-dir", run, "-o", "SimulationTimeout=3",
+                            "--run-dir", run, "-o", "SimulationTimeout=1",  # 30 frames scored
                             "-o", "EngineConfigs/%d/Backend=ground_truth" % det],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=300)
         self.assertEqual(r.returncode, 0, r.stderr)
@@ -113,3 +113,4 @@ class Both(unittest.TestCase):
         self.assertEqual(s["detector_precision"], 1.0)  # ground truth scored against itself
         self.assertEqual(s["detector_recall"], 1.0)
         self.assertEqual(s["detector_map50"], 1.0)
+        self.assertGreater(s["detector_scored_objects"], 0)  # something was scored

@@ -6,7 +6,8 @@ leaderboard, report and the runs' configs; a second campaign gives the same lead
 (apart from wall_s) and the same runs; the leaderboard's score columns from a scorer.
 Slurm (ctest label `slurm`; skipped only without sbatch): the cluster from
 tools/campaign/slurm_local.sh in a temp folder; a 4-task campaign; a failing task resubmitted
-once; a driver killed while its array runs, then the same command again.
+once. SlurmLong (labels `slurm` and `long`): a driver killed while its array runs, then the
+same command again (test_campaign_faults_slurm.Slurm does the same at random points).
 BadInput: one message naming the file or option, exit 2; a failing task under the local
 backend: the leaderboard is written, exit 1.
 Distribution: an OpenSCENARIO parameter distribution (2 variants of benchmarks/suite/cut_in.xosc,
@@ -154,7 +155,7 @@ class Local(CampaignTest):
         self.assertIn("<code>convoy view %s</code>" % out, page)
 
 
-class Slurm(CampaignTest):
+class SlurmCase(CampaignTest):
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
@@ -163,6 +164,8 @@ class Slurm(CampaignTest):
     def run_slurm(self, suite, out, *extra):
         return campaign(suite, "--backend", "slurm", "--out", out, "--poll", 0.3, *extra, env=self.env)
 
+
+class Slurm(SlurmCase):
     def test_four_tasks(self):
         out = os.path.join(self.dir, "out")
         r = self.run_slurm(self.cut_in_suite(), out, "--seeds", 2, "--weathers", "clear,night",
@@ -198,6 +201,14 @@ class Slurm(CampaignTest):
                          [("cut_in", "0"), ("cut_in_no_map", "2")])
         with open(os.path.join(out, "report.html")) as f:
             self.assertIn("missing_world.xodr", f.read())   # the failed task's log tail
+
+
+
+class SlurmLong(SlurmCase):
+    """(ctest label `long`) The driver SIGKILLed once a task is done and started again: in the
+    default run, e2e_campaign_faults.Slurm (test_sigkill_driver) kills the driver at random
+    points and checks the same (one array, the same job, done tasks kept and not run again,
+    the same leaderboard)."""
 
     def test_restart(self):
         out = os.path.join(self.dir, "out")

@@ -1,5 +1,6 @@
 """Slurm campaigns killed at random points and started again (test_campaign_faults.py has the
-machinery and the local backend; docs/campaigns.md, "Restart")."""
+machinery and the local backend; docs/campaigns.md, "Restart"). SlurmLong (label `long`): a
+task's convoy run killed under Slurm."""
 import os
 import shutil
 import signal
@@ -11,7 +12,7 @@ from test_campaign_faults import *  # noqa: F401,F403 (the machinery: FaultTest,
 from test_campaign_faults import FaultTest
 
 
-class Slurm(FaultTest):
+class SlurmCase(FaultTest):
     BACKEND = "slurm"
     SEEDS = 2
 
@@ -19,14 +20,6 @@ class Slurm(FaultTest):
     def setUpClass(cls):
         super().setUpClass()
         cls.env = start_local_slurm(cls, "convoy-e2e-slurm-faults-")
-
-    def test_sigkill_driver(self):
-        """Two SIGKILLs of the driver at random points (the array keeps running): the restart
-        follows the same array; exactly one array is ever submitted."""
-        self.kill_rounds([signal.SIGKILL, signal.SIGKILL], arrays=1)
-
-    def test_sigterm_and_sigint_driver(self):
-        self.kill_rounds([signal.SIGTERM, signal.SIGINT], arrays=1)
 
     def kill_in_task(self, what):
         """SIGKILLs the worker (what="worker") or the convoy run (what="run") of a random
@@ -57,11 +50,18 @@ class Slurm(FaultTest):
             victim, "done" if late else "failed once and was resubmitted", arrays))
         self.finish(c, {}, set(), arrays=len(arrays))
 
+
+class Slurm(SlurmCase):
+    def test_sigkill_driver(self):
+        """Two SIGKILLs of the driver at random points (the array keeps running): the restart
+        follows the same array; exactly one array is ever submitted."""
+        self.kill_rounds([signal.SIGKILL, signal.SIGKILL], arrays=1)
+
+    def test_sigterm_and_sigint_driver(self):
+        self.kill_rounds([signal.SIGTERM, signal.SIGINT], arrays=1)
+
     def test_killed_worker(self):
         self.kill_in_task("worker")
-
-    def test_killed_run(self):
-        self.kill_in_task("run")
 
     def sbatch_wrapper(self, when):
         """A `sbatch` on PATH that SIGKILLs the driver (its parent) before or after the real
@@ -133,6 +133,16 @@ class Slurm(FaultTest):
                                           "finished": False}] if found else [])
             self.assertEqual([t["attempts"] for t in st.tasks], [1, 1] if found else [0, 0])
             say(lines[0])
+
+
+class SlurmLong(SlurmCase):
+    """(ctest label `long`) A task's convoy run SIGKILLed under Slurm. In the default run:
+    Slurm.test_killed_worker (a task's worker SIGKILLed: failed, resubmitted once, the same
+    checks) and test_campaign_faults.Local.test_killed_run_and_missing_task_json (a task's
+    convoy run SIGKILLed)."""
+
+    def test_killed_run(self):
+        self.kill_in_task("run")
 
 
 if __name__ == "__main__":

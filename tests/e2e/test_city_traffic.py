@@ -9,8 +9,9 @@ traffic on the generated city map.
 - Bad input: two participants placed on the same spot end the run with a message naming both
   and a non-zero exit, and leave no process behind.
 
-- Density: 10 simulated minutes of the dense variant (every agent respawning, SUMO's flows
-  doubled) without a contact among the participants (about a minute of wall time)."""
+- Density: 3 simulated minutes of the dense variant (every agent respawning, SUMO's flows
+  doubled) without a contact among the participants; DensityLong (label `long`), the issue's
+  10 minutes (about 100 s of wall time)."""
 
 import json
 import os
@@ -133,25 +134,41 @@ class Determinism(CityCase):
         self.assertEqual(digests[0], digests[1])
 
 
-class Density(CityCase):
-    """The issue's density test: 10 simulated minutes of the dense scene (every agent
-    respawning, SUMO's flows doubled; about a minute of wall time), no contact among the
-    participants and no red light run."""
-
-    def test_ten_minutes_without_a_collision(self):
+class DensityCase(CityCase):
+    def check_dense(self, seconds, min_sumo_vehicles, min_peak):
+        """`seconds` of the dense scene (every agent respawning, SUMO's flows doubled): no
+        contact among the participants, no red light run, SUMO kept feeding vehicles and the
+        scene filled up (tracks.jsonl's peak of road users)."""
         d = os.path.join(self.tmp, "run")
-        args = [CONVOY, "run", "-c", "simulation_config_density.json", "--run-dir", d, "-q"]
+        args = [CONVOY, "run", "-c", "simulation_config_density.json", "--run-dir", d, "-q",
+                "-o", "SimulationTimeout=%g" % seconds]
         r = subprocess.run(args, cwd=EXAMPLE, capture_output=True, text=True, timeout=900)
         self.assertEqual(r.returncode, 0, r.stderr)
         s = self.summary(d)
-        self.assertAlmostEqual(s["sim_time_s"], 600.0, delta=0.1)
+        self.assertAlmostEqual(s["sim_time_s"], seconds, delta=0.1)
         self.assertEqual(s["collisions"], [])
         self.assertEqual(s["red_light_violations"], 0)
-        # dense: all 30 agents came back at least once, and SUMO kept feeding vehicles
-        self.assertGreater(s["participants"]["sumo_vehicles"], 150)
+        self.assertGreater(s["participants"]["sumo_vehicles"], min_sumo_vehicles)
         with open(os.path.join(d, "tracks.jsonl")) as f:
             peak = max(len(json.loads(line)["users"]) for line in f)
-        self.assertGreater(peak, 100)
+        self.assertGreater(peak, min_peak)
+
+
+class Density(DensityCase):
+    """The first 3 simulated minutes of the dense scene (about 20 s of wall time): the 30
+    agents and 60 of SUMO's vehicles, up to 78 road users at once (40 at the start)."""
+
+    def test_three_minutes_without_a_collision(self):
+        self.check_dense(180.0, 50, 65)
+
+
+class DensityLong(DensityCase):
+    """The issue's density test (ctest label `long`): 10 simulated minutes of the dense scene
+    (about 190 of SUMO's vehicles, up to 140 road users at once; about 100 s of wall time),
+    no contact among the participants and no red light run."""
+
+    def test_ten_minutes_without_a_collision(self):
+        self.check_dense(600.0, 150, 100)
 
 
 class BadInput(CityCase):

@@ -1,7 +1,8 @@
 """The web dashboard (web/dashboard, docs/dashboard.md) in headless Chromium, driven by
 tools/dashboard_check (puppeteer-core): a short live run of experiments/city_traffic served by
 `convoy run --live` (the page at http://127.0.0.1:PORT/, the Foxglove WebSocket protocol on the
-same port), then its recording replayed by `convoy view RUN_DIR`.
+same port) and ended by Ctrl-C once the page has been checked, then its recording replayed by
+`convoy view RUN_DIR`. (A live, recorded run that ends by itself: test_live.Watched.)
 
 The check asserts that the page loads without errors, draws the road users (and sees them
 move), draws camera frames, shows the score (/convoy/metrics), and that its pause / step / play
@@ -12,6 +13,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import socket
 import subprocess
 import tempfile
@@ -24,7 +26,8 @@ CHECK_DIR = os.path.join(REPO, "tools", "dashboard_check")
 DIST = os.path.join(REPO, "web", "dashboard", "dist")
 CHROMIUM = os.environ.get("CONVOY_CHROMIUM", "/usr/bin/chromium")
 EXAMPLE = os.path.join(REPO, "experiments", "city_traffic")
-SIM_S = 30  # simulated seconds: the check needs about 15 s of the run
+SIM_S = 60  # simulated seconds, a bound: the check needs about 10 s of the run, then Ctrl-C
+SAMPLE_S = "5"  # wall seconds the check watches the page (road users moving, frames drawn)
 SHOW = os.environ.get("CONVOY_E2E_SHOW") == "1"
 
 
@@ -56,7 +59,7 @@ def check(tmp, name, url, *flags):
     """Runs tools/dashboard_check; returns (exit code, its JSON figures, stderr)."""
     shot = os.path.join(tmp, name + ".png")
     r = subprocess.run(["node", os.path.join(CHECK_DIR, "check.mjs"), "--url", url,
-                        "--screenshot", shot, "--seconds", "8", "--timeout", "120", *flags],
+                        "--screenshot", shot, "--seconds", SAMPLE_S, "--timeout", "120", *flags],
                        capture_output=True, text=True, timeout=300)
     try:
         figures = json.loads(r.stdout)
@@ -89,8 +92,13 @@ class Dashboard(unittest.TestCase):
         cls.run_dir = os.path.join(cls.tmp, "run")
         port = free_port()
         err = open(os.path.join(cls.tmp, "convoy.stderr"), "w")
+        # The example's video recorder (camera.mp4 through ffmpeg, not what the page shows)
+        # steps once, at t = 0, rather than at 30 Hz.
+        with open(os.path.join(EXAMPLE, "simulation_config.json")) as f:
+            names = [e["EngineName"] for e in json.load(f)["EngineConfigs"]]
         run = subprocess.Popen(
             [CONVOY, "run", "-c", "simulation_config.json", "-o", "SimulationTimeout=%d" % SIM_S,
+             "-o", "EngineConfigs/%d/EngineTimestep=%d" % (names.index("recorder"), SIM_S),
              "--run-dir", cls.run_dir, "--live", str(port), "--record"],
             cwd=EXAMPLE, stdout=subprocess.DEVNULL, stderr=err)
         try:
@@ -98,7 +106,12 @@ class Dashboard(unittest.TestCase):
                 raise AssertionError("the live server did not listen on %d" % port)
             cls.live = check(cls.tmp, "live", "http://127.0.0.1:%d/" % port, "--expect-live",
                              "--expect-score", "--expect-control")
-            cls.run_exit = run.wait(timeout=400)
+            # The page has been checked: Ctrl-C ends the run (its recording is kept), rather
+            # than simulating the rest of SIM_S.
+            cls.ended_by_us = run.poll() is None
+            if cls.ended_by_us:
+                run.send_signal(signal.SIGINT)
+            cls.run_exit = run.wait(timeout=120)
         finally:
             stop(run)
             err.close()
@@ -122,10 +135,13 @@ class Dashboard(unittest.TestCase):
         if os.environ.get("CONVOY_E2E_KEEP") != "1":
             shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def test_the_run_completes(self):
-        self.assertEqual(self.run_exit, 0, self.run_stderr[-3000:])
+    def test_the_run_ends_on_ctrl_c_with_its_summary_and_recording(self):
+        self.assertTrue(self.ended_by_us, "the run ended before the page was checked: raise SIM_S")
+        self.assertEqual(self.run_exit, 130, self.run_stderr[-3000:])
         with open(os.path.join(self.run_dir, "summary.json")) as f:
             summary = json.load(f)
+        self.assertEqual(summary["exit_code"], 130)
+        self.assertGreater(summary["sim_time_s"], 1.0)
         self.assertGreaterEqual(len(summary["live"]["clients"]), 1, summary["live"])
         self.assertTrue(os.path.exists(os.path.join(self.run_dir, "recording.mcap")))
 

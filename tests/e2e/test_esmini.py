@@ -1,9 +1,12 @@
 """esmini's example scenarios through Convoy (issue 25; docs/scenarios.md, "Agreement with
 esmini"), on the copies and reference tracks committed in tests/data/esmini:
 
-- Agreement: benchmarks/esmini_compare.py runs all 69 with `convoy run --scenario FILE --ego
-  scenario` and compares each run's tracks.csv with esmini's; every scenario meets what
+- Agreement: benchmarks/esmini_compare.py runs a subset with `convoy run --scenario FILE --ego
+  scenario` and compares each run's tracks.csv with esmini's: at least one scenario of each kind
+  of action found in the 69 (SpeedAction, LaneChangeAction, ... 21 kinds; a new kind in the
+  examples fails the test until the subset has it) and the refused one; each meets what
   tests/data/esmini/expected.json says of it (within 0.5 m, or a listed, explained difference).
+- AgreementAll (ctest label `long`): all 69 the same way, and expected.json's counts.
 - EgoScenario: the same run twice gives the same tracks.csv byte for byte; tracks.csv's
   columns; --scenario-param reaches the scenario; a scenario without a road network runs.
 - BadInput: an element Convoy does not read, a missing map and a missing catalog end before any
@@ -20,6 +23,7 @@ import shutil
 import subprocess
 import sys
 import unittest
+import xml.etree.ElementTree as ET
 
 from e2e_util import CONVOY, REPO, E2ETestCase
 
@@ -42,18 +46,40 @@ class EsminiCase(E2ETestCase):
         self.assertEqual(out.stdout.strip(), "", "a process was left behind")
 
 
-class Agreement(EsminiCase):
-    def test_every_example_as_expected(self):
+# Agreement's subset: the cheapest scenarios (about 0.5-4 s each on 2 cores) that together hold
+# every kind of action of the 69 examples, and car_walk (refused). The kinds only in scenarios
+# that expected.json lists under "differ" (trailers connected, LateralDistanceAction,
+# SpeedProfileAction) are checked to run, as in AgreementAll.
+SUBSET = ("acc-toggle", "car_walk", "cut-in_visibility", "distance_test", "keep_lateral_distance",
+          "lane_change", "light_state", "ltap-od-relative-speed", "speed-profile", "swarm",
+          "traffic_lights", "trailer_connect", "trailers")
+
+
+def action_kinds(xosc):
+    """The kinds of action in an .xosc: the elements named *Action with no *Action inside
+    (SpeedAction, not LongitudinalAction or PrivateAction)."""
+    kinds = set()
+    for el in ET.parse(xosc).getroot().iter():
+        if el.tag.endswith("Action") and not any(
+                d is not el and d.tag.endswith("Action") for d in el.iter()):
+            kinds.add(el.tag)
+    return kinds
+
+
+class AgreementCase(EsminiCase):
+    def compare(self, only=None):
+        """Runs benchmarks/esmini_compare.py (on `only`, or all 69); asserts that every scenario
+        run is as expected.json says; returns ({name: result}, expected)."""
         with open(os.path.join(ESMINI, "expected.json")) as f:
             expected = json.load(f)
         out = os.path.join(self.dir, "compare")
         report = os.path.join(self.dir, "compare.json")
         p = subprocess.run([sys.executable, BENCH, XOSC, "--convoy", CONVOY, "--out", out,
-                            "--json", report], capture_output=True, text=True, timeout=1500)
+                            "--json", report] + (["--only"] + list(only) if only else []),
+                           capture_output=True, text=True, timeout=1500)
         self.assertEqual(p.returncode, 0, p.stderr[-2000:])
         with open(report) as f:
             results = {r["name"]: r for r in json.load(f)["scenarios"]}
-        self.assertEqual(len(results), 69)
         problems = []
         for name, r in sorted(results.items()):
             if name in expected["refused"]:
@@ -70,6 +96,32 @@ class Agreement(EsminiCase):
                 problems.append("%s: position error %s m over %.0f%% of esmini's steps" % (
                     name, err, 100 * cov))
         self.assertEqual(problems, [], "\n".join(problems))
+        return results, expected
+
+
+class Agreement(AgreementCase):
+    def test_the_subset_has_every_kind_of_action(self):
+        kinds = {f[:-5]: action_kinds(os.path.join(XOSC, f))
+                 for f in os.listdir(XOSC) if f.endswith(".xosc")}
+        self.assertEqual(len(kinds), 69)
+        every = set().union(*kinds.values())
+        self.assertGreaterEqual(len(every), 21, sorted(every))
+        self.assertEqual(sorted(every - set().union(*(kinds[n] for n in SUBSET))), [])
+
+    def test_each_kind_of_action_as_expected(self):
+        results, expected = self.compare(SUBSET)
+        self.assertEqual(sorted(results), sorted(SUBSET))
+        # those expected.json does not excuse are within 0.5 m (compare() checked each)
+        within = [n for n in SUBSET if n not in expected["refused"] and n not in expected["differ"]]
+        self.assertGreaterEqual(len(within), 8)
+
+
+class AgreementAll(AgreementCase):
+    """ctest label `long` (Agreement has each kind of action in the default run)."""
+
+    def test_every_example_as_expected(self):
+        results, expected = self.compare()
+        self.assertEqual(len(results), 69)
         ran = sum(1 for r in results.values() if r["status"] == "run")
         within = sum(1 for r in results.values() if r.get("position_error_m") is not None and
                      r["position_error_m"] <= 0.5 and r["coverage"] >= 0.95)

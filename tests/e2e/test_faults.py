@@ -11,7 +11,13 @@ camera.mp4), SmallEngines (python_json, python_grpc, datatransfer, scenario), Re
 engine over gRPC killed, its connection cut), Coordinator, and Checks (the checks catch a bad
 run folder).
 
-Run:  cd tests/e2e && /usr/bin/python3 -m unittest -v test_faults
+Each group tries one kill point per fault (the first step drawn from the seed: 16 kill points
+in all, the default test run); its twin <Group>Full (ctest label `long`) tries the full set,
+3 or 4 per fault (51 kill points), those drawn from the same seed, the default's among them.
+Every kill point gets the same checks either way.
+
+Run:  cd tests/e2e && /usr/bin/python3 -m unittest -v test_faults.CityWorld   # one group
+      cd tests/e2e && /usr/bin/python3 -m unittest -v test_faults            # all, both sets
 """
 
 import json
@@ -153,10 +159,14 @@ class FaultCase(unittest.TestCase):
         fr.check_recording()
         return fr.report()
 
+    # One kill point per fault (the first of the seeded draw); the *Full groups: all n.
+    full = False
+
     def kill_points(self, what, run_one, n=KILLS_PER_TYPE, high=40):
-        """run_one(k, i) for n steps k drawn for `what`; every kill point must be clean."""
+        """run_one(k, i) for the n steps k drawn for `what` (the first of them only unless
+        self.full); every kill point must be clean."""
         failed = []
-        for i, k in enumerate(kill_steps(what, n, high=high)):
+        for i, k in enumerate(kill_steps(what, n, high=high, take=None if self.full else 1)):
             line = run_one(k, i)
             if "[fault FAILED]" in line:
                 failed.append(line)
@@ -164,7 +174,8 @@ class FaultCase(unittest.TestCase):
 
 
 class CityCase(FaultCase):
-    """Engines of a trimmed city_traffic run (recorded, with camera.mp4), each killed 3 times."""
+    """Engines of a trimmed city_traffic run (recorded, with camera.mp4), each killed once
+    (3 times in the Full groups)."""
 
     @classmethod
     def setUpClass(cls):
@@ -413,6 +424,27 @@ class Coordinator(FaultCase):
 
         # Up to 300 steps of 10 ms: some kill points after whole recording chunks.
         self.kill_points("coordinator-small", one, n=4, high=300)
+
+
+# The full set of kill points (ctest label `long`): the groups above with every step drawn.
+class CityWorldFull(CityWorld):
+    full = True
+
+
+class CityAgentsFull(CityAgents):
+    full = True
+
+
+class SmallEnginesFull(SmallEngines):
+    full = True
+
+
+class RemoteFull(Remote):
+    full = True
+
+
+class CoordinatorFull(Coordinator):
+    full = True
 
 
 class Checks(FaultCase):

@@ -101,18 +101,15 @@ class DrivingEnvTest(unittest.TestCase):
             self.assertIsInstance(info, dict)
         self.assertEqual(info["steps"], 20)
 
-    def test_same_seed_same_episode(self):
+    def test_same_seed_same_episode_another_seed_another(self):
+        # (each reset costs about a second: three episodes prove both)
         a, ra = self.episode(seed=11)
-        self.episode(seed=12)  # something else in between
+        other, _ = self.episode(seed=12)  # something else in between
         b, rb = self.episode(seed=11)
         np.testing.assert_array_equal(a, b)
         self.assertEqual(ra, rb)
         self.assertGreater(a[-1][0] - a[0][0], 5.0, "the car should drive forward")
-
-    def test_different_seeds_differ(self):
-        a, _ = self.episode(seed=1, steps=10)
-        b, _ = self.episode(seed=2, steps=10)
-        self.assertFalse(np.array_equal(a, b))
+        self.assertFalse(np.array_equal(a[:11], other[:11]), "seeds 11 and 12 start alike")
 
     def test_action_outside_the_space(self):
         self.env.reset(seed=0)
@@ -252,21 +249,20 @@ class Vector(unittest.TestCase):
         self.assertEqual(list(infos["steps"]), [1, 1])
 
     def test_seeds_autoreset_and_single_envs(self):
+        # (one episode: each sub-environment equal to a DrivingEnv with its seed, which gives the
+        # same episode for the same seed (DrivingEnvTest), makes the vector env's repeatable)
         traj, actions, rewards, after = self.episode(seed=21)
         self.assertFalse(np.array_equal(traj[:, 0], traj[:, 1]), "seeds 21 and 22 differ")
-        again, _, rewards2, after2 = self.episode(seed=21)
-        np.testing.assert_array_equal(traj, again)
-        np.testing.assert_array_equal(rewards, rewards2)
         # the step after the truncation reset both envs, continuing their generators
         obs, reward, terminated, truncated, infos = after
         self.assertEqual(list(reward), [0.0, 0.0])
         self.assertEqual(list(terminated) + list(truncated), [False] * 4)
         self.assertEqual(list(infos["steps"]), [0, 0])
         self.assertEqual(list(infos["_start"]), [True, True])
-        np.testing.assert_array_equal(obs, after2[0])
-        # each sub-environment is a DrivingEnv with seed 21 + i
-        for i in range(2):
-            with DrivingEnv(max_steps=self.STEPS) as env:
+        # each sub-environment is a DrivingEnv with seed 21 + i (one DrivingEnv for both: a
+        # reset with a seed starts as a new one does)
+        with DrivingEnv(max_steps=self.STEPS) as env:
+            for i in range(2):
                 o, _ = env.reset(seed=21 + i)
                 single, single_rewards = [o], []
                 for a in actions[:, i]:

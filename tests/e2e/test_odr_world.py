@@ -3,8 +3,9 @@ and scenario runs on esmini's maps (tests/data/esmini/xodr, scenarios in
 benchmarks/worlds) whose worlds `convoy run --scenario` generates and caches.
 
 Groups: Cli (the command's outputs, exit codes and warnings), Drive (the smart car on a
-generated urban map with traffic lights and on a map that climbs a crest: it keeps its lane,
-and a second run takes the world from the cache), Long (label long: every esmini map
+generated urban map with traffic lights, its first 14 of 20 simulated seconds (82 of 128 m), and
+on a map that climbs a crest, 17 s (to near its top): it keeps its lane, and a second run takes
+the world from the cache), Long (label long: every esmini map
 generated, loaded, rendered and driven, as benchmarks/odr_world_bench.py --render does)."""
 
 import csv
@@ -95,7 +96,8 @@ class Drive(E2ETestCase):
             return json.load(f), p.stderr
 
     def test_an_urban_map_with_traffic_lights(self):
-        s, err = self.drive("fabriksgatan_traffic_lights")
+        # 14 s of the scenario's 20: past 60 m at 12 s
+        s, err = self.drive("fabriksgatan_traffic_lights", timeout=14)
         self.assertIn("generated from fabriksgatan_traffic_lights.xodr", err)
         self.assertGreater(s["detector_frames"], 50)                 # the camera saw the world
         self.assertLessEqual(s["score"]["route_max_offset_m"], LANE_KEEPING_M)
@@ -106,9 +108,10 @@ class Drive(E2ETestCase):
 
     def test_a_map_over_a_crest(self):
         # the road climbs 6 m over its crest (s 200 to 340) and comes down; one run checks the
-        # drive and, below, that the car drives on the road's surface
+        # drive and, below, that the car drives on the road's surface; 17 s of the scenario's 20:
+        # 4 m up at 14 s, 6.4 m at 17 s (the top, 6.6 m, at 18 s)
         rows = []
-        s, err = self.drive("crest-curve", tracks=rows)
+        s, err = self.drive("crest-curve", timeout=17, tracks=rows)
         self.assertLessEqual(s["score"]["route_max_offset_m"], LANE_KEEPING_M)
         self.assertGreater(s["score"]["route_progress_m"], 60)
         self.assertEqual(s["score"]["nuplan_score"]["collisions"], [])

@@ -135,7 +135,7 @@ class KilledCoordinator(ReadersTestCase):
 
     def test_sigkill_at_several_points(self):
         found = []
-        for after_s in (0.3, 2.0, 5.0):
+        for after_s in (0.3, 2.0, 3.5):
             sizes = self.run_and_kill(after_s)
             size = os.path.getsize(self.mcap)
             rec, msgs, warned = python_read(self.mcap)
@@ -187,8 +187,10 @@ def chunk_table(path):
 
 class Truncated(ReadersTestCase):
     def test_cut_at_random_offsets(self):
-        # With the blobs (a 40 kB frame every 20 ms): chunks fill by size, a few of them.
-        self.write_config(tr.config(timeout=2))
+        # With the blobs (a 40 kB frame every 20 ms): chunks fill by size, several of them
+        # (1 simulated s: about 9; every cut file is read by all three readers, @mcap/core's
+        # pure-JavaScript zstd taking the longest, so the recording is kept short).
+        self.write_config(tr.config(timeout=1))
         self.assertExit(self.record("--record-blobs"), 0)
         full, table = chunk_table(self.mcap)
         all_msgs = [(m.topic, m.sequence, m.log_time, m.data) for m in full.messages()]

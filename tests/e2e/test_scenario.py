@@ -11,8 +11,9 @@ positions), a timed trajectory (follow_trajectory), a pedestrian's untimed traje
 turns to a snowy night through its ControlDataPack), and the end of the run at the StopTrigger.
 BadInput: an .xosc outside the subset, at start and while running; an unknown map; each one
 message naming the file (and element and line), a non-zero exit, no engine left behind.
-Run: `convoy run --scenario` on a suite scenario (the city map, the report's ego): the summary's
-driving score; a second run gives the same score, bit for bit. Campaign: a local 4-task
+Run: `convoy run --scenario` on a suite scenario (the city map, the report's ego), its first
+14 simulated seconds (both its infractions, then SimulationTimeout's): the summary's driving
+score; a second run gives the same score, bit for bit. Campaign: a local 4-task
 campaign over .xosc entries. Long (ctest label `long`): 20 repeats of one scenario, and the
 whole suite.
 
@@ -242,12 +243,16 @@ class BadInput(ScenarioCase):
 
 class Run(ScenarioCase):
     SCENARIO = os.path.join(SUITE, "cut_in.xosc")
+    # of its 22 s (it ends at the route's end): both min_speed infractions (8.3 s, 12.9 s) and
+    # 140 detector frames; whole runs: Long (and test_own_ego's run ends at its route's end)
+    SECONDS = "14"
 
     def test_run_and_repeat(self):
         runs = []
         for k in range(2):
             d = os.path.join(self.dir, "run%d" % k)
-            code, out, err = self.run_scenario(self.SCENARIO, run_dir=d)
+            code, out, err = self.run_scenario(self.SCENARIO, "-o", "SimulationTimeout=" + self.SECONDS,
+                                               run_dir=d)
             self.assertEqual(code, 0, err)
             s = self.summary(d)
             runs.append(s)
@@ -259,6 +264,7 @@ class Run(ScenarioCase):
         self.assertEqual(runs[0]["driving_score"], runs[1]["driving_score"])
         self.assertEqual(runs[0]["infractions"], runs[1]["infractions"])
         self.assertGreater(runs[0]["route_completion"], 0.0)
+        self.assertAlmostEqual(runs[0]["sim_time_s"], float(self.SECONDS), places=6)
         # the detector against ground truth (convoy_bench/detection_tf.py): one scored frame per
         # detector cycle but the first, the same in both runs
         self.assertGreater(runs[0]["detector_frames"], 100)
@@ -299,9 +305,9 @@ class Campaign(ScenarioCase):
             with open(os.path.join(suite, name + ".xosc"), "w") as f:
                 f.write(text)
         out = os.path.join(self.dir, "campaign")
-        # 10 simulated seconds a run: the campaign's plumbing, not the scenarios, is under test
+        # 4 simulated seconds a run: the campaign's plumbing, not the scenarios, is under test
         p = subprocess.run([CONVOY, "campaign", suite, "--seeds", "2", "--workers", "2", "--out", out,
-                            "--seconds", "10"],
+                            "--seconds", "4"],
                            cwd=self.dir, capture_output=True, text=True, timeout=600)
         self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
         with open(os.path.join(out, "leaderboard.csv")) as f:
