@@ -7,9 +7,9 @@
 // (politeness, threshold, b_safe) into a lane the lane graph allows a change to. Inputs are
 // acted on ReactionTime late. Deterministic: no wall clock, the only randomness is Seed's.
 // The models themselves (IDM, MOBIL, pure pursuit, the bicycle, paths on the lane graph, the
-// leader and the lane neighbours, lights, junction yielding, the weather) are in
-// src/road_users; this engine turns its datapacks into their inputs, plans the routes and
-// carries out commands.
+// leader and the lane neighbours, lights, junction yielding, the weather, the command
+// contract) are in src/road_users; this engine turns its datapacks into their inputs, plans
+// the routes and carries out commands.
 //
 // Config keys (schema.json): Map, Route {from, to} ("ROAD:LANE") or Seed, StartS, Position,
 // StartPose, InitialSpeed, Model, Category, Length, Width, Height, Wheelbase, v0,
@@ -65,6 +65,7 @@
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
 #include "road_users/bicycle.h"
+#include "road_users/command.h"
 #include "road_users/idm.h"
 #include "road_users/junction.h"
 #include "road_users/lights.h"
@@ -72,6 +73,7 @@
 #include "road_users/neighbours.h"
 #include "road_users/path.h"
 #include "road_users/pure_pursuit.h"
+#include "road_users/routing.h"
 #include "road_users/weather.h"
 
 namespace convoy::engines::vehicle_agent {
@@ -88,6 +90,7 @@ constexpr double kHeadingTolerance = 60.0 * M_PI / 180.0;  // localising: lane d
 using ru::Idm;
 using ru::Path;
 using Points = ru::Points;
+using Goal = ru::Goal;  // a point its route passes
 
 struct Snapshot {
   int64_t time_ns = 0;
@@ -126,28 +129,7 @@ ru::LightStates light_states(const json& j) {
   return out;
 }
 
-// One step's command from the scenario engine (docs/road_users.md, "Commands").
-struct Command {
-  struct Speed {
-    double speed = 0;
-    std::optional<double> acceleration;
-  };
-  struct Lane {
-    std::string road;
-    int lane = 0, from_lane = 0;
-    double offset = 0, progress = 0;
-  };
-  struct Pose {
-    double x = 0, y = 0, yaw = 0;
-    std::optional<double> speed;
-  };
-  std::optional<Speed> speed;
-  std::optional<Lane> lane;
-  std::optional<Points> route;
-  std::optional<Pose> timed;       // trajectory with a timing: the pose to take
-  std::optional<Points> polyline;  // trajectory without: the path to follow
-  std::optional<Pose> teleport;
-};
+using Command = ru::VehicleCommand;
 
 // A lane command under way: the path is the target lane's, the agent `lateral` m left of it.
 struct LaneRun {
@@ -158,12 +140,6 @@ struct LaneRun {
   double e0 = 0;      // the agent's offset from the from lane's centre when it began
   double progress = 0, lateral = 0;
   int side = 0;  // +1 to the left, -1 to the right
-};
-
-// A point its route passes: (lane, s) on the lane graph.
-struct Goal {
-  odr::LaneIndex lane = odr::kNoLane;
-  double s = 0;
 };
 
 }  // namespace
@@ -212,27 +188,32 @@ class VehicleAgent final : public Engine {
                                        bool on_poly) const;
   void consider_lane_change();
   const Snapshot* perceived() const;
-  // Commands and localisation (docs/road_users.md, "Commands").
-  Command parse_command(const std::string& dp, const json& j) const;
-  Points parse_points(const std::string& key, const json& v, size_t min_points) const;
+  // Localisation after a command (docs/road_users.md, "Commands"; the command itself is
+  // checked by road_users/command.h).
   std::optional<odr::LanePosition> locate_drivable(double x, double y, double yaw,
                                                    double max_distance) const;
-  // The lane graph onward from (lane, s), at each fork a choice drawn from Seed, until
-  // `length` m or a dead end (*open: false).
-  odr::LaneRoute onward(odr::LaneIndex lane, double s, double length, bool* open);
+  // Routing on the lane graph (road_users/routing.h) with its goals_, onward_, open_end_ and
+  // rng_ (the onward choices, drawn from Seed).
+  ru::RoutePlan plan() { return {*graph_, kOnwardLength, rng_}; }
   // A route from (lane, s) through goals_[first..] and then, when onward_, onward. nullopt
   // with *failed = the index of the goal it cannot reach.
   std::optional<odr::LaneRoute> route_from(odr::LaneIndex lane, double s, size_t first,
-                                           size_t* failed);
+                                           size_t* failed) {
+    return ru::route_from(plan(), goals_, onward_, lane, s, first, &open_end_, failed);
+  }
   // The route on from (lane, s): through its goals when it can still reach them, else
   // onward (its goals given up).
-  odr::LaneRoute plan_from(odr::LaneIndex lane, double s);
+  odr::LaneRoute plan_from(odr::LaneIndex lane, double s) {
+    return ru::plan_from(plan(), goals_, onward_, lane, s, &open_end_);
+  }
   // After a change into `target` (lane ids `shift` from its own): the route keeping that
   // lane to its next goal's road when it can (else to the goal), then on; onward without
   // goals; nullopt when there is none.
-  std::optional<odr::LaneRoute> route_keeping(odr::LaneIndex target, double s, int shift);
+  std::optional<odr::LaneRoute> route_keeping(odr::LaneIndex target, double s, int shift) {
+    return ru::route_keeping(plan(), goals_, onward_, target, s, shift, &open_end_);
+  }
   void set_path(const odr::LaneRoute& route);
-  void compute_goal_arcs();
+  void compute_goal_arcs() { goal_arcs_ = ru::goal_arcs(*graph_, path_, goals_); }
   // Onto the nearest lane from its present pose and a route on from there; false when no
   // driving lane is near (it stops where it is).
   bool relocalise();
@@ -716,140 +697,6 @@ void VehicleAgent::consider_lane_change() {
   open_end_ = open_before;
 }
 
-Points VehicleAgent::parse_points(const std::string& key, const json& v, size_t min_points) const {
-  if (!v.is_array() || v.size() < min_points)
-    fail(key, "expected a list of at least " + std::to_string(min_points) + " points [x, y], got " +
-                  v.dump().substr(0, 80));
-  Points out;
-  for (size_t i = 0; i < v.size(); ++i) {
-    const json& p = v[i];
-    const std::string k = key + "[" + std::to_string(i) + "]";
-    if (!p.is_array() || p.size() < 2 || p.size() > 3)
-      fail(k, "expected a point [x, y] (or [x, y, z]), got " + p.dump().substr(0, 80));
-    for (const json& c : p) {
-      if (!c.is_number() || !std::isfinite(c.get<double>()))
-        fail(k, "expected numbers, got " + p.dump().substr(0, 80));
-    }
-    out.push_back({p[0].get<double>(), p[1].get<double>()});
-  }
-  return out;
-}
-
-Command VehicleAgent::parse_command(const std::string& dp, const json& j) const {
-  if (!j.is_object()) fail(dp, "expected a JSON object of commands, got " + j.dump().substr(0, 80));
-  auto object = [&](const std::string& key, const json& v,
-                    std::initializer_list<const char*> known) -> const json& {
-    if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
-    for (const auto& [k, x] : v.items()) {
-      bool ok = false;
-      std::string list;
-      for (const char* n : known) {
-        ok = ok || k == n;
-        list += std::string(list.empty() ? "" : ", ") + n;
-      }
-      if (!ok) fail(key + "." + k, "unknown key (" + list + ")");
-    }
-    return v;
-  };
-  auto number = [&](const std::string& key, const json& obj, const char* k) {
-    if (!obj.contains(k)) fail(key + "." + k, "missing (a number)");
-    const json& v = obj[k];
-    if (!v.is_number() || !std::isfinite(v.get<double>()))
-      fail(key + "." + k, "expected a number, got " + v.dump().substr(0, 80));
-    return v.get<double>();
-  };
-  auto pose = [&](const std::string& key, const json& v, bool speed_needed) {
-    object(key, v, {"x", "y", "z", "yaw", "speed"});
-    Command::Pose p;
-    p.x = number(key, v, "x");
-    p.y = number(key, v, "y");
-    p.yaw = number(key, v, "yaw");
-    if (v.contains("z")) number(key, v, "z");
-    if (v.contains("speed") || speed_needed) {
-      p.speed = number(key, v, "speed");
-      if (*p.speed < 0) fail(key + ".speed", "must be >= 0 m/s (reversing is not modelled)");
-    }
-    return p;
-  };
-  Command c;
-  for (const auto& [k, v] : j.items()) {
-    const std::string key = dp + "." + k;
-    if (k == "time_ns") {
-      if (!v.is_number()) fail(key, "expected a number (ns)");
-    } else if (k == "speed") {
-      object(key, v, {"speed", "target_speed", "acceleration"});
-      Command::Speed sp;
-      sp.speed = number(key, v, "speed");
-      if (sp.speed < 0) fail(key + ".speed", "must be >= 0 m/s (reversing is not modelled)");
-      if (v.contains("target_speed")) number(key, v, "target_speed");
-      if (v.contains("acceleration")) sp.acceleration = number(key, v, "acceleration");
-      c.speed = sp;
-    } else if (k == "lane") {
-      object(key, v, {"road", "lane", "from_lane", "offset", "progress"});
-      Command::Lane ln;
-      if (!v.contains("road") || !v["road"].is_string())
-        fail(key + ".road", "expected the road's id as a string");
-      ln.road = v["road"].get<std::string>();
-      const odr::Road* road = net_->find_road(ln.road);
-      if (!road) fail(key + ".road", "no road " + ln.road + " in " + net_->source);
-      auto lane_id = [&](const char* n) {
-        if (!v.contains(n) || !v[n].is_number_integer() || v[n].get<int64_t>() == 0)
-          fail(key + "." + n, "expected a non-zero integer lane id, got " +
-                                  (v.contains(n) ? v[n].dump() : std::string("nothing")));
-        const int id = v[n].get<int>();
-        bool found = false;
-        for (const auto& sec : road->sections) found = found || sec.find_lane(id) != nullptr;
-        if (!found) fail(key + "." + n, "road " + ln.road + " has no lane " + std::to_string(id));
-        return id;
-      };
-      ln.lane = lane_id("lane");
-      ln.from_lane = v.contains("from_lane") ? lane_id("from_lane") : ln.lane;
-      ln.offset = v.contains("offset") ? number(key, v, "offset") : 0.0;
-      ln.progress = v.contains("progress") ? number(key, v, "progress") : 1.0;
-      if (ln.progress < 0 || ln.progress > 1)
-        fail(key + ".progress", "must be in [0, 1], got " + v["progress"].dump());
-      c.lane = ln;
-    } else if (k == "route") {
-      object(key, v, {"positions"});
-      if (!v.contains("positions")) fail(key + ".positions", "missing (a list of [x, y])");
-      Points pts = parse_points(key + ".positions", v["positions"], 1);
-      for (size_t i = 0; i < pts.size(); ++i) {
-        const auto loc =
-            graph_->locate_if(pts[i][0], pts[i][1], std::nullopt, 20.0,
-                              [](const odr::LaneNode& n, double) { return n.drivable(); });
-        if (!loc) {
-          char what[160];
-          std::snprintf(what, sizeof what,
-                        "(%.2f, %.2f) is farther than 20 m from any driving lane of ", pts[i][0],
-                        pts[i][1]);
-          fail(key + ".positions[" + std::to_string(i) + "]", what + net_->source);
-        }
-      }
-      c.route = std::move(pts);
-    } else if (k == "trajectory") {
-      if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
-      if (v.contains("polyline")) {
-        object(key, v, {"polyline", "length"});
-        if (v.contains("length")) number(key, v, "length");
-        c.polyline = parse_points(key + ".polyline", v["polyline"], 1);
-      } else {
-        c.timed = pose(key, v, true);
-      }
-    } else if (k == "teleport") {
-      c.teleport = pose(key, v, false);
-    } else {
-      fail(key, "unknown key (time_ns, speed, lane, route, trajectory, teleport)");
-    }
-  }
-  if (c.timed && (c.speed || c.lane))
-    fail(dp + ".trajectory", "a timed trajectory sets both speed and lane: give it alone");
-  if (c.polyline && c.lane)
-    fail(dp + ".trajectory", "both lane and trajectory steer: give one of them");
-  if (c.teleport && (c.timed || c.polyline))
-    fail(dp + ".teleport", "give teleport or trajectory, not both");
-  return c;
-}
-
 std::optional<odr::LanePosition> VehicleAgent::locate_drivable(double x, double y, double yaw,
                                                                double max_distance) const {
   // A driving lane whose direction is within kHeadingTolerance of yaw; else any driving lane
@@ -860,142 +707,6 @@ std::optional<odr::LanePosition> VehicleAgent::locate_drivable(double x, double 
   if (loc) return loc;
   return graph_->locate_if(x, y, yaw, max_distance,
                            [](const odr::LaneNode& n, double) { return n.drivable(); });
-}
-
-odr::LaneRoute VehicleAgent::onward(odr::LaneIndex lane, double s, double length, bool* open) {
-  odr::LaneRoute r;
-  odr::LaneIndex cur = lane;
-  double cs = s;
-  *open = false;
-  for (int guard = 0; guard < 10000; ++guard) {
-    const odr::LaneNode& n = graph_->lane(cur);
-    odr::RouteSegment seg;
-    seg.lane = cur;
-    seg.road_id = n.road->id;
-    seg.lane_id = n.lane_id;
-    seg.junction = n.junction;
-    seg.s_from = std::clamp(cs, n.s0, n.s1);
-    seg.s_to = n.forward ? n.s1 : n.s0;
-    if (n.s1 > n.s0) r.length += std::abs(seg.s_to - seg.s_from) / (n.s1 - n.s0) * n.length;
-    if (n.junction != "-1" && (r.junctions.empty() || r.junctions.back() != n.junction))
-      r.junctions.push_back(n.junction);
-    r.segments.push_back(std::move(seg));
-    if (r.length >= length) {
-      *open = true;
-      break;
-    }
-    std::vector<odr::LaneIndex> next;
-    for (odr::LaneIndex l : graph_->successors(cur)) {
-      if (graph_->lane(l).drivable()) next.push_back(l);
-    }
-    if (next.empty()) break;  // a dead end: the route ends there
-    cur = next.size() == 1 ? next[0] : next[rng_() % next.size()];
-    const odr::LaneNode& nn = graph_->lane(cur);
-    cs = nn.forward ? nn.s0 : nn.s1;
-  }
-  r.cost = r.length;
-  return r;
-}
-
-std::optional<odr::LaneRoute> VehicleAgent::route_from(odr::LaneIndex lane, double s, size_t first,
-                                                       size_t* failed) {
-  odr::LaneRoute out;
-  auto append = [&](const odr::LaneRoute& r) {
-    for (const auto& seg : r.segments) {
-      if (!out.segments.empty() && !seg.lane_change && seg.lane == out.segments.back().lane &&
-          std::abs(seg.s_from - out.segments.back().s_to) < 1e-9) {
-        out.segments.back().s_to = seg.s_to;  // the same lane on
-      } else {
-        out.segments.push_back(seg);
-      }
-    }
-    out.length += r.length;
-    out.cost += r.cost;
-    out.lane_changes += r.lane_changes;
-    for (const auto& j : r.junctions) {
-      if (out.junctions.empty() || out.junctions.back() != j) out.junctions.push_back(j);
-    }
-  };
-  odr::LaneIndex cur = lane;
-  double cs = s;
-  for (size_t i = first; i < goals_.size(); ++i) {
-    auto r = graph_->route(cur, cs, goals_[i].lane, goals_[i].s);
-    if (!r) {
-      *failed = i;
-      return std::nullopt;
-    }
-    append(*r);
-    cur = goals_[i].lane;
-    cs = goals_[i].s;
-  }
-  open_end_ = false;
-  if (onward_) append(onward(cur, cs, kOnwardLength, &open_end_));
-  if (out.segments.empty()) {
-    // At its goal already: a route of no length there.
-    const odr::LaneNode& n = graph_->lane(cur);
-    odr::RouteSegment seg;
-    seg.lane = cur;
-    seg.road_id = n.road->id;
-    seg.lane_id = n.lane_id;
-    seg.junction = n.junction;
-    seg.s_from = seg.s_to = cs;
-    out.segments.push_back(seg);
-  }
-  return out;
-}
-
-odr::LaneRoute VehicleAgent::plan_from(odr::LaneIndex lane, double s) {
-  size_t failed = 0;
-  if (auto r = route_from(lane, s, 0, &failed)) return *r;
-  // Its goals cannot be reached from here any more: the lane graph onward.
-  goals_.clear();
-  onward_ = true;
-  return *route_from(lane, s, 0, &failed);
-}
-
-std::optional<odr::LaneRoute> VehicleAgent::route_keeping(odr::LaneIndex target, double s,
-                                                          int shift) {
-  if (goals_.empty()) {
-    if (!onward_) return std::nullopt;
-    return onward(target, s, kOnwardLength, &open_end_);
-  }
-  odr::RouteOptions keep;
-  keep.lane_changes = false;
-  std::optional<odr::LaneRoute> route;
-  const Goal& g = goals_.front();
-  const odr::LaneNode& dest = graph_->lane(g.lane);
-  const odr::LaneIndex dest2 = graph_->find(dest.road->id, dest.lane_id + shift, g.s);
-  if (dest2 != odr::kNoLane) route = graph_->route(target, s, dest2, g.s, keep);
-  if (!route) route = graph_->route(target, s, g.lane, g.s);
-  if (route && !route->segments.empty() && (goals_.size() > 1 || onward_)) {
-    // On through the other goals (and onward) from where it reaches the first.
-    size_t failed = 0;
-    const auto& end = route->segments.back();
-    auto rest = route_from(end.lane, end.s_to, 1, &failed);
-    if (!rest) return std::nullopt;
-    for (auto& seg : rest->segments) {
-      if (seg.lane == route->segments.back().lane &&
-          std::abs(seg.s_from - route->segments.back().s_to) < 1e-9 && !seg.lane_change) {
-        route->segments.back().s_to = seg.s_to;
-      } else {
-        route->segments.push_back(seg);
-      }
-    }
-  }
-  return route;
-}
-
-void VehicleAgent::compute_goal_arcs() {
-  goal_arcs_.clear();
-  size_t lo = 0;
-  for (const Goal& g : goals_) {
-    const odr::LaneNode& n = graph_->lane(g.lane);
-    const double s = std::clamp(g.s, n.s0 + 1e-3, std::max(n.s0 + 1e-3, n.s1 - 1e-3));
-    const odr::WorldPose w = graph_->world_pose(n.road->id, n.lane_id, s);
-    const auto pr = path_.project(w.x, w.y, lo);
-    goal_arcs_.push_back(std::isfinite(pr.d2) ? pr.arc : path_.length());
-    lo = pr.index;
-  }
 }
 
 void VehicleAgent::set_path(const odr::LaneRoute& route) {
@@ -1123,33 +834,8 @@ void VehicleAgent::set_polyline(const Points& points) {
 }
 
 void VehicleAgent::extend() {
-  // The route so far from 30 m behind it, and the lane graph onward from its end.
-  odr::LaneRoute route = path_.route;
-  size_t lo = 0, keep_from = 0;
-  for (size_t i = 0; i < route.segments.size(); ++i) {
-    const auto& g = route.segments[i];
-    const double dir = g.s_to >= g.s_from ? 1.0 : -1.0;
-    const double probe = std::abs(g.s_to - g.s_from) > 2e-3 ? g.s_to - dir * 1e-3 : g.s_to;
-    const odr::WorldPose w = graph_->world_pose(g.road_id, g.lane_id, probe);
-    const auto pr = path_.project(w.x, w.y, lo);
-    lo = pr.index;
-    if (pr.arc >= arc_ - 30.0) break;
-    keep_from = i + 1;
-  }
-  if (keep_from > 0) keep_from -= 1;  // one more behind, for the lane change blends
-  route.segments.erase(route.segments.begin(), route.segments.begin() + keep_from);
-  if (!route.segments.empty()) route.segments.front().lane_change = false;
-  const odr::RouteSegment last = route.segments.back();
   bool open = false;
-  const odr::LaneRoute more = onward(last.lane, last.s_to, kOnwardLength, &open);
-  for (const auto& seg : more.segments) {
-    if (seg.lane == route.segments.back().lane &&
-        std::abs(seg.s_from - route.segments.back().s_to) < 1e-9) {
-      route.segments.back().s_to = seg.s_to;
-    } else {
-      route.segments.push_back(seg);
-    }
-  }
+  const odr::LaneRoute route = ru::extended(plan(), path_, arc_, &open);
   open_end_ = open;
   path_ = make_path(route);
   const auto pr = path_.project(x_, y_);
@@ -1400,7 +1086,11 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
     if (j.is_object() && j.empty()) {
       command_.reset();  // on its own AI
     } else {
-      command_ = parse_command(name, j);
+      try {
+        command_ = ru::parse_vehicle_command(j, name, *graph_);
+      } catch (const ru::CommandError& e) {
+        fail(e.key(), e.detail());
+      }
     }
     return;
   } else if (name == lights_dp_) {
