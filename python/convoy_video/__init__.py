@@ -7,8 +7,9 @@
     ...                         # frame is the video's
     video.close()               # also at interpreter exit
 
-Frames go through a pipe to a separate `ffmpeg` process (libx264, yuv420p, `-movflags
-+faststart`), which encodes on the other core while the engine steps; `write` only copies the
+Frames go through a pipe to a separate `ffmpeg` process (libx264, yuv420p, a fragmented MP4:
+`-movflags +frag_keyframe+empty_moov+default_base_moof`), which encodes on the other core while
+the engine steps; `write` only copies the
 frame into the pipe, and blocks when the encoder is behind, so no frame is dropped and the
 simulation never sees the encoder (its results do not depend on it).
 
@@ -80,7 +81,12 @@ class VideoWriter:
         if width % 2 or height % 2:  # yuv420p halves both: pad to even sizes
             cmd += ["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"]
         cmd += ["-c:v", "libx264", "-preset", PRESET, "-crf", str(CRF), "-pix_fmt", "yuv420p",
-                "-movflags", "+faststart", "-fflags", "+bitexact", "-flags:v", "+bitexact",
+                # Fragmented (a fragment per key frame, 250 frames): the muxer keeps no index of
+                # the whole video (an hour's grew ffmpeg by 12 MiB, and +faststart rewrote the
+                # file at the end), browsers stream it (the moov box comes first), and a
+                # file cut short plays up to its last fragment.
+                "-movflags", "+frag_keyframe+empty_moov+default_base_moof",
+                "-fflags", "+bitexact", "-flags:v", "+bitexact",
                 self.path]
         # A broken pipe is an error to report, not a signal that ends the engine (the embedded
         # interpreter leaves SIGPIPE at its default). The main thread only may set it.

@@ -5,6 +5,7 @@
 #include <zlib.h>
 #include <zstd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <limits>
@@ -289,17 +290,37 @@ void McapWriter::keep_chunk_index(std::string rec) {
   chunk_index_records_.push_back(std::move(rec));
 }
 
+void McapWriter::put_summary(std::string_view bytes) {
+  constexpr size_t kBlock = 1 << 20;
+  pending_.append(bytes);
+  summary_crc_ = crc32(bytes, summary_crc_);
+  pos_ += bytes.size();
+  if (pending_.size() >= kBlock) commit();
+}
+
+void McapWriter::put_summary_group(uint8_t op, const std::vector<std::string>& records) {
+  if (records.empty()) return;
+  const uint64_t start = pos_;
+  for (const auto& r : records) put_summary(r);
+  summary_groups_.emplace_back(op, start, pos_ - start);
+}
+
 // Every chunk index kept, in the order written (the spilled ones, then any kept in memory).
-std::string McapWriter::chunk_indexes() {
-  std::string out;
+void McapWriter::put_chunk_indexes() {
+  const uint64_t start = pos_;
   if (std::FILE* f = chunk_index_spill_.get(); f && chunk_index_spilled_ > 0) {
     std::fflush(f);
     std::rewind(f);
-    out.resize(chunk_index_spilled_);
-    out.resize(std::fread(out.data(), 1, out.size(), f));
+    std::string block(1 << 20, '\0');
+    for (uint64_t left = chunk_index_spilled_; left > 0;) {
+      const size_t n = std::fread(block.data(), 1, std::min<uint64_t>(left, block.size()), f);
+      if (n == 0) break;
+      put_summary(std::string_view(block.data(), n));
+      left -= n;
+    }
   }
-  for (const auto& r : chunk_index_records_) out += r;
-  return out;
+  for (const auto& r : chunk_index_records_) put_summary(r);
+  if (pos_ > start) summary_groups_.emplace_back(kOpChunkIndex, start, pos_ - start);
 }
 
 void McapWriter::write_metadata(const std::string& name, const StringMap& metadata) {
@@ -328,22 +349,18 @@ std::string McapWriter::close() {
     fd_ = -1;
     return error_;
   }
+  commit();
+  const uint64_t cut_back = file_pos_;  // where the file ends if the summary cannot be written
   std::string data_end;
   put_u32(&data_end, data_crc_);
   write_raw(record(kOpDataEnd, data_end));
 
   // Summary, grouped by opcode; everything after Data End goes into the summary CRC.
   const uint64_t summary_start = pos_;
-  std::string summary;
-  std::vector<std::tuple<uint8_t, uint64_t, uint64_t>> groups;
-  auto group = [&](uint8_t op, const std::vector<std::string>& records) {
-    if (records.empty()) return;
-    const uint64_t start = summary_start + summary.size();
-    for (const auto& r : records) summary += r;
-    groups.emplace_back(op, start, summary_start + summary.size() - start);
-  };
-  group(kOpSchema, schema_records_);
-  group(kOpChannel, channel_records_);
+  summary_crc_ = 0;
+  summary_groups_.clear();
+  put_summary_group(kOpSchema, schema_records_);
+  put_summary_group(kOpChannel, channel_records_);
   std::string stats;
   put_u64(&stats, message_count_);
   put_u16(&stats, static_cast<uint16_t>(schema_records_.size()));
@@ -359,31 +376,32 @@ std::string McapWriter::close() {
     put_u64(&counts, n);
   }
   put_string(&stats, counts);
-  group(kOpStatistics, {record(kOpStatistics, stats)});
-  if (std::string indexes = chunk_indexes(); !indexes.empty())
-    group(kOpChunkIndex, {std::move(indexes)});
-  group(kOpMetadataIndex, metadata_index_records_);
-  const uint64_t offsets_start = summary_start + summary.size();
-  for (const auto& [op, start, length] : groups) {
+  put_summary_group(kOpStatistics, {record(kOpStatistics, stats)});
+  put_chunk_indexes();
+  put_summary_group(kOpMetadataIndex, metadata_index_records_);
+  const uint64_t offsets_start = pos_;
+  for (const auto& [op, start, length] : summary_groups_) {
     std::string so;
     put_u8(&so, op);
     put_u64(&so, start);
     put_u64(&so, length);
-    summary += record(kOpSummaryOffset, so);
+    put_summary(record(kOpSummaryOffset, so));
   }
   std::string footer_head;
   put_u8(&footer_head, kOpFooter);
   put_u64(&footer_head, 8 + 8 + 4);
   put_u64(&footer_head, summary_start);
   put_u64(&footer_head, offsets_start);
-  summary += footer_head;
-  const uint32_t summary_crc = crc32(summary);
-  put_u32(&summary, summary_crc);
-  summary.append(kMcapMagic);
-  // Data End and the summary in one write (Data End went into pending_ by write_raw).
-  pending_ += summary;
-  pos_ += summary.size();
-  commit();
+  put_summary(footer_head);
+  std::string tail;
+  put_u32(&tail, summary_crc_);
+  tail.append(kMcapMagic);
+  pending_ += tail;
+  pos_ += tail.size();
+  // A summary cut short would not be one: the file then ends at its last chunk, as a cut
+  // recording does.
+  if (!commit() && ::ftruncate(fd_, static_cast<off_t>(cut_back)) != 0)
+    error_ += " (and cannot cut it back)";
   if (::close(fd_) != 0 && !io_error_) {
     io_error_ = true;
     error_ = "cannot write " + path_.string() + ": " + std::strerror(errno);

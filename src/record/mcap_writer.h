@@ -28,6 +28,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -146,7 +147,13 @@ class McapWriter {
   // wait in an unlinked temporary file, so that the writer's memory stays flat over a long run
   // (in memory if no temporary file can be made).
   void keep_chunk_index(std::string record);
-  std::string chunk_indexes();
+  // The summary, written in blocks (an hour's chunk indexes are megabytes: never all in memory
+  // at once). put_summary appends to it, adding to summary_crc_.
+  void put_summary(std::string_view bytes);
+  void put_summary_group(uint8_t op, const std::vector<std::string>& records);
+  void put_chunk_indexes();
+  uint32_t summary_crc_ = 0;
+  std::vector<std::tuple<uint8_t, uint64_t, uint64_t>> summary_groups_;  // op, start, length
   std::vector<std::string> schema_records_, channel_records_, chunk_index_records_,
       metadata_index_records_;
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> chunk_index_spill_{nullptr, &std::fclose};

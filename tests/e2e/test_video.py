@@ -63,8 +63,10 @@ class Writer(unittest.TestCase):
         with open(path, "rb") as f:
             head = f.read(64)
         self.assertLess(head.find(b"moov"), head.find(b"mdat") if b"mdat" in head else 1 << 30,
-                        "moov is not before mdat (faststart)")
+                        "moov is not before mdat (browsers stream it)")
         self.assertIn(b"moov", head)
+        with open(path, "rb") as f:
+            self.assertIn(b"moof", f.read(), "not fragmented (an index of the whole video in memory)")
 
     def test_odd_sizes_are_padded_to_even(self):
         path = os.path.join(self.dir, "odd.mp4")

@@ -119,6 +119,56 @@ TEST(McapWriter, ChunksAndIndexesReadBack) {
   fs::remove(p);
 }
 
+// A long run's summary (its chunk indexes alone over the writer's 1 MiB block) is written in
+// blocks: it must still be one valid summary, with its CRC, offsets and footer.
+TEST(McapWriter, ASummaryOverOneBlockIsWhole) {
+  fs::path p = temp_file("long.mcap");
+  McapWriter w;
+  w.open(p, "test", {8192, McapCompression::kNone});
+  const uint16_t s = w.add_schema("convoy.JsonDataPack", "jsonschema", "{}");
+  std::vector<uint16_t> channels;
+  for (int c = 0; c < 300; ++c)
+    channels.push_back(w.add_channel("e/" + std::to_string(c), "json", s, {}));
+  int n = 0;
+  for (int round = 0; round < 600; ++round)
+    for (uint16_t c : channels) {
+      w.write_message(c, n, uint64_t(n), uint64_t(n), "{}");
+      ++n;
+    }
+  ASSERT_EQ(w.close(), "");
+  McapReader r(p);
+  McapMessage m;
+  int read = 0;
+  while (r.next(&m)) ++read;
+  r.read_to_end();
+  EXPECT_EQ(read, n);
+  EXPECT_TRUE(r.complete()) << r.incomplete_reason();
+  const std::string f = slurp(p);
+  const size_t footer = f.size() - 8 - 29;
+  ASSERT_EQ(uint8_t(f[footer]), kOpFooter);
+  const uint64_t summary_start = u64(f, footer + 9), offsets_start = u64(f, footer + 17);
+  uint32_t crc;
+  std::memcpy(&crc, f.data() + footer + 25, 4);
+  EXPECT_EQ(crc,
+            mcap_io::crc32(std::string_view(f).substr(summary_start, footer + 25 - summary_start)));
+  // The chunk-index group's offset record: over a block long, and where the records are.
+  bool found = false;
+  for (size_t at = offsets_start; at < footer; at += 9 + u64(f, at + 1)) {
+    ASSERT_EQ(uint8_t(f[at]), kOpSummaryOffset);
+    if (uint8_t(f[at + 9]) != kOpChunkIndex) continue;
+    found = true;
+    const uint64_t start = u64(f, at + 10), length = u64(f, at + 18);
+    EXPECT_GT(length, uint64_t(1) << 20);
+    size_t records = 0, end = start;  // whole chunk-index records, exactly filling it
+    for (; end < start + length; end += 9 + u64(f, end + 1), ++records)
+      ASSERT_EQ(uint8_t(f[end]), kOpChunkIndex) << "at " << end;
+    EXPECT_EQ(end, start + length);
+    EXPECT_GT(records, 500u);
+  }
+  EXPECT_TRUE(found);
+  fs::remove(p);
+}
+
 TEST(McapReader, CorruptionAndTruncationAreCaught) {
   fs::path p = write_file(200, 1024);
   std::string f = slurp(p);
