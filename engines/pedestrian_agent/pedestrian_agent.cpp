@@ -39,6 +39,10 @@
 // StartPose {x, y, yaw}: it starts exactly there and walks to the nearest sidewalk, then to
 // Route.to, or without a Route along the sidewalks onward in the direction it faces (forks
 // chosen by Seed). With no sidewalk within 50 m it stands there until commanded.
+//
+// Its path (poses and arcs), the command contract, and the crossing's threats, gap acceptance,
+// lights and caution on the road are in src/road_users; this engine plans its walks on the
+// sidewalk graph and turns its datapacks into their inputs.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -59,6 +63,9 @@
 #include "engine/engine.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
+#include "road_users/path.h"
+#include "road_users/pedestrian_command.h"
+#include "road_users/walker.h"
 
 namespace convoy::engines::pedestrian_agent {
 namespace odr = convoy::opendrive;
@@ -79,37 +86,11 @@ struct Crossing {
   std::vector<std::string> ped_signals, veh_signals;
 };
 
-struct Path {
-  std::vector<odr::Pose2> poses;
-  std::vector<double> arc;
-  std::vector<Crossing> crossings;
-  double length() const { return arc.empty() ? 0 : arc.back(); }
-  odr::Pose2 at(double a) const {
-    if (poses.empty()) return {};
-    if (a <= 0) return poses.front();
-    if (a >= arc.back()) return poses.back();
-    size_t i = std::upper_bound(arc.begin(), arc.end(), a) - arc.begin();
-    const odr::Pose2& p = poses[i - 1];
-    const odr::Pose2& q = poses[i];
-    const double f = (a - arc[i - 1]) / std::max(arc[i] - arc[i - 1], 1e-9);
-    odr::Pose2 r = p;
-    r.x = p.x + f * (q.x - p.x);
-    r.y = p.y + f * (q.y - p.y);
-    r.heading = p.heading + f * std::remainder(q.heading - p.heading, 2 * M_PI);
-    return r;
-  }
-  void append(const std::vector<odr::Pose2>& more) {
-    for (const auto& p : more) {
-      if (!poses.empty()) {
-        const double d = std::hypot(p.x - poses.back().x, p.y - poses.back().y);
-        if (d < 1e-6) continue;
-        arc.push_back(arc.back() + d);
-      } else {
-        arc.push_back(0);
-      }
-      poses.push_back(p);
-    }
-  }
+// Its path: the library's poses and arcs, with the roads it crosses on it.
+using RoadCrossings = std::vector<Crossing>;  // (inside Path, Crossing is the junction's)
+
+struct Path : road_users::Path {
+  RoadCrossings road_crossings;
 };
 
 // A point on a sidewalk lane.
@@ -130,20 +111,8 @@ struct Plan {
   double length = INFINITY;
 };
 
-using Points = std::vector<std::array<double, 2>>;
-
-// One step's command from the scenario engine (docs/road_users.md, "Commands").
-struct Command {
-  struct Pose {
-    double x = 0, y = 0, yaw = 0;
-    std::optional<double> speed;
-  };
-  std::optional<double> speed;
-  std::optional<Points> route;
-  std::optional<Pose> timed;
-  std::optional<Points> polyline;
-  std::optional<Pose> teleport;
-};
+using road_users::Points;
+using Command = road_users::PedestrianCommand;
 
 }  // namespace
 
@@ -176,18 +145,8 @@ class PedestrianAgent final : public Engine {
   void start();
   void publish();
   bool lights_allow(const Crossing& c);
-  struct Threat {
-    double tta = INFINITY;  // s until its front reaches the crossing line
-    double front = 0;       // m from its front to the line, along its heading
-    double u = 0;           // where it crosses the line, m from the leg's start
-    double half_width = 0.9;
-    double speed = 0;
-  };
-  std::vector<Threat> threats(const Crossing& c) const;
+  std::vector<road_users::CrossingThreat> threats(const Crossing& c) const;
   double walker_ahead_speed(double v) const;
-  // Commands (docs/road_users.md, "Commands").
-  Command parse_command(const std::string& dp, const json& j) const;
-  Points parse_points(const std::string& key, const json& v) const;
   std::optional<odr::LanePosition> nearest_sidewalk(double x, double y) const;
   // A straight leg from a to b; the part of it off the sidewalks is a crossing (with gap
   // acceptance), `committed` when it starts on the road already.
@@ -491,7 +450,7 @@ Path PedestrianAgent::make_path(const Plan& p) const {
         if (sig.traffic_light) cr.veh_signals.push_back(sig.signal->id);
       }
     }
-    path.crossings.push_back(cr);
+    path.road_crossings.push_back(cr);
     if (p.after && !p.after->segments.empty()) path.append(graph_->sample(*p.after, kSampleDs));
   }
   return path;
@@ -643,22 +602,10 @@ bool PedestrianAgent::lights_allow(const Crossing& c) {
     auto it = sig.find(id);
     return it != sig.end() && it->is_string() ? it->get<std::string>() : std::string();
   };
-  bool known = false;
-  if (!c.ped_signals.empty()) {
-    for (const auto& id : c.ped_signals) {
-      const std::string st = state(id);
-      if (st.empty() || st == "off") continue;
-      known = true;
-      if (st != "green") return false;
-    }
-    if (known) return true;
-  }
-  for (const auto& id : c.veh_signals) {
-    const std::string st = state(id);
-    if (st.empty() || st == "off") continue;
-    if (st != "red") return false;  // the traffic it crosses may move
-  }
-  return true;
+  std::vector<std::string> ped, veh;
+  for (const auto& id : c.ped_signals) ped.push_back(state(id));
+  for (const auto& id : c.veh_signals) veh.push_back(state(id));
+  return road_users::walker_lights_allow(ped, veh);
 }
 
 // The pace it may walk at with other walkers ahead: one in its way (within its body's width
@@ -678,139 +625,22 @@ double PedestrianAgent::walker_ahead_speed(double v) const {
   return v;
 }
 
-std::vector<PedestrianAgent::Threat> PedestrianAgent::threats(const Crossing& c) const {
-  std::vector<Threat> out;
+std::vector<road_users::CrossingThreat> PedestrianAgent::threats(const Crossing& c) const {
+  std::vector<road_users::CrossingThreat> out;
   if (!neighbours_) return out;
   const odr::Pose2 a = path_.at(c.start), b = path_.at(c.end);
   const double ex = b.x - a.x, ey = b.y - a.y;
   const double len = std::hypot(ex, ey);
   if (len < 1e-6) return out;
-  const double ux = ex / len, uy = ey / len;
+  const road_users::CrossingLeg leg{a.x, a.y, ex / len, ey / len, len};
   for (const auto& u : neighbours_->users()) {
     if (u.absent() || u.id() == name_ || u.category() == "pedestrian") continue;
     if (std::hypot(u.x() - x_, u.y() - y_) > radius_) continue;
-    const double dx = std::cos(u.yaw()), dy = std::sin(u.yaw());
-    const double denom = dx * uy - dy * ux;  // cross(dir, e)
-    if (std::abs(denom) < 0.2) continue;     // moving along the crossing, not across it
-    const double lo = u.length_offset() + 0.5 * u.length();
-    const double fx = u.x() + lo * dx, fy = u.y() + lo * dy;  // its front
-    const double wx = a.x - fx, wy = a.y - fy;
-    const double tau = (wx * uy - wy * ux) / denom;    // along its heading to the line
-    const double along = (wx * dy - wy * dx) / denom;  // where on the line (from a), m
-    Threat t;
-    t.half_width = 0.5 * (u.width() > 0 ? u.width() : 1.8);
-    if (along < -t.half_width - 1.0 || along > len + t.half_width + 1.0) continue;
-    if (tau < -std::max(u.length(), 1.0)) continue;  // its back has passed
-    t.front = tau;
-    t.u = along;
-    t.speed = u.speed();
-    t.tta = tau <= 0 ? 0.0 : (u.speed() > 0.05 ? tau / u.speed() : INFINITY);
-    out.push_back(t);
+    const road_users::CrossingVehicle v{u.x(),      u.y(),     u.yaw(),          u.speed(),
+                                        u.length(), u.width(), u.length_offset()};
+    if (const auto t = road_users::crossing_threat(leg, v)) out.push_back(*t);
   }
   return out;
-}
-
-Points PedestrianAgent::parse_points(const std::string& key, const json& v) const {
-  if (!v.is_array() || v.empty())
-    fail(key, "expected a list of points [x, y], got " + v.dump().substr(0, 80));
-  Points out;
-  for (size_t i = 0; i < v.size(); ++i) {
-    const json& p = v[i];
-    const std::string k = key + "[" + std::to_string(i) + "]";
-    if (!p.is_array() || p.size() < 2 || p.size() > 3)
-      fail(k, "expected a point [x, y] (or [x, y, z]), got " + p.dump().substr(0, 80));
-    for (const json& c : p) {
-      if (!c.is_number() || !std::isfinite(c.get<double>()))
-        fail(k, "expected numbers, got " + p.dump().substr(0, 80));
-    }
-    out.push_back({p[0].get<double>(), p[1].get<double>()});
-  }
-  return out;
-}
-
-Command PedestrianAgent::parse_command(const std::string& dp, const json& j) const {
-  if (!j.is_object()) fail(dp, "expected a JSON object of commands, got " + j.dump().substr(0, 80));
-  auto object = [&](const std::string& key, const json& v,
-                    std::initializer_list<const char*> known) {
-    if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
-    for (const auto& [k, x] : v.items()) {
-      bool ok = false;
-      std::string list;
-      for (const char* n : known) {
-        ok = ok || k == n;
-        list += std::string(list.empty() ? "" : ", ") + n;
-      }
-      if (!ok) fail(key + "." + k, "unknown key (" + list + ")");
-    }
-  };
-  auto number = [&](const std::string& key, const json& obj, const char* k) {
-    if (!obj.contains(k)) fail(key + "." + k, "missing (a number)");
-    const json& v = obj[k];
-    if (!v.is_number() || !std::isfinite(v.get<double>()))
-      fail(key + "." + k, "expected a number, got " + v.dump().substr(0, 80));
-    return v.get<double>();
-  };
-  auto pose = [&](const std::string& key, const json& v, bool speed_needed) {
-    object(key, v, {"x", "y", "z", "yaw", "speed"});
-    Command::Pose p;
-    p.x = number(key, v, "x");
-    p.y = number(key, v, "y");
-    p.yaw = number(key, v, "yaw");
-    if (v.contains("z")) number(key, v, "z");
-    if (v.contains("speed") || speed_needed) {
-      p.speed = number(key, v, "speed");
-      if (*p.speed < 0) fail(key + ".speed", "must be >= 0 m/s");
-    }
-    return p;
-  };
-  Command c;
-  for (const auto& [k, v] : j.items()) {
-    const std::string key = dp + "." + k;
-    if (k == "time_ns") {
-      if (!v.is_number()) fail(key, "expected a number (ns)");
-    } else if (k == "speed") {
-      object(key, v, {"speed", "target_speed", "acceleration"});
-      c.speed = number(key, v, "speed");
-      if (*c.speed < 0) fail(key + ".speed", "must be >= 0 m/s");
-      if (v.contains("target_speed")) number(key, v, "target_speed");
-      if (v.contains("acceleration")) number(key, v, "acceleration");
-    } else if (k == "lane") {
-      fail(key,
-           "a pedestrian has no lane to change to (a pedestrian_agent takes speed, route, "
-           "trajectory and teleport)");
-    } else if (k == "route") {
-      object(key, v, {"positions"});
-      if (!v.contains("positions")) fail(key + ".positions", "missing (a list of [x, y])");
-      Points pts = parse_points(key + ".positions", v["positions"]);
-      for (size_t i = 0; i < pts.size(); ++i) {
-        if (!graph_->locate(pts[i][0], pts[i][1], std::nullopt, 20.0)) {
-          char what[160];
-          std::snprintf(what, sizeof what, "(%.2f, %.2f) is farther than 20 m from any lane of ",
-                        pts[i][0], pts[i][1]);
-          fail(key + ".positions[" + std::to_string(i) + "]", what + net_->source);
-        }
-      }
-      c.route = std::move(pts);
-    } else if (k == "trajectory") {
-      if (!v.is_object()) fail(key, "expected an object, got " + v.dump().substr(0, 80));
-      if (v.contains("polyline")) {
-        object(key, v, {"polyline", "length"});
-        if (v.contains("length")) number(key, v, "length");
-        c.polyline = parse_points(key + ".polyline", v["polyline"]);
-      } else {
-        c.timed = pose(key, v, true);
-      }
-    } else if (k == "teleport") {
-      c.teleport = pose(key, v, false);
-    } else {
-      fail(key, "unknown key (time_ns, speed, route, trajectory, teleport)");
-    }
-  }
-  if (c.timed && c.speed)
-    fail(dp + ".trajectory", "a timed trajectory sets the speed too: give it alone");
-  if (c.teleport && (c.timed || c.polyline))
-    fail(dp + ".teleport", "give teleport or trajectory, not both");
-  return c;
 }
 
 std::optional<odr::LanePosition> PedestrianAgent::nearest_sidewalk(double x, double y) const {
@@ -847,7 +677,7 @@ void PedestrianAgent::append_leg(Path& path, double ax, double ay, double bx, do
   if (cr.exit > cr.enter) {
     cr.enter = std::max(cr.enter, cr.start);
     cr.exit = std::min(cr.exit, cr.end);
-    path.crossings.push_back(cr);
+    path.road_crossings.push_back(cr);
   }
 }
 
@@ -869,12 +699,12 @@ bool PedestrianAgent::path_from(Path& path, double x, double y, double yaw, doub
                                                          rest.poses[0].y - path.poses.back().y);
       const double offset = base + (gap < 1e-6 ? 0.0 : gap);
       path.append(rest.poses);
-      for (Crossing c : rest.crossings) {
+      for (Crossing c : rest.road_crossings) {
         c.start += offset;
         c.end += offset;
         c.enter += offset;
         c.exit += offset;
-        path.crossings.push_back(c);
+        path.road_crossings.push_back(c);
       }
       return true;
     }
@@ -932,8 +762,8 @@ void PedestrianAgent::replan(const Points& via) {
   kr_ = 0;
   // Already on the road where the path starts: it is crossing, it does not wait.
   committed_ = SIZE_MAX;
-  for (size_t i = 0; i < path_.crossings.size(); ++i) {
-    if (path_.crossings[i].enter - kCurbWait <= 1e-9) committed_ = i;
+  for (size_t i = 0; i < path_.road_crossings.size(); ++i) {
+    if (path_.road_crossings[i].enter - kCurbWait <= 1e-9) committed_ = i;
     break;
   }
 }
@@ -1080,45 +910,27 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   double limit = path_.length();  // the farthest arc it may be at
   // The next crossing not yet behind it.
   size_t ci = SIZE_MAX;
-  for (size_t i = 0; i < path_.crossings.size(); ++i) {
-    if (path_.crossings[i].exit > arc_ + 1e-9 &&
-        path_.crossings[i].exit > path_.crossings[i].enter) {
+  for (size_t i = 0; i < path_.road_crossings.size(); ++i) {
+    if (path_.road_crossings[i].exit > arc_ + 1e-9 &&
+        path_.road_crossings[i].exit > path_.road_crossings[i].enter) {
       ci = i;
       break;
     }
   }
   if (ci != SIZE_MAX) {
-    const Crossing& c = path_.crossings[ci];
+    const Crossing& c = path_.road_crossings[ci];
     const double wait_at = c.enter - kCurbWait;
     if (committed_ != ci) {
       if (arc_ >= wait_at - 3.0) {
         bool ok = lights_allow(c);
-        if (ok) {
-          for (const Threat& t : threats(c)) {
-            if (t.tta < gap_) ok = false;
-          }
-        }
+        if (ok) ok = road_users::gap_accepted(threats(c), gap_);
         if (ok && arc_ >= wait_at - v_des * dt - 1e-6) committed_ = ci;
         if (!ok) limit = std::min(limit, wait_at);
       }
     }
     if (committed_ == ci) {
-      const double my_u = arc_ - c.start;
-      for (const Threat& t : threats(c)) {
-        const bool over = t.front <= 0;        // its body is over the crossing line
-        if (!over && t.speed < 0.5) continue;  // standing before the line
-        const double lo = t.u - t.half_width - 0.5, hi = t.u + t.half_width + 0.5;
-        if (my_u > lo && my_u < hi) {
-          // In its lane: back out when the vehicle is within StepBackDistance, or when it
-          // would arrive before it could clear the lane forwards and backing out is shorter.
-          const double t_fwd = (hi - my_u) / v_des, t_back = (my_u - lo) / v_des;
-          if (!over && (t.front < step_back_distance_ || (t.tta < t_fwd + 0.5 && t_back < t_fwd)))
-            limit = std::min(limit, c.start + lo - 0.2);
-        } else if (my_u <= lo && lo - my_u < 1.5 &&
-                   (over || t.front < stop_distance_ || t.tta < (hi - my_u) / v_des + 1.0)) {
-          limit = std::min(limit, std::max(arc_, c.start + lo - 0.2));  // wait before it
-        }
-      }
+      limit = road_users::crossing_limit(threats(c), c.start, arc_, v_des,
+                                         {stop_distance_, step_back_distance_}, limit);
     }
   }
   double v = 0;
@@ -1127,8 +939,8 @@ int64_t PedestrianAgent::step(int64_t duration_ns) {
   } else if (cmd && cmd->speed) {
     // Commanded: on along its path at that speed, whatever the traffic.
     v = std::min(v_des, (path_.length() - arc_) / dt);
-    for (size_t i = 0; i < path_.crossings.size(); ++i) {
-      const Crossing& c = path_.crossings[i];
+    for (size_t i = 0; i < path_.road_crossings.size(); ++i) {
+      const Crossing& c = path_.road_crossings[i];
       if (c.exit > c.enter && c.enter - kCurbWait <= arc_ + v * dt && c.exit > arc_) {
         committed_ = i;  // on it: the AI finishes the crossing
         break;
@@ -1216,7 +1028,11 @@ void PedestrianAgent::set_datapack(const datapack::View& dp) {
     if (j.is_object() && j.empty()) {
       command_.reset();  // on its own AI
     } else {
-      command_ = parse_command(name, j);
+      try {
+        command_ = road_users::parse_pedestrian_command(j, name, *graph_);
+      } catch (const road_users::CommandError& e) {
+        fail(e.key(), e.detail());
+      }
     }
   } else if (name == weather_dp_) {
     if (!dp.is_json()) fail(name, "expected the JSON weather datapack");

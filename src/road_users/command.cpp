@@ -2,8 +2,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <initializer_list>
 #include <utility>
 
 #include "opendrive/network.h"
@@ -14,50 +12,14 @@ using nlohmann::json;
 
 namespace {
 
-[[noreturn]] void fail(const std::string& key, const std::string& detail) {
-  throw CommandError(key, detail);
-}
+using command_parts::check_object;
+using command_parts::fail;
+using command_parts::number;
 
-std::string shown(const json& v) { return v.dump().substr(0, 80); }
-
-// v is an object whose keys are all among `known`.
-void check_object(const std::string& key, const json& v, std::initializer_list<const char*> known) {
-  if (!v.is_object()) fail(key, "expected an object, got " + shown(v));
-  for (const auto& [k, x] : v.items()) {
-    bool ok = false;
-    std::string list;
-    for (const char* n : known) {
-      ok = ok || k == n;
-      list += std::string(list.empty() ? "" : ", ") + n;
-    }
-    if (!ok) fail(key + "." + k, "unknown key (" + list + ")");
-  }
-}
-
-// obj[k], which must be there and a finite number.
-double number(const std::string& key, const json& obj, const char* k) {
-  if (!obj.contains(k)) fail(key + "." + k, "missing (a number)");
-  const json& v = obj[k];
-  if (!v.is_number() || !std::isfinite(v.get<double>()))
-    fail(key + "." + k, "expected a number, got " + shown(v));
-  return v.get<double>();
-}
+const char* const kNoReversing = " (reversing is not modelled)";
 
 double speed_of(const std::string& key, const json& v) {
-  const double speed = number(key, v, "speed");
-  if (speed < 0) fail(key + ".speed", "must be >= 0 m/s (reversing is not modelled)");
-  return speed;
-}
-
-VehicleCommand::Pose parse_pose(const std::string& key, const json& v, bool speed_needed) {
-  check_object(key, v, {"x", "y", "z", "yaw", "speed"});
-  VehicleCommand::Pose p;
-  p.x = number(key, v, "x");
-  p.y = number(key, v, "y");
-  p.yaw = number(key, v, "yaw");
-  if (v.contains("z")) number(key, v, "z");
-  if (v.contains("speed") || speed_needed) p.speed = speed_of(key, v);
-  return p;
+  return command_parts::speed_of(key, v, kNoReversing);
 }
 
 VehicleCommand::Speed parse_speed(const std::string& key, const json& v) {
@@ -98,32 +60,7 @@ VehicleCommand::Lane parse_lane(const std::string& key, const json& v, const odr
   return ln;
 }
 
-Points parse_route(const std::string& key, const json& v, const odr::LaneGraph& graph) {
-  check_object(key, v, {"positions"});
-  if (!v.contains("positions")) fail(key + ".positions", "missing (a list of [x, y])");
-  Points pts = parse_points(key + ".positions", v["positions"], 1);
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const auto loc = graph.locate_if(pts[i][0], pts[i][1], std::nullopt, 20.0,
-                                     [](const odr::LaneNode& n, double) { return n.drivable(); });
-    if (loc) continue;
-    char what[160];
-    std::snprintf(what, sizeof what, "(%.2f, %.2f) is farther than 20 m from any driving lane of ",
-                  pts[i][0], pts[i][1]);
-    fail(key + ".positions[" + std::to_string(i) + "]", what + graph.network().source);
-  }
-  return pts;
-}
-
-void parse_trajectory(const std::string& key, const json& v, VehicleCommand& c) {
-  if (!v.is_object()) fail(key, "expected an object, got " + shown(v));
-  if (v.contains("polyline")) {
-    check_object(key, v, {"polyline", "length"});
-    if (v.contains("length")) number(key, v, "length");
-    c.polyline = parse_points(key + ".polyline", v["polyline"], 1);
-  } else {
-    c.timed = parse_pose(key, v, true);
-  }
-}
+Points at_least_one(const std::string& key, const json& v) { return parse_points(key, v, 1); }
 
 // The parts that cannot be given together.
 void check_combination(const std::string& where, const VehicleCommand& c) {
@@ -137,47 +74,20 @@ void check_combination(const std::string& where, const VehicleCommand& c) {
 
 }  // namespace
 
-Points parse_points(const std::string& key, const json& v, size_t min_points) {
-  if (!v.is_array() || v.size() < min_points)
-    fail(key, "expected a list of at least " + std::to_string(min_points) + " points [x, y], got " +
-                  shown(v));
-  Points out;
-  for (size_t i = 0; i < v.size(); ++i) {
-    const json& p = v[i];
-    const std::string k = key + "[" + std::to_string(i) + "]";
-    if (!p.is_array() || p.size() < 2 || p.size() > 3)
-      fail(k, "expected a point [x, y] (or [x, y, z]), got " + shown(p));
-    for (const json& x : p) {
-      if (!x.is_number() || !std::isfinite(x.get<double>()))
-        fail(k, "expected numbers, got " + shown(p));
-    }
-    out.push_back({p[0].get<double>(), p[1].get<double>()});
-  }
-  return out;
-}
-
 VehicleCommand parse_vehicle_command(const json& j, const std::string& where,
                                      const odr::LaneGraph& graph) {
-  if (!j.is_object()) fail(where, "expected a JSON object of commands, got " + shown(j));
   VehicleCommand c;
-  for (const auto& [k, v] : j.items()) {
-    const std::string key = where + "." + k;
-    if (k == "time_ns") {
-      if (!v.is_number()) fail(key, "expected a number (ns)");
-    } else if (k == "speed") {
-      c.speed = parse_speed(key, v);
-    } else if (k == "lane") {
-      c.lane = parse_lane(key, v, graph.network());
-    } else if (k == "route") {
-      c.route = parse_route(key, v, graph);
-    } else if (k == "trajectory") {
-      parse_trajectory(key, v, c);
-    } else if (k == "teleport") {
-      c.teleport = parse_pose(key, v, false);
-    } else {
-      fail(key, "unknown key (time_ns, speed, lane, route, trajectory, teleport)");
-    }
-  }
+  const command_parts::PathParts how{at_least_one, true, kNoReversing};
+  command_parts::parse_path_command(
+      j, where, graph, how, c, [&](const std::string& key, const std::string& k, const json& v) {
+        if (k == "speed") {
+          c.speed = parse_speed(key, v);
+        } else if (k == "lane") {
+          c.lane = parse_lane(key, v, graph.network());
+        } else {
+          fail(key, "unknown key (time_ns, speed, lane, route, trajectory, teleport)");
+        }
+      });
   check_combination(where, c);
   return c;
 }

@@ -41,6 +41,19 @@ Path::Proj Path::project(double x, double y, size_t lo, size_t hi) const {
   return best;
 }
 
+void Path::append(const std::vector<odr::Pose2>& more) {
+  for (const auto& p : more) {
+    if (!poses.empty()) {
+      const double d = std::hypot(p.x - poses.back().x, p.y - poses.back().y);
+      if (d < 1e-6) continue;
+      arc.push_back(arc.back() + d);
+    } else {
+      arc.push_back(0);
+    }
+    poses.push_back(p);
+  }
+}
+
 namespace {
 
 // Stop lines: each traffic light that applies to a lane of the route, where the route passes

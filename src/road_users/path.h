@@ -40,6 +40,9 @@ struct Path {
     size_t index = 0;
   };
   Proj project(double x, double y, size_t lo = 0, size_t hi = SIZE_MAX) const;
+  // Appends `more` to the poses, each arc the last one's plus the straight distance to it;
+  // a pose within 1e-6 m of the last one is skipped.
+  void append(const std::vector<opendrive::Pose2>& more);
 };
 
 // The path along `route`, poses `ds` m apart, with the stop lines of the traffic lights that

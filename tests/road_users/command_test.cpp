@@ -8,36 +8,19 @@
 #include <cmath>
 #include <string>
 
-#include "opendrive/parser.h"
+#include "test_map.h"
 
 namespace convoy::road_users {
 namespace {
 
-namespace odr = convoy::opendrive;
 using nlohmann::json;
 
-struct Map {
-  odr::Network net = odr::load(CONVOY_LANE_GRAPH_XODR);
-  odr::LaneGraph graph{net};
-};
-
-const Map& map() {
-  static const Map m;
-  return m;
-}
+using testing::map;
 
 VehicleCommand parse(const json& j) { return parse_vehicle_command(j, "command", map().graph); }
 
 // The message a command is rejected with ("accepted" if it is not).
-std::string error_of(const json& j) {
-  try {
-    parse(j);
-  } catch (const CommandError& e) {
-    EXPECT_EQ(std::string(e.what()), e.key() + ": " + e.detail());
-    return e.what();
-  }
-  return "accepted";
-}
+std::string error_of(const json& j) { return testing::rejection(parse, j); }
 
 TEST(Command, NothingIsNoPart) {
   const VehicleCommand c = parse(json::parse(R"({"time_ns": 100})"));

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "opendrive/parser.h"
 
@@ -68,6 +69,18 @@ TEST(Path, HeadingInterpolatesTheShortWayRound) {
   p.poses = {{0, 0, 3.1, 0}, {1, 0, -3.1, 0}};
   p.arc = {0, 1};
   EXPECT_NEAR(p.at(0.5).heading, 3.1 + 0.5 * (2 * M_PI - 6.2), 1e-12);
+}
+
+TEST(Path, AppendSkipsRepeatedPoses) {
+  Path p;
+  p.append({{1, 1, 0, 0}});
+  ASSERT_EQ(p.arc, std::vector<double>{0.0});
+  // (4, 5) is 5 m on; a pose 1e-7 m from the last is dropped; then 2 m back along x.
+  p.append({{4, 5, 0.3, 0}, {4 + 1e-7, 5, 0.4, 0}, {2, 5, M_PI, 0}});
+  ASSERT_EQ(p.poses.size(), 3u);
+  EXPECT_EQ(p.arc, (std::vector<double>{0.0, 5.0, 7.0}));
+  EXPECT_EQ(p.poses[1].heading, 0.3);
+  EXPECT_EQ(p.length(), 7.0);
 }
 
 TEST(Path, OnTheLaneGraph) {
