@@ -280,6 +280,9 @@ def main():
                     help="simulated seconds before growth is measured")
     ap.add_argument("--max-wall", type=float, default=0.0,
                     help="stop the run after this many wall seconds (0: never)")
+    ap.add_argument("--fail-above", type=float, default=0.0,
+                    help="exit 1 when a process grew by this many MiB or more after the "
+                         "warm-up, or did not pass it (0: report only); the soak test's check")
     ap.add_argument("--out", help="folder for the run and the CSV (default: new under /tmp)")
     ap.add_argument("--csv", help="samples CSV (default OUT/soak_samples.csv)")
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
@@ -319,6 +322,9 @@ def main():
               % args.warmup)
     worst = report(growth_table(rows, args.warmup), args.warmup, sim)
     print("max growth MiB: %.1f" % worst)
+    if args.fail_above > 0 and (worst >= args.fail_above or sim <= args.warmup):
+        print("FAILED: max growth %.1f MiB, the limit is < %g MiB" % (worst, args.fail_above))
+        sys.exit(1)
     # stopped by --max-wall or Ctrl-C: the run ends as on Ctrl-C (exit 130), not a failure
     sys.exit(0 if rc == 0 or (stopped and rc == 130) else 1)
 
