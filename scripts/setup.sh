@@ -21,6 +21,10 @@ PACKAGES=(
   zlib1g-dev libzstd-dev libboost-dev
   ffmpeg
   chromium
+  ros-core-dev python3-rospy python3-rosmaster python3-genpy python3-gencpp
+  libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev libvisualization-msgs-dev
+  python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-tf2-msgs python3-visualization-msgs
+  python3-message-filters
 )
 
 if [[ "${CONVOY_SKIP_APT:-0}" != 1 ]]; then
