@@ -62,6 +62,10 @@ class CameraSensors {
     return scene_.instances()[instance].material;
   }
   void set_material(int instance, const render::Material& m) { scene_.set_material(instance, m); }
+  // The scene the cameras render (meshes, posed instances, materials), for other sensors that
+  // look at the same world (src/lidar).
+  const render::Scene& scene() const { return scene_; }
+  render::Scene& scene() { return scene_; }  // (benchmarks hide or move parts of it)
 
   // The weather from now on (see weather_effects.h): the sun, the sky, fog, wet or snowy
   // ground, rain or snow over the image, and at night the vehicles' headlights and the street
