@@ -100,20 +100,7 @@ void Session::initialize(bool keep_observations) {
   };
   if (const int64_t start = process_start_ns(); start > 0)
     startup_.process_s = (now_ns() - start) * 1e-9;
-  for (const auto& f : cfg_.functions) {
-    if (!f.active) continue;
-    python::add_python_path(f.file.parent_path());
-    for (auto& fn : runtime_.load(f.name, f.file)) functions_.push_back(std::move(fn));
-  }
-  if (cfg_.status_function && cfg_.status_function->active) {
-    const auto& f = *cfg_.status_function;
-    python::add_python_path(f.file.parent_path());
-    status_ = runtime_.load_status(f.name, f.file);
-  }
-  std::vector<const loop::LoadedFunction*> all;
-  for (const auto& fn : functions_) all.push_back(&fn);
-  if (status_) all.push_back(&*status_);
-  check_functions(all, cfg_);
+  load_functions();
   startup_.functions_s = since(t0);
 
   if (replay_channel_) {
@@ -131,9 +118,11 @@ void Session::initialize(bool keep_observations) {
               " s");
   }
 
-  loop_ = std::make_unique<loop::FtiLoop>(engines_.handles(), runtime_, functions_,
+  loop::FunctionRunner& runner = graph_ ? static_cast<loop::FunctionRunner&>(*graph_) : runtime_;
+  loop_ = std::make_unique<loop::FtiLoop>(engines_.handles(), runner, functions_,
                                           status_ ? &*status_ : nullptr);
   loop_->keep_observations(keep_observations);
+  attach_graph();
   if (show_scene_) {
     std::string extra;
     for (const auto& id : scene_datapacks(engines_.handles()))
@@ -169,6 +158,41 @@ void Session::initialize(bool keep_observations) {
   startup_.prime_s = since(t_prime);
   if (const int64_t start = process_start_ns(); start > 0)
     startup_.total_s = (now_ns() - start) * 1e-9;
+}
+
+void Session::load_functions() {
+  if (cfg_.datapack_processor == "cg") {
+    // As in NRP-Core, the graph replaces the functions (the config warns about them).
+    python::add_python_path(cfg_.dir);
+    std::vector<std::string> engines;
+    for (const auto& e : cfg_.engines) engines.push_back(e.name);
+    graph_ = std::make_unique<python::GraphRuntime>();
+    graph_->load(cfg_.computational_graph, cfg_.dir, engines);
+    graph_label_.name = graph_->label();
+    graph_label_.file = cfg_.computational_graph.empty() ? cfg_.file : cfg_.computational_graph[0];
+    log_.info("loaded the " + graph_->label());
+    return;
+  }
+  for (const auto& f : cfg_.functions) {
+    if (!f.active) continue;
+    python::add_python_path(f.file.parent_path());
+    for (auto& fn : runtime_.load(f.name, f.file)) functions_.push_back(std::move(fn));
+  }
+  if (cfg_.status_function && cfg_.status_function->active) {
+    const auto& f = *cfg_.status_function;
+    python::add_python_path(f.file.parent_path());
+    status_ = runtime_.load_status(f.name, f.file);
+  }
+  std::vector<const loop::LoadedFunction*> all;
+  for (const auto& fn : functions_) all.push_back(&fn);
+  if (status_) all.push_back(&*status_);
+  check_functions(all, cfg_);
+}
+
+void Session::attach_graph() {
+  if (!graph_) return;
+  for (const auto& [engine, name] : graph_->requested()) loop_->also_want(engine, name);
+  loop_->set_graph(&graph_label_);
 }
 
 void Session::record_to(const fs::path& file, bool blobs, const record::StringMap& metadata) {

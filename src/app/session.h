@@ -19,6 +19,7 @@
 #include "loop/fti_loop.h"
 #include "loop/tap_fanout.h"
 #include "python/function_runtime.h"
+#include "python/graph_runtime.h"
 #include "record/recorder.h"
 
 namespace convoy::app {
@@ -115,12 +116,18 @@ class Session {
  private:
   template <typename F>
   void timed(F&& run);
+  // The TF, PF and status function files, or the computational graph (DataPackProcessor cg).
+  void load_functions();
+  // With a graph: the loop runs it, and takes the datapacks it reads.
+  void attach_graph();
 
   const config::SimulationConfig& cfg_;
   std::filesystem::path run_dir_;
   RunLog& log_;
   bool quiet_;
   python::FunctionRuntime runtime_;
+  std::unique_ptr<python::GraphRuntime> graph_;  // DataPackProcessor cg
+  loop::LoadedFunction graph_label_;             // names the graph in errors and to taps
   EngineSet engines_;
   std::vector<loop::LoadedFunction> functions_;
   std::optional<loop::LoadedFunction> status_;

@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "app/engine_set.h"
+#include "app/external_processes.h"
 #include "app/live_run.h"
 #include "app/nrp_server.h"
 #include "app/run_log.h"
@@ -257,15 +258,13 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
   }
   if (cfg->loop != "FTILoop")
     log.info("warning: SimulationLoop " + cfg->loop + " is not available yet; running FTILoop");
-  if (cfg->datapack_processor != "tf")
-    log.info("warning: DataPackProcessor " + cfg->datapack_processor +
-             " is not available yet; running tf");
   if (cfg->process_launcher_type != "Basic")
     log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
              " is not available; using Basic");
-  for (const char* key :
-       {"ExternalProcesses", "ConnectROS", "ConnectMQTT", "ComputationalGraph", "EventLoop",
-        "EventLoopTimeout", "EventLoopTimestep", "ROSNode", "MQTTNode"}) {
+  // ComputationalGraph, EventLoop and ExternalProcesses are the config's (its warnings say
+  // when they are ignored); MQTTNode and ROSNode are read, but the graph has no client yet.
+  for (const char* key : {"ConnectROS", "ConnectMQTT", "EventLoopTimeout", "EventLoopTimestep",
+                          "ROSNode", "MQTTNode"}) {
     // An object counts when present ("ROSNode": {} starts a node with the defaults in NRP-Core);
     // an empty list asks for nothing.
     if (cfg->json.contains(key) && (!cfg->json[key].empty() || cfg->json[key].is_object())) {
@@ -291,6 +290,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
                     loop::DataPackTap* live_tap, loop::PauseGate* gate) {
   export_run_environment(run_dir);
   python::Interpreter interpreter;
+  ExternalProcesses external(cfg, run_dir / "logs");
   Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
   if (live_tap) {
@@ -307,6 +307,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
         throw UserError(std::string("Record: ") + e.what());
       }
     }
+    external.start(log);
     session.initialize(/*keep_observations=*/false);
     session.run_to_end();
     if (interrupted()) outcome = {kExitInterrupted, interrupted_text()};
@@ -323,6 +324,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
     log.error(outcome.error);
   }
   std::string shutdown_error = session.shut_down(outcome.code == kExitOk);
+  external.stop(&log);
   if (!shutdown_error.empty()) {
     if (outcome.code == kExitOk) outcome.code = kExitEngineError;
     if (outcome.error.empty()) outcome.error = shutdown_error;
@@ -414,8 +416,10 @@ int serve_simulation(const RunOptions& options) {
   {
     export_run_environment(run_dir);
     python::Interpreter interpreter;
+    ExternalProcesses external(cfg, run_dir / "logs");
     NrpServer server(cfg, run_dir, log);
     try {
+      external.start(log);
       server.listen(options.server_address, options.insecure);
       {
         pybind11::gil_scoped_release release;  // each call takes the GIL in its gRPC thread
@@ -429,6 +433,7 @@ int serve_simulation(const RunOptions& options) {
       outcome = outcome_of(std::current_exception());
       log.error(outcome.error);
     }
+    external.stop(&log);
     if (outcome.code == kExitOk && interrupted()) outcome = {kExitInterrupted, interrupted_text()};
   }
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();

@@ -467,6 +467,10 @@ SimulationConfig load_simulation_config(const fs::path& file,
     engine.json.erase("AuthToken");  // the engine gets its config in Initialize: not the token
     config.engines.push_back(std::move(engine));
   }
+  std::vector<std::pair<std::string, std::string>> errors, warnings;
+  read_graph_keys(doc, config, &errors, &warnings);
+  for (const auto& [pointer, message] : errors) report.add(pointer, message);
+  for (const auto& [pointer, message] : warnings) report.add(pointer, message, true);
   report.throw_if_errors();
 
   const json& functions = doc["DataPackProcessingFunctions"];

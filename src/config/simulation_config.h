@@ -20,6 +20,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace convoy::config {
@@ -50,6 +51,32 @@ struct FunctionConfig {
   std::string pointer;  // e.g. "/DataPackProcessingFunctions/0"
 };
 
+// One of ExternalProcesses (NRP-Core's process_launcher.json).
+struct ExternalProcessConfig {
+  std::string cmd;                        // ProcCmd
+  std::vector<std::string> start_params;  // ProcStartParams
+  std::vector<std::string> env_params;    // ProcEnvParams, "KEY=VALUE"
+  std::string launch_type = "BasicFork";  // LaunchCommand/LaunchType, or "EmptyLaunchCommand"
+  std::string pointer;                    // "/ExternalProcesses/0"
+};
+
+// The EventLoop object (used by SimulationLoop EventLoop).
+struct EventLoopConfig {
+  double timeout_s = 0;  // 0: no timeout
+  double timestep_s = 0.01;
+  double timestep_warn_threshold_s = 0.001;
+  std::string execution_mode = "AllNodes";  // or "OutputDriven"
+};
+
+struct MqttNodeConfig {
+  std::string broker = "localhost:1883";
+  std::string client_name = "NRP-core-client";
+};
+
+struct RosNodeConfig {
+  std::string node_name = "nrp_core";
+};
+
 struct SimulationConfig {
   std::filesystem::path file, dir;  // absolute
   std::string name, description;
@@ -64,6 +91,11 @@ struct SimulationConfig {
   std::vector<EngineConfig> engines;
   std::vector<FunctionConfig> functions;  // DataPackProcessingFunctions, in config order
   std::optional<FunctionConfig> status_function;
+  std::vector<std::filesystem::path> computational_graph;  // absolute, in config order
+  EventLoopConfig event_loop;
+  std::optional<MqttNodeConfig> mqtt_node;  // present: MQTTNode was given
+  std::optional<RosNodeConfig> ros_node;    // present: ROSNode was given
+  std::vector<ExternalProcessConfig> external_processes;
   nlohmann::json json;                // whole config after overrides, defaults, path resolution
   std::vector<std::string> warnings;  // e.g. unknown keys, same format as errors
 };
@@ -97,6 +129,13 @@ class ConfigError : public std::runtime_error {
 SimulationConfig load_simulation_config(const std::filesystem::path& file,
                                         const std::vector<std::string>& overrides,
                                         const std::filesystem::path& share_dir);
+
+// Reads ComputationalGraph, EventLoop, MQTTNode, ROSNode and ExternalProcesses from `doc`
+// (validated, defaults filled, paths absolute) into `config`; adds "<pointer>: <message>" to
+// `errors` for what the schema cannot check and to `warnings` for keys that are ignored.
+void read_graph_keys(const nlohmann::json& doc, SimulationConfig& config,
+                     std::vector<std::pair<std::string, std::string>>* errors,
+                     std::vector<std::pair<std::string, std::string>>* warnings);
 
 // Applies one "Key=Value" override to `config`. Throws ConfigError on bad syntax.
 void apply_override(nlohmann::json& config, const std::string& override_text);

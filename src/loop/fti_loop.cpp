@@ -190,6 +190,12 @@ void FtiLoop::run_functions() {
     runner_.run_transceiver(fn, source_, &outputs_);
     route(outputs_, fn);
   }
+  if (graph_) {
+    due_names_.clear();
+    for (auto* e : due_) due_names_.push_back(e->name());
+    runner_.run_graph(due_names_, source_, &outputs_);
+    route(outputs_, *graph_);
+  }
   if (status_) {
     const size_t before = observations_.size();
     done_ = runner_.run_status(*status_, source_, &observations_);

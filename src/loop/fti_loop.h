@@ -61,6 +61,12 @@ class FtiLoop {
   // unknown engine.
   bool also_want(const std::string& engine, const std::string& datapack);
 
+  // Runs the runner's computational graph (FunctionRunner::run_graph) each cycle, after the
+  // functions; `label` names it in errors and to the tap (its name and first file). The
+  // datapacks it reads are asked for with also_want(). Before prime(); `label` must outlive
+  // the loop.
+  void set_graph(const LoadedFunction* label) { graph_ = label; }
+
   // Fetches the functions' inputs from every engine (after Initialize). With
   // keep_observations(), the non-empty ones are the first observations (what NRP-Core's
   // initialize() returns to its client).
@@ -118,6 +124,8 @@ class FtiLoop {
   FunctionRunner& runner_;
   const std::vector<LoadedFunction>& functions_;
   const LoadedFunction* status_;
+  const LoadedFunction* graph_ = nullptr;  // set_graph()'s: runs the graph
+  std::vector<std::string> due_names_;     // the due engines' names, for the graph
   InputSource source_;
   struct Pooled {
     engine::DataPack datapack;

@@ -77,6 +77,11 @@ class FunctionRunner {
   // (datapacks whose id may be empty) to `observations`.
   virtual bool run_status(const LoadedFunction& fn, const InputSource& src,
                           std::vector<engine::DataPack>* observations);
+  // The computational graph (DataPackProcessor "cg"), run instead of the functions when the
+  // loop has one (FtiLoop::set_graph): one step after the engines `due_engines` (config order)
+  // finished theirs; appends the datapacks its ToEngine nodes send them to `outputs`.
+  virtual void run_graph(const std::vector<std::string>& /*due_engines*/,
+                         const InputSource& /*src*/, std::vector<engine::DataPack>* /*outputs*/) {}
   // Forgets what the functions kept between cycles (preprocessed datapacks): the simulation
   // was reset.
   virtual void reset() {}

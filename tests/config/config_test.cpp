@@ -422,5 +422,57 @@ TEST_F(ConfigTest, BuildShareDir) {
   EXPECT_EQ(c.engines[0].type, "python_json");
 }
 
+TEST_F(ConfigTest, GraphAndEventLoopKeys) {
+  json doc = minimal();
+  const SimulationConfig plain = load(doc);
+  EXPECT_TRUE(plain.computational_graph.empty());
+  EXPECT_FALSE(plain.mqtt_node || plain.ros_node);
+  EXPECT_TRUE(plain.external_processes.empty());
+  doc["DataPackProcessor"] = "cg";
+  doc["ComputationalGraph"] = {"g1.py", "/abs/g2.py"};
+  doc["EventLoop"] = {{"ExecutionMode", "OutputDriven"}};
+  doc["MQTTNode"] = json::object();
+  doc["ROSNode"] = {{"NodeName", "n"}};
+  doc["DataPackProcessingFunctions"] = {{{"Name", "tf"}, {"FileName", "tf.py"}}};
+  const SimulationConfig c = load(doc);
+  EXPECT_EQ(c.computational_graph, (std::vector<fs::path>{dir_ / "g1.py", "/abs/g2.py"}));
+  EXPECT_EQ(c.event_loop.execution_mode, "OutputDriven");
+  EXPECT_DOUBLE_EQ(c.event_loop.timestep_s, 0.01);
+  EXPECT_DOUBLE_EQ(c.event_loop.timestep_warn_threshold_s, 0.001);
+  ASSERT_TRUE(c.mqtt_node && c.ros_node);
+  EXPECT_EQ(c.mqtt_node->broker, "localhost:1883");
+  EXPECT_EQ(c.mqtt_node->client_name, "NRP-core-client");
+  EXPECT_EQ(c.ros_node->node_name, "n");
+  EXPECT_EQ(c.warnings,
+            (std::vector<std::string>{
+                prefix() + "/DataPackProcessingFunctions: ignored: DataPackProcessor is cg "
+                           "(as in NRP-Core, the graph replaces the transceiver functions)",
+                prefix() + "/EventLoop: ignored: used with SimulationLoop EventLoop only"}));
+  doc["EventLoop"] = {{"Timestep", 0}, {"ExecutionMode", "Sometimes"}};
+  EXPECT_TRUE(Contains(error(doc), "/EventLoop/Timestep: must be > 0, got 0"));
+  EXPECT_TRUE(Contains(error(doc), "/EventLoop/ExecutionMode: must be one of"));
+}
+
+TEST_F(ConfigTest, ExternalProcesses) {
+  json doc = minimal();
+  doc["ExternalProcesses"] = {
+      {{"ProcCmd", "roslaunch x.launch"}, {"ProcStartParams", {"a"}}, {"ProcEnvParams", {"K=$V"}}},
+      {{"ProcCmd", "y"}, {"LaunchCommand", {{"LaunchType", "EmptyLaunchCommand"}}}}};
+  const SimulationConfig c = load(doc);
+  ASSERT_EQ(c.external_processes.size(), 2u);
+  EXPECT_EQ(c.external_processes[0].cmd, "roslaunch x.launch");
+  EXPECT_EQ(c.external_processes[0].start_params, (std::vector<std::string>{"a"}));
+  EXPECT_EQ(c.external_processes[0].env_params, (std::vector<std::string>{"K=$V"}));
+  EXPECT_EQ(c.external_processes[0].launch_type, "BasicFork");
+  EXPECT_EQ(c.external_processes[1].launch_type, "EmptyLaunchCommand");
+  EXPECT_EQ(c.external_processes[1].pointer, "/ExternalProcesses/1");
+  doc["ExternalProcesses"] = {{{"ProcCmd", "  "}, {"ProcEnvParams", {"=x"}}}, {{"ProcArgs", "a"}}};
+  const std::string e = error(doc);
+  EXPECT_TRUE(Contains(e, "/ExternalProcesses/1/ProcCmd: is required")) << e;
+  doc["ExternalProcesses"].erase(1);
+  EXPECT_EQ(error(doc), prefix() + "/ExternalProcesses/0/ProcCmd: is blank\n" + prefix() +
+                            "/ExternalProcesses/0/ProcEnvParams/0: must be KEY=VALUE, got \"=x\"");
+}
+
 }  // namespace
 }  // namespace convoy::config

@@ -249,7 +249,7 @@ class Files(DataTransferCase):
         r = self.run_convoy()
         self.assertExit(r, 0)
         for needle in ("ProcessLauncherType Docker is not available",
-                       "EventLoop is not supported yet", "EventLoopTimestep is not supported yet",
+                       "/EventLoop: ignored", "EventLoopTimestep is not supported yet",
                        "ROSNode is not supported yet", "MQTTNode is not supported yet",
                        "/EngineConfigs/1/EngineExtraConfigs: unknown key"):
             self.assertEqual(r.stderr.count(needle), 1, "%s: %r" % (needle, r))

@@ -135,9 +135,10 @@ class FunctionalNode(Node):
         try:
             result = self.function(**kwargs)
         except Exception as e:
+            # The user's frames only: this method's own is left out.
+            trace = traceback.format_exception(type(e), e, e.__traceback__.tb_next)
             raise ComputationalGraphError('An error occurred while executing Functional Node with '
-                                          'id "%s":\n%s' % (self.id, traceback.format_exc())) \
-                from e
+                                          'id "%s":\n%s' % (self.id, "".join(trace))) from e
         if result is None:
             return None
         if not isinstance(result, list):
