@@ -16,7 +16,11 @@ which a transceiver function turns into the car's joint targets, and a status fu
 returning done=True and one JSON observation every step with the keys t, x, y, yaw, speed,
 heading_error, off_path, waypoint, waypoints, episode_over and (optionally) ahead, a list of
 [forward, left] route points in the car's frame. One step() is one run_loop(1), i.e. one
-step of the smallest EngineTimestep (0.05 s on the Parkring). See docs/gym.md.
+step of the smallest EngineTimestep (0.05 s on the Parkring). With camera=(H, W), the
+observation is a Dict {"state": that Box, "camera": uint8 H x W x 3}: the ego camera's frame
+of the step, rendered at H x W by the world engine in a copy of the world (world_variant.py)
+and returned by the status function `<name>_camera.py` (rl_parkring's observe_camera.py).
+See docs/gym.md.
 """
 import os
 import shutil
@@ -26,7 +30,7 @@ import numpy as np
 
 from convoy_gym import spaces
 from convoy_gym.closing import ClosesOnExit
-from convoy_gym.world_variant import variant_config
+from convoy_gym.world_variant import check_camera, variant_config
 from nrp_client import NrpCore
 
 __all__ = ["DrivingEnv", "default_reward", "OBSERVATION_KEYS"]
@@ -68,6 +72,8 @@ class DrivingEnv(ClosesOnExit):
     (m/s), heading_error (rad, towards the route a few points ahead), off_path (m), then
     N_AHEAD route points ahead (2, 4, 8, 16, 24 m along the route) as [forward, left] m in
     the car's frame (zeros when the status function gives no `ahead`).
+    With camera=(H, W): Dict {"state": that Box, "camera": Box uint8 (H, W, 3) in [0, 255]},
+    the ego camera's frame at the end of the step (rendered H x W, one frame per step).
     Action: Box float32 (2,) = [steer in [-0.55, 0.55] rad, target speed in [0, 15] m/s].
     An action outside it raises ValueError.
     """
@@ -77,7 +83,7 @@ class DrivingEnv(ClosesOnExit):
 
     def __init__(self, config=DEFAULT_CONFIG, max_steps=1000, reward_fn=None,
                  start_steps=20, start_speed=6.0, start_steer=0.05, physics_step=None,
-                 args="", address=None, log_output=""):
+                 args="", address=None, log_output="", camera=None):
         """:param config: the simulation config; its folder is the experiment folder
         :param max_steps: steps per episode before `truncated`
         :param reward_fn: reward_fn(before, after, action) -> float; default_reward if None
@@ -89,6 +95,8 @@ class DrivingEnv(ClosesOnExit):
         :param args: more NRPCoreSim options, e.g. "-o SimulationTimeout=600"
         :param address: HOST:PORT for the server (default: a free loopback port)
         :param log_output: file in the experiment folder for the server's output ("" none)
+        :param camera: None, or (H, W): the observation also holds the ego camera's frame,
+            rendered H x W pixels once per step (see the class's docstring)
         """
         self._nrp = None
         self._tmp = None
@@ -104,18 +112,26 @@ class DrivingEnv(ClosesOnExit):
         self.reward_fn = reward_fn or default_reward
         self.start = (int(start_steps), float(start_speed), float(start_steer))
         inf = np.inf
-        self.observation_space = spaces.Box(
+        self.state_space = spaces.Box(
             low=np.array([-inf, -inf, -np.pi, 0.0, -np.pi, 0.0] + [-inf] * (2 * N_AHEAD)),
             high=np.array([inf, inf, np.pi, inf, np.pi, inf] + [inf] * (2 * N_AHEAD)),
             dtype=np.float32)
+        self.observation_space = self.state_space
+        self.camera = None
+        if camera is not None:
+            self.camera = check_camera(camera)
+            self.observation_space = spaces.Dict({
+                "state": self.state_space,
+                "camera": spaces.Box(0, 255, self.camera + (3,), dtype=np.uint8)})
+        self._frame = None
         self.action_space = spaces.Box(low=np.array([-MAX_STEER, 0.0]),
                                        high=np.array([MAX_STEER, MAX_SPEED]), dtype=np.float32)
         self.np_random = np.random.Generator(np.random.PCG64())
         self._raw = None
         self._steps = 0
         run_config = config
-        if physics_step is not None:
-            run_config, self._tmp = variant_config(config, physics_step)
+        if physics_step is not None or camera is not None:
+            run_config, self._tmp = variant_config(config, physics_step, self.camera)
         try:
             self._nrp = NrpCore(address or _free_address(),
                                 experiment_folder=os.path.dirname(config),
@@ -218,12 +234,15 @@ class DrivingEnv(ClosesOnExit):
     def _run(self, action):
         self._nrp.set_json_datapack("action", "agent", action)
         _, observations = self._nrp.run_loop(1)
-        if not observations:  # the status function had no car pose yet
+        dicts = [o for o in observations if isinstance(o, dict)]
+        if self.camera is not None and (dicts or self._frame is None):
+            self._take_frame([o for o in observations if not isinstance(o, dict)])
+        if not dicts:  # the status function had no car pose yet
             if self._raw is None:
                 raise RuntimeError("DrivingEnv: the status function returned no observation "
                                    "(%s)" % self.config)
             return self._raw
-        raw = observations[-1]
+        raw = dicts[-1]
         missing = [k for k in ("x", "y", "yaw", "speed", "heading_error", "off_path",
                                "waypoint", "waypoints", "episode_over") if k not in raw]
         if missing:
@@ -231,14 +250,34 @@ class DrivingEnv(ClosesOnExit):
                            % (self.config, ", ".join(missing)))
         return raw
 
+    def _take_frame(self, messages):
+        """The step's camera frame from the status function's camera datapack(s): every
+        step with an observation has one."""
+        frames = [m for m in messages if hasattr(m, "imageData")]
+        if not frames:
+            raise RuntimeError("DrivingEnv: the status function of %s returned no camera "
+                               "frame with its observation" % self.config)
+        m = frames[-1]
+        shape = (m.imageHeight, m.imageWidth, m.imageDepth)
+        if shape != self.camera + (3,) or len(m.imageData) != shape[0] * shape[1] * shape[2]:
+            raise RuntimeError("DrivingEnv: the camera frame is %s (%d bytes), not %s x 3"
+                               % (shape, len(m.imageData), self.camera))
+        self._frame = np.frombuffer(m.imageData, dtype=np.uint8).reshape(shape)
+
     def _observation(self):
+        state = self._state()
+        if self.camera is None:
+            return state
+        return {"state": state, "camera": self._frame.copy()}
+
+    def _state(self):
         r = self._raw
         ahead = r.get("ahead") or [[0.0, 0.0]] * N_AHEAD
         values = [r["x"], r["y"], r["yaw"], r["speed"], r["heading_error"], r["off_path"]]
         for i in range(N_AHEAD):
             values += ahead[min(i, len(ahead) - 1)][:2]
         obs = np.asarray(values, dtype=np.float32)
-        return np.clip(obs, self.observation_space.low, self.observation_space.high)
+        return np.clip(obs, self.state_space.low, self.state_space.high)
 
     def _info(self):
         r = self._raw

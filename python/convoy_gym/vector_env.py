@@ -86,6 +86,9 @@ class VectorDrivingEnv(ClosesOnExit):
         if env_kwargs.get("address"):
             raise ValueError("VectorDrivingEnv: every sub-environment needs its own address; "
                              "do not pass address=")
+        if env_kwargs.get("camera") is not None:
+            raise ValueError("VectorDrivingEnv: camera observations are not batched yet; "
+                             "use DrivingEnv(camera=...)")
         if env_fns is not None and len(env_fns) != num_envs:
             raise ValueError("VectorDrivingEnv: %d env_fns for %d envs" % (len(env_fns), num_envs))
         self.num_envs = num_envs

@@ -1,10 +1,17 @@
-"""A copy of an experiment's config whose Gazebo world has another physics step.
+"""A copy of an experiment's config whose Gazebo world has another physics step, or whose
+cameras render another size once per step.
 
 The Parkring world's physics (DART) steps every 1 ms, so one 0.05 s environment step is 50 physics steps,
 most of its time. variant_config(config, 0.005) writes, in a new temporary folder, the world
 with <max_step_size>0.005</max_step_size> and the config pointing at it (its file paths made
 absolute, since NRPCoreSim resolves them against the config's folder). The world's own
-folder and its models/ stay on the model path through a `models` link beside the copy."""
+folder and its models/ stay on the model path through a `models` link beside the copy.
+
+variant_config(config, camera=(H, W)) also gives every camera sensor of the world and of the
+models in its models/ folder an H x W image and an update_rate of one frame per step of the
+config's smallest EngineTimestep (the models carrying one are copied: their other files
+linked, model.sdf rewritten), and runs the status function `<name>_camera.py` beside the
+config's `<name>.py` (rl_parkring: observe_camera.py, which returns the frame)."""
 import json
 import os
 import re
@@ -12,6 +19,7 @@ import shutil
 import tempfile
 
 _STEP = re.compile(r"<max_step_size>\s*[^<]*\s*</max_step_size>")
+_CAMERA = re.compile(r"<sensor\b[^>]*\btype\s*=\s*['\"]camera['\"][^>]*>.*?</sensor>", re.S)
 
 
 def _absolute_paths(value, folder):
@@ -30,34 +38,119 @@ def _absolute_paths(value, folder):
     return value
 
 
-def variant_config(config, physics_step):
-    """Returns (path of the new config, its temporary folder: remove it after the run)."""
-    step = float(physics_step)
-    if not 0.0 < step <= 0.05:
-        raise ValueError("physics_step must be in (0, 0.05] s, got %r" % (physics_step,))
+def _resized_cameras(sdf, camera, rate):
+    """(the SDF with every camera sensor's image H x W and update_rate `rate`, how many)."""
+    height, width = camera
+
+    def resize(m):
+        s = re.sub(r"<width>\s*\d+\s*</width>", "<width>%d</width>" % width, m.group(0))
+        s = re.sub(r"<height>\s*\d+\s*</height>", "<height>%d</height>" % height, s)
+        if re.search(r"<update_rate>", s):
+            return re.sub(r"<update_rate>[^<]*</update_rate>",
+                          "<update_rate>%r</update_rate>" % rate, s)
+        return s.replace("</sensor>", "<update_rate>%r</update_rate></sensor>" % rate)
+    return _CAMERA.subn(resize, sdf)
+
+
+def _models_with_camera(models, dest, camera, rate):
+    """dest/: a link to each model of the folder `models`, but a copy of those with a camera
+    (their files linked, model.sdf rewritten). Returns how many cameras were resized."""
+    os.mkdir(dest)
+    count = 0
+    for name in sorted(os.listdir(models)):
+        src = os.path.join(models, name)
+        sdf_path = os.path.join(src, "model.sdf")
+        n = 0
+        if os.path.isfile(sdf_path):
+            with open(sdf_path) as f:
+                sdf, n = _resized_cameras(f.read(), camera, rate)
+        if not n:
+            os.symlink(src, os.path.join(dest, name))
+            continue
+        count += n
+        os.mkdir(os.path.join(dest, name))
+        for entry in os.listdir(src):
+            if entry != "model.sdf":
+                os.symlink(os.path.join(src, entry), os.path.join(dest, name, entry))
+        with open(os.path.join(dest, name, "model.sdf"), "w") as f:
+            f.write(sdf)
+    return count
+
+
+def check_camera(camera):
+    try:
+        height, width = (int(v) for v in camera)
+    except (TypeError, ValueError):
+        raise ValueError("camera must be None or (H, W) in pixels, got %r"
+                         % (camera,)) from None
+    if not (1 <= height <= 4096 and 1 <= width <= 4096):
+        raise ValueError("camera must be (H, W) with 1..4096 pixels each, got %r" % (camera,))
+    return height, width
+
+
+def _camera_status(cfg, config):
+    """Points the config's status function at `<name>_camera.py` beside its file."""
+    status = cfg.get("StatusFunction") or {}
+    path = status.get("FileName", "")
+    stem, ext = os.path.splitext(path)
+    camera_file = stem + "_camera" + ext
+    if not path or not os.path.isfile(camera_file):
+        raise ValueError("camera: %s's status function has no camera variant %s (the status "
+                         "function returning the camera frame)" % (config, camera_file or "?"))
+    status["FileName"] = camera_file
+
+
+def _world_copy(world, sub, physics_step, camera, rate):
+    """Writes `world` (with its changes) into the folder `sub`; returns the copy's path."""
+    with open(world) as f:
+        sdf = f.read()
+    if physics_step is not None:
+        if not _STEP.search(sdf):
+            raise ValueError("physics_step: %s has no <max_step_size>" % world)
+        sdf = _STEP.sub("<max_step_size>%r</max_step_size>" % physics_step, sdf)
+    models = os.path.join(os.path.dirname(world), "models")
+    cameras = 0
+    if camera is not None:
+        sdf, cameras = _resized_cameras(sdf, camera, rate)
+        if os.path.isdir(models):
+            cameras += _models_with_camera(models, os.path.join(sub, "models"), camera, rate)
+        if not cameras:
+            raise ValueError("camera: %s and its models/ have no camera sensor" % world)
+    elif os.path.isdir(models):
+        os.symlink(models, os.path.join(sub, "models"))
+    copy = os.path.join(sub, os.path.basename(world))
+    with open(copy, "w") as f:
+        f.write(sdf)
+    return copy
+
+
+def variant_config(config, physics_step=None, camera=None):
+    """Returns (path of the new config, its temporary folder: remove it after the run).
+    physics_step: the worlds' physics step in s (None: unchanged); camera: (H, W) or None."""
+    if physics_step is not None:
+        physics_step = float(physics_step)
+        if not 0.0 < physics_step <= 0.05:
+            raise ValueError("physics_step must be in (0, 0.05] s, got %r" % (physics_step,))
+    if camera is not None:
+        camera = check_camera(camera)
     folder = os.path.dirname(os.path.abspath(config))
     with open(config) as f:
         cfg = _absolute_paths(json.load(f), folder)
-    worlds = [e for e in cfg.get("EngineConfigs", []) if e.get("GazeboWorldFile")]
+    engines = cfg.get("EngineConfigs", [])
+    worlds = [e for e in engines if e.get("GazeboWorldFile")]
     if not worlds:
-        raise ValueError("physics_step: %s has no engine with a GazeboWorldFile" % config)
+        raise ValueError("%s has no engine with a GazeboWorldFile" % config)
+    steps = [float(e["EngineTimestep"]) for e in engines if e.get("EngineTimestep")]
+    rate = 1.0 / min(steps) if steps else 20.0  # one frame per step of the loop
+    if camera is not None:
+        _camera_status(cfg, config)
     tmp = tempfile.mkdtemp(prefix="convoy_gym_")
     try:
         for i, engine in enumerate(worlds):
-            world = engine["GazeboWorldFile"]
-            with open(world) as f:
-                sdf = f.read()
-            if not _STEP.search(sdf):
-                raise ValueError("physics_step: %s has no <max_step_size>" % world)
             sub = os.path.join(tmp, "world%d" % i)
             os.mkdir(sub)
-            models = os.path.join(os.path.dirname(world), "models")
-            if os.path.isdir(models):
-                os.symlink(models, os.path.join(sub, "models"))
-            copy = os.path.join(sub, os.path.basename(world))
-            with open(copy, "w") as f:
-                f.write(_STEP.sub("<max_step_size>%r</max_step_size>" % step, sdf))
-            engine["GazeboWorldFile"] = copy
+            engine["GazeboWorldFile"] = _world_copy(engine["GazeboWorldFile"], sub,
+                                                    physics_step, camera, rate)
         path = os.path.join(tmp, os.path.basename(config))
         with open(path, "w") as f:
             json.dump(cfg, f, indent=2)

@@ -5,6 +5,9 @@ space, termination and truncation, a custom reward, another physics step, and th
 a `with` block and garbage collection leave no process behind. `Vector`: VectorDrivingEnv(2)
 (batch shapes, each sub-environment equal to a DrivingEnv with its seed, autoreset, a bad
 action naming the env, an error in one env closing all, no process left after close()).
+`Camera`: DrivingEnv(camera=(H, W)) (the Dict observation's shapes, dtypes and contains(), a
+new frame every step, rendered at H x W by a camera of that size, the same frames bit for bit
+for the same seed, bad camera arguments).
 
 Run: cd tests/e2e && CONVOY_BIN_DIR=../../build/bin /usr/bin/python3 -m unittest -v test_gym"""
 import gc
@@ -314,3 +317,71 @@ class Vector(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class Camera(unittest.TestCase):
+    """DrivingEnv(camera=(H, W)): a camera 60 x 80 (not square: rows and columns stay apart)."""
+    SIZE = (60, 80)
+
+    @classmethod
+    def setUpClass(cls):
+        cls.env = DrivingEnv(max_steps=200, camera=cls.SIZE)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.env.close()
+
+    def episode(self, seed, steps=25):
+        obs, _ = self.env.reset(seed=seed)
+        frames, states = [obs["camera"]], [obs["state"]]
+        for _ in range(steps):
+            obs, _, _, _, _ = self.env.step(policy(obs["state"]))
+            frames.append(obs["camera"])
+            states.append(obs["state"])
+        return np.array(frames), np.array(states)
+
+    def test_spaces_shapes_and_frames(self):
+        env = self.env
+        space = env.observation_space
+        self.assertEqual(sorted(space.spaces), ["camera", "state"])
+        self.assertEqual(space["state"].shape, (16,))
+        self.assertEqual(space["state"].dtype, np.float32)
+        self.assertEqual(space["camera"].shape, self.SIZE + (3,))
+        self.assertEqual(space["camera"].dtype, np.uint8)
+        self.assertEqual((int(space["camera"].low.min()), int(space["camera"].high.max())),
+                         (0, 255))
+        self.assertTrue(space.contains(space.sample()))
+        frames, states = self.episode(seed=2, steps=10)
+        self.assertEqual(frames.shape, (11,) + self.SIZE + (3,))
+        self.assertEqual(frames.dtype, np.uint8)
+        self.assertEqual(states.dtype, np.float32)
+        obs, *_ = env.step(policy(states[-1]))
+        self.assertTrue(space.contains(obs))
+        self.assertFalse(space.contains({"state": obs["state"], "camera": obs["camera"].T}))
+        # one frame per step: the car moves, every step's frame is a new one
+        for a, b in zip(frames, frames[1:]):
+            self.assertFalse(np.array_equal(a, b))
+        # a picture (road, sky), not a blank: the top rows (sky) are brighter than the middle
+        self.assertGreater(frames[-1].std(), 20)
+        self.assertGreater(frames[-1][:10].mean(), frames[-1][30:40].mean())
+        # rendered at that size: the world copy's camera is 80 x 60, one frame per 0.05 s step
+        with open(os.path.join(env._tmp, "world0", "models", "smart_car", "model.sdf")) as f:
+            sdf = f.read()
+        self.assertIn("<width>80</width>", sdf)
+        self.assertIn("<height>60</height>", sdf)
+        self.assertIn("<update_rate>20.0</update_rate>", sdf)
+
+    def test_same_seed_same_frames(self):
+        frames_a, states_a = self.episode(seed=5)
+        frames_b, _ = self.episode(seed=6)
+        frames_c, states_c = self.episode(seed=5)
+        np.testing.assert_array_equal(frames_a, frames_c)
+        np.testing.assert_array_equal(states_a, states_c)
+        self.assertFalse(np.array_equal(frames_a, frames_b))
+
+    def test_bad_camera_arguments(self):
+        for bad in [(0, 84), (84,), "84x84", (84, 84, 3), (5000, 84)]:
+            with self.assertRaisesRegex(ValueError, "camera"):
+                DrivingEnv(camera=bad)
+        with self.assertRaisesRegex(ValueError, "camera observations are not batched"):
+            VectorDrivingEnv(2, camera=(84, 84))
