@@ -88,7 +88,11 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
         c.link = physics.link_index(link.name);
         cameras_.push_back(std::move(c));
       }
-  if (cameras_.empty()) return;
+  bool lidars = false;  // a LiDAR scans the same scene (systems/lidar_sensors.h)
+  for (const auto& model : desc.models)
+    for (const auto& link : model.links) lidars = lidars || !link.lidars.empty();
+  if (cameras_.empty() && !lidars) return;
+  has_scene_ = true;
   // Gaussian noise comes from a fixed table read at a random offset per frame: as random as
   // a camera needs, deterministic for a seed, and far cheaper than a draw per pixel. The tables
   // take about as long as the renderer and the scene, which touch neither rng_ nor the
@@ -114,7 +118,7 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
   const auto t0 = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point t1, t2;
   try {
-    renderer_ = std::make_unique<render::Renderer>();
+    if (!cameras_.empty()) renderer_ = std::make_unique<render::Renderer>();
     t1 = std::chrono::steady_clock::now();
     build_scene(desc);
     t2 = std::chrono::steady_clock::now();
@@ -281,7 +285,7 @@ std::vector<int> CameraSensors::visual_instances(const std::string& link,
 
 int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls,
                              const std::vector<ModelDesc>& poses) {
-  if (cameras_.empty()) return -1;
+  if (!has_scene_) return -1;
   model_names_.push_back(model.name);
   model_classes_.push_back(cls);
   const auto label = static_cast<uint32_t>(model_names_.size());
@@ -343,11 +347,7 @@ void CameraSensors::update(double t) {
     // 1/30 s timestep) fall a little short of the camera's period in doubles.
     if (cam.rendered && t + 0.5 * physics_.step_size() < cam.next_update) continue;
     if (!poses_fresh) {
-      for (const auto& tr : tracked_) {
-        render::Pose link = to_pose(physics_.link_pose(tr.link));
-        for (size_t k = 0; k < tr.instances.size(); ++k)
-          scene_.set_pose(tr.instances[k], render::compose(link, tr.offsets[k]));
-      }
+      refresh_poses();
       poses_fresh = true;
     }
     render(cam);
@@ -355,6 +355,14 @@ void CameraSensors::update(double t) {
     double period = d.update_rate > 0 ? 1.0 / d.update_rate : 0;
     cam.next_update = period > 0 ? std::max(cam.next_update + period, t) : t;
     if (period > 0 && cam.next_update <= t) cam.next_update = t + period;
+  }
+}
+
+void CameraSensors::refresh_poses() {
+  for (const auto& tr : tracked_) {
+    render::Pose link = to_pose(physics_.link_pose(tr.link));
+    for (size_t k = 0; k < tr.instances.size(); ++k)
+      scene_.set_pose(tr.instances[k], render::compose(link, tr.offsets[k]));
   }
 }
 

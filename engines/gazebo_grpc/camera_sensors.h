@@ -66,6 +66,16 @@ class CameraSensors {
   // look at the same world (src/lidar).
   const render::Scene& scene() const { return scene_; }
   render::Scene& scene() { return scene_; }  // (benchmarks hide or move parts of it)
+  // Whether the scene was built: the world has a camera or a LiDAR.
+  bool has_scene() const { return has_scene_; }
+  // The world models' scene instances to their links' current poses (the cameras do it before
+  // they render; other sensors call it before they look).
+  void refresh_poses();
+  // Ground truth of a scene instance's model_id (1-based: the world's models, then actors).
+  const std::string& model_name(uint32_t id) const { return model_names_.at(id - 1); }
+  const std::string& model_class(uint32_t id) const { return model_classes_.at(id - 1); }
+  // The weather set last (null until set_weather).
+  const Weather* weather() const { return has_weather_ ? &weather_ : nullptr; }
 
   // The weather from now on (see weather_effects.h): the sun, the sky, fog, wet or snowy
   // ground, rain or snow over the image, and at night the vehicles' headlights and the street
@@ -179,6 +189,7 @@ class CameraSensors {
   render::Rgba base_ambient_{}, base_background_{};
   std::vector<Vehicle> vehicles_;
   bool has_weather_ = false;
+  bool has_scene_ = false;
   Weather weather_;  // simulated time of the last update()
 };
 

@@ -16,6 +16,7 @@
 //   link_states          systems/link_states.h          <link plugin>::<link>, <model>::<link>
 //   actors               systems/road_user_actors.h     RoadUser(s) datapacks, any name
 //   cameras              systems/camera_datapacks.h     <camera plugin>::<sensor>[::depth|...]
+//   lidars               systems/lidar_sensors.h        <model>::<link>::<sensor> (PointCloud)
 //   ego_state            systems/ego_state.h            <model>::road_user
 //   contacts             systems/contacts.h             collisions
 #include <chrono>
@@ -30,6 +31,7 @@
 #include "systems/ego_state.h"
 #include "systems/initial_speeds.h"
 #include "systems/joint_controllers.h"
+#include "systems/lidar_sensors.h"
 #include "systems/link_states.h"
 #include "systems/road_user_actors.h"
 #include "systems/traffic_light_state.h"
@@ -76,6 +78,7 @@ class GazeboEngine final : public Engine {
     world_->add<world::LinkStates>();
     world_->add<world::RoadUserActors>();
     world_->add<world::CameraDatapacks>();
+    world_->add<world::LidarSensors>();
     world_->add<world::EgoState>();
     world_->add<world::Contacts>();
     std::vector<engine::DataPackId> ids;

@@ -11,79 +11,18 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "world_cache_io.h"
+
 namespace convoy::world {
 
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '7'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '8'};  // bump on format change
 
-// --- Binary writer and reader -------------------------------------------------------------
-
-class Writer {
- public:
-  template <typename T>
-  void pod(const T& v) {
-    // Plain values and fixed-size Eigen matrices (a plain array of doubles).
-    out_.append(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  void str(const std::string& s) {
-    pod<uint64_t>(s.size());
-    out_ += s;
-  }
-  void path(const fs::path& p) { str(p.string()); }
-  void iso(const Eigen::Isometry3d& t) { pod(t.matrix()); }
-  void v3(const Eigen::Vector3d& v) { pod(v); }
-  void rgba(const Rgba& c) { pod(c); }
-  void size(size_t n) { pod<uint64_t>(n); }
-  std::string& bytes() { return out_; }
-
- private:
-  std::string out_;
-};
-
-class Reader {
- public:
-  explicit Reader(const std::string& in) : in_(in) {}
-  template <typename T>
-  T pod() {
-    // Plain values and fixed-size Eigen matrices (a plain array of doubles).
-    need(sizeof(T));
-    T v;
-    std::memcpy(&v, in_.data() + at_, sizeof v);
-    at_ += sizeof v;
-    return v;
-  }
-  std::string str() {
-    auto n = pod<uint64_t>();
-    need(n);
-    std::string s = in_.substr(at_, n);
-    at_ += n;
-    return s;
-  }
-  fs::path path() { return str(); }
-  Eigen::Isometry3d iso() {
-    Eigen::Isometry3d t;
-    t.matrix() = pod<Eigen::Matrix4d>();
-    return t;
-  }
-  Eigen::Vector3d v3() { return pod<Eigen::Vector3d>(); }
-  Rgba rgba() { return pod<Rgba>(); }
-  size_t size() {
-    auto n = pod<uint64_t>();
-    if (n > in_.size()) throw std::runtime_error("corrupt count");
-    return n;
-  }
-  bool done() const { return at_ == in_.size(); }
-
- private:
-  void need(size_t n) const {
-    if (n > in_.size() - at_) throw std::runtime_error("truncated");
-  }
-  const std::string& in_;
-  size_t at_ = 0;
-};
+using cache_io::Reader;
+using cache_io::Writer;
 
 void put(Writer& w, const Shape& s) {
   w.pod<int32_t>(s.kind);
@@ -157,6 +96,20 @@ void put(Writer& w, const LinkDesc& l) {
       w.pod(d);
     w.pod<uint8_t>(c.noise);
   }
+  w.size(l.lidars.size());
+  for (const auto& d : l.lidars) {
+    for (const auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name}) w.str(*s);
+    w.iso(d.pose);
+    const lidar::LidarModel& m = d.lidar;
+    for (const auto* a : {&m.horizontal, &m.vertical}) {
+      w.pod<int32_t>(a->samples);
+      for (double v : {a->resolution, a->min_angle, a->max_angle}) w.pod(v);
+    }
+    for (double v : {m.range_min, m.range_max, m.range_resolution, m.noise_mean, m.noise_stddev,
+                     m.update_rate})
+      w.pod(v);
+    w.pod<uint8_t>(m.gaussian_noise);
+  }
 }
 void get(Reader& r, LinkDesc& l) {
   l.name = r.str();
@@ -194,6 +147,20 @@ void get(Reader& r, LinkDesc& l) {
          {&c.hfov, &c.near_clip, &c.far_clip, &c.update_rate, &c.noise_mean, &c.noise_stddev})
       *d = r.pod<double>();
     c.noise = r.pod<uint8_t>() != 0;
+  }
+  l.lidars.resize(r.size());
+  for (auto& d : l.lidars) {
+    for (auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name}) *s = r.str();
+    d.pose = r.iso();
+    lidar::LidarModel& m = d.lidar;
+    for (auto* a : {&m.horizontal, &m.vertical}) {
+      a->samples = r.pod<int32_t>();
+      for (double* v : {&a->resolution, &a->min_angle, &a->max_angle}) *v = r.pod<double>();
+    }
+    for (double* v : {&m.range_min, &m.range_max, &m.range_resolution, &m.noise_mean,
+                      &m.noise_stddev, &m.update_rate})
+      *v = r.pod<double>();
+    m.gaussian_noise = r.pod<uint8_t>() != 0;
   }
 }
 

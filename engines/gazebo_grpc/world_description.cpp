@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "lidar_desc.h"
 #include "world_plugins.h"
 
 namespace convoy::world {
@@ -231,6 +232,8 @@ class Loader {
       ld.visuals.push_back(visual(l->VisualByIndex(v), where));
     for (uint64_t s = 0; s < l->SensorCount(); ++s) {
       const sdf::Sensor* sensor = l->SensorByIndex(s);
+      if (is_lidar_sensor(sensor))
+        ld.lidars.push_back(lidar_desc(sensor, model_name, l->Name(), file_));
       if (sensor->Type() != sdf::SensorType::CAMERA) continue;
       ld.cameras.push_back(camera(sensor, ld.name));
     }

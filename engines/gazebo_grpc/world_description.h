@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "lidar/lidar_model.h"
+
 namespace convoy::world {
 
 using Rgba = std::array<float, 4>;
@@ -59,6 +61,17 @@ struct CameraDesc {
   double noise_mean = 0, noise_stddev = 0;
 };
 
+// A LiDAR: <sensor type="lidar|gpu_lidar|ray|gpu_ray"> (lidar_desc.h reads it).
+struct LidarDesc {
+  std::string name;                                        // sensor name
+  std::string model;                                       // the model's (scoped) name
+  std::string link;                                        // the link's name (unscoped)
+  std::string plugin_name;                                 // its <plugin name> ("" if none)
+  std::string scoped_name;                                 // model::link::sensor
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
+  lidar::LidarModel lidar;
+};
+
 struct LinkDesc {
   std::string name;                                        // model::link
   std::string short_name;                                  // link
@@ -70,6 +83,7 @@ struct LinkDesc {
   std::vector<CollisionDesc> collisions;
   std::vector<VisualDesc> visuals;
   std::vector<CameraDesc> cameras;
+  std::vector<LidarDesc> lidars;
 };
 
 struct AxisDesc {

@@ -1,5 +1,6 @@
 // The protobuf datapack types every Convoy program knows. One line per type.
 #include "convoy/datapacks.pb.h"
+#include "convoy/point_cloud.pb.h"
 #include "convoy/road_users.pb.h"
 #include "datapack/nrp.h"
 #include "datapack/registry.h"
@@ -14,6 +15,7 @@ void register_standard_types(Registry& r) {
   // Road users (proto/convoy/road_users.proto, docs/road_users.md).
   r.add<data::RoadUser>("RoadUserDataPack");
   r.add<data::RoadUsers>("RoadUsersDataPack");
+  r.add<data::PointCloud>("PointCloudDataPack");  // LiDAR (proto/convoy/point_cloud.proto)
   // NRP-Core's message set (datapack/nrp.h): Dump, EngineTest, Gazebo, NrpGenericProto,
   // Wrappers. Gazebo.Camera / Joint / Link travel as the three above, whose Python classes
   // keep the names GazeboCameraDataPack... (Registry::add: a named class wins).

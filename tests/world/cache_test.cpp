@@ -89,6 +89,55 @@ TEST_F(CacheTest, TheScenesShadowsSettingIsKept) {
   EXPECT_FLOAT_EQ(hit.background[2], 0.3f);
 }
 
+TEST_F(CacheTest, LidarsAreKept) {
+  write(world_,
+        "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
+        "<model name='car'><link name='roof'><inertial><mass>1</mass></inertial>"
+        "<sensor name='scanner' type='gpu_lidar'><pose>0.1 0 0.3 0 0 0</pose>"
+        "<update_rate>10</update_rate><lidar><scan><horizontal><samples>64</samples>"
+        "<min_angle>-1</min_angle><max_angle>1</max_angle></horizontal><vertical>"
+        "<samples>4</samples><min_angle>-0.2</min_angle><max_angle>0.1</max_angle></vertical>"
+        "</scan><range><min>0.5</min><max>60</max></range><noise><type>gaussian</type>"
+        "<stddev>0.02</stddev></noise></lidar></sensor></link></model></world></sdf>");
+  CacheResult r;
+  const std::string parsed = serialize_world(load_world_cached(world_, {}, &r));
+  EXPECT_EQ(r, CacheResult::kMiss);
+  WorldDesc hit = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kHit);
+  EXPECT_EQ(serialize_world(hit), parsed);
+  ASSERT_EQ(hit.models[0].links[0].lidars.size(), 1u);
+  const LidarDesc& d = hit.models[0].links[0].lidars[0];
+  EXPECT_EQ(d.scoped_name, "car::roof::scanner");
+  EXPECT_EQ(d.model, "car");
+  EXPECT_EQ(d.link, "roof");
+  EXPECT_NEAR(d.pose.translation().z(), 0.3, 1e-12);
+  EXPECT_EQ(d.lidar.horizontal.samples, 64);
+  EXPECT_EQ(d.lidar.vertical.samples, 4);
+  EXPECT_DOUBLE_EQ(d.lidar.vertical.min_angle, -0.2);
+  EXPECT_DOUBLE_EQ(d.lidar.range_max, 60);
+  EXPECT_DOUBLE_EQ(d.lidar.update_rate, 10);
+  EXPECT_TRUE(d.lidar.gaussian_noise);
+  EXPECT_DOUBLE_EQ(d.lidar.noise_stddev, 0.02);
+}
+
+TEST_F(CacheTest, ABadLidarNamesModelLinkAndSensor) {
+  write(world_,
+        "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
+        "<model name='car'><link name='roof'><inertial><mass>1</mass></inertial>"
+        "<sensor name='scanner' type='ray'><ray><scan><horizontal><samples>0</samples>"
+        "</horizontal></scan><range><min>0.5</min><max>60</max></range></ray></sensor>"
+        "</link></model></world></sdf>");
+  try {
+    load_world_cached(world_);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "model 'car' link 'roof' sensor 'scanner': <lidar><scan><horizontal><samples>"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST_F(CacheTest, AChangedIncludedFileIsRebuilt) {
   CacheResult r;
   load_world_cached(world_, {}, &r);

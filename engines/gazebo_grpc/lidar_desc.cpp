@@ -1,0 +1,55 @@
+#include "lidar_desc.h"
+
+#include <sdf/Element.hh>
+#include <stdexcept>
+
+namespace convoy::world {
+
+namespace {
+
+std::string sensor_type(const sdf::Sensor* sensor) {
+  const sdf::ElementPtr e = sensor->Element();
+  return e && e->HasAttribute("type") ? e->GetAttribute("type")->GetAsString() : "";
+}
+
+Eigen::Isometry3d to_eigen(const ignition::math::Pose3d& p) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(p.Pos().X(), p.Pos().Y(), p.Pos().Z());
+  t.linear() = Eigen::Quaterniond(p.Rot().W(), p.Rot().X(), p.Rot().Y(), p.Rot().Z())
+                   .normalized()
+                   .toRotationMatrix();
+  return t;
+}
+
+}  // namespace
+
+bool is_lidar_sensor(const sdf::Sensor* sensor) {
+  return sensor && lidar::is_lidar_type(sensor_type(sensor));
+}
+
+LidarDesc lidar_desc(const sdf::Sensor* sensor, const std::string& model, const std::string& link,
+                     const std::filesystem::path& file) {
+  LidarDesc d;
+  d.name = sensor->Name();
+  d.model = model;
+  d.link = link;
+  d.scoped_name = model + "::" + link + "::" + sensor->Name();
+  const std::string where =
+      file.string() + ": model '" + model + "' link '" + link + "' sensor '" + d.name + "': ";
+  try {
+    d.lidar = lidar::parse_lidar(sensor->Element());
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + e.what());
+  }
+  ignition::math::Pose3d pose;
+  if (!sensor->SemanticPose().Resolve(pose).empty())
+    throw std::runtime_error(where + "its pose cannot be resolved");
+  d.pose = to_eigen(pose);
+  if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
+    auto p = e->GetElement("plugin");
+    if (p->HasAttribute("name")) d.plugin_name = p->GetAttribute("name")->GetAsString();
+  }
+  return d;
+}
+
+}  // namespace convoy::world
