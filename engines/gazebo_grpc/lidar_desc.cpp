@@ -3,6 +3,8 @@
 #include <sdf/Element.hh>
 #include <stdexcept>
 
+#include "sdf_eigen.h"
+
 namespace convoy::world {
 
 namespace {
@@ -10,15 +12,6 @@ namespace {
 std::string sensor_type(const sdf::Sensor* sensor) {
   const sdf::ElementPtr e = sensor->Element();
   return e && e->HasAttribute("type") ? e->GetAttribute("type")->GetAsString() : "";
-}
-
-Eigen::Isometry3d to_eigen(const ignition::math::Pose3d& p) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(p.Pos().X(), p.Pos().Y(), p.Pos().Z());
-  t.linear() = Eigen::Quaterniond(p.Rot().W(), p.Rot().X(), p.Rot().Y(), p.Rot().Z())
-                   .normalized()
-                   .toRotationMatrix();
-  return t;
 }
 
 }  // namespace

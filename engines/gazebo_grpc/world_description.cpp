@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "lidar_desc.h"
+#include "sdf_eigen.h"
 #include "world_plugins.h"
 
 namespace convoy::world {
@@ -16,17 +17,6 @@ namespace convoy::world {
 namespace fs = std::filesystem;
 
 namespace {
-
-Eigen::Isometry3d to_eigen(const ignition::math::Pose3d& p) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(p.Pos().X(), p.Pos().Y(), p.Pos().Z());
-  t.linear() = Eigen::Quaterniond(p.Rot().W(), p.Rot().X(), p.Rot().Y(), p.Rot().Z())
-                   .normalized()
-                   .toRotationMatrix();
-  return t;
-}
-
-Eigen::Vector3d to_eigen(const ignition::math::Vector3d& v) { return {v.X(), v.Y(), v.Z()}; }
 
 Rgba to_rgba(const ignition::math::Color& c) { return {c.R(), c.G(), c.B(), c.A()}; }
 
