@@ -17,6 +17,7 @@
 //   actors               systems/road_user_actors.h     RoadUser(s) datapacks, any name
 //   cameras              systems/camera_datapacks.h     <camera plugin>::<sensor>[::depth|...]
 //   lidars               systems/lidar_sensors.h        <model>::<link>::<sensor> (PointCloud)
+//   nav_sensors          systems/nav_sensors.h          <model>::<link>::<sensor> (Imu, NavSat)
 //   ego_state            systems/ego_state.h            <model>::road_user
 //   contacts             systems/contacts.h             collisions
 #include <chrono>
@@ -33,6 +34,7 @@
 #include "systems/joint_controllers.h"
 #include "systems/lidar_sensors.h"
 #include "systems/link_states.h"
+#include "systems/nav_sensors.h"
 #include "systems/road_user_actors.h"
 #include "systems/traffic_light_state.h"
 #include "systems/weather_input.h"
@@ -79,6 +81,7 @@ class GazeboEngine final : public Engine {
     world_->add<world::RoadUserActors>();
     world_->add<world::CameraDatapacks>();
     world_->add<world::LidarSensors>();
+    world_->add<world::NavSensors>();
     world_->add<world::EgoState>();
     world_->add<world::Contacts>();
     std::vector<engine::DataPackId> ids;

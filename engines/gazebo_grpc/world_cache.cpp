@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "world_cache_io.h"
+#include "world_cache_sensors.h"
 
 namespace convoy::world {
 
@@ -19,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '8'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '9'};  // bump on format change
 
 using cache_io::Reader;
 using cache_io::Writer;
@@ -96,20 +97,7 @@ void put(Writer& w, const LinkDesc& l) {
       w.pod(d);
     w.pod<uint8_t>(c.noise);
   }
-  w.size(l.lidars.size());
-  for (const auto& d : l.lidars) {
-    for (const auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name}) w.str(*s);
-    w.iso(d.pose);
-    const lidar::LidarModel& m = d.lidar;
-    for (const auto* a : {&m.horizontal, &m.vertical}) {
-      w.pod<int32_t>(a->samples);
-      for (double v : {a->resolution, a->min_angle, a->max_angle}) w.pod(v);
-    }
-    for (double v : {m.range_min, m.range_max, m.range_resolution, m.noise_mean, m.noise_stddev,
-                     m.update_rate})
-      w.pod(v);
-    w.pod<uint8_t>(m.gaussian_noise);
-  }
+  put_sensors(w, l);
 }
 void get(Reader& r, LinkDesc& l) {
   l.name = r.str();
@@ -148,20 +136,7 @@ void get(Reader& r, LinkDesc& l) {
       *d = r.pod<double>();
     c.noise = r.pod<uint8_t>() != 0;
   }
-  l.lidars.resize(r.size());
-  for (auto& d : l.lidars) {
-    for (auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name}) *s = r.str();
-    d.pose = r.iso();
-    lidar::LidarModel& m = d.lidar;
-    for (auto* a : {&m.horizontal, &m.vertical}) {
-      a->samples = r.pod<int32_t>();
-      for (double* v : {&a->resolution, &a->min_angle, &a->max_angle}) *v = r.pod<double>();
-    }
-    for (double* v : {&m.range_min, &m.range_max, &m.range_resolution, &m.noise_mean,
-                      &m.noise_stddev, &m.update_rate})
-      *v = r.pod<double>();
-    m.gaussian_noise = r.pod<uint8_t>() != 0;
-  }
+  get_sensors(r, l);
 }
 
 void put(Writer& w, const ModelDesc& m) {
@@ -369,6 +344,8 @@ std::string serialize_world(const WorldDesc& d) {
   w.str(d.name);
   w.v3(d.gravity);
   w.pod(d.max_step_size);
+  for (double v : {d.geo.latitude_deg, d.geo.longitude_deg, d.geo.elevation_m, d.geo.heading_deg})
+    w.pod(v);
   w.rgba(d.ambient);
   w.rgba(d.background);
   w.pod<uint8_t>(d.shadows);
@@ -398,6 +375,9 @@ WorldDesc deserialize_world(const std::string& bytes) {
   d.name = r.str();
   d.gravity = r.v3();
   d.max_step_size = r.pod<double>();
+  for (double* v :
+       {&d.geo.latitude_deg, &d.geo.longitude_deg, &d.geo.elevation_m, &d.geo.heading_deg})
+    *v = r.pod<double>();
   d.ambient = r.rgba();
   d.background = r.rgba();
   d.shadows = r.pod<uint8_t>() != 0;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "lidar_desc.h"
+#include "nav_desc.h"
 #include "sdf_eigen.h"
 #include "world_plugins.h"
 
@@ -224,6 +225,8 @@ class Loader {
       const sdf::Sensor* sensor = l->SensorByIndex(s);
       if (is_lidar_sensor(sensor))
         ld.lidars.push_back(lidar_desc(sensor, model_name, l->Name(), file_));
+      if (is_nav_sensor(sensor))
+        ld.nav_sensors.push_back(nav_desc(sensor, model_name, l->Name(), file_));
       if (sensor->Type() != sdf::SensorType::CAMERA) continue;
       ld.cameras.push_back(camera(sensor, ld.name));
     }
@@ -450,6 +453,7 @@ WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& ex
   world.file = file;
   world.name = w->Name();
   world.gravity = to_eigen(w->Gravity());
+  world.geo = geo_origin(w, file);
   if (w->PhysicsCount() > 0) world.max_step_size = w->PhysicsByIndex(0)->MaxStepSize();
   if (const sdf::Scene* scene = w->Scene()) {
     world.ambient = to_rgba(scene->Ambient());

@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "lidar/lidar_model.h"
+#include "nav_sensors/geodetic.h"
+#include "nav_sensors/imu_model.h"
+#include "nav_sensors/navsat_model.h"
 
 namespace convoy::world {
 
@@ -72,6 +75,15 @@ struct LidarDesc {
   lidar::LidarModel lidar;
 };
 
+// An IMU or a GNSS receiver: <sensor type="imu|navsat"> (nav_desc.h reads it).
+struct NavSensorDesc {
+  enum Kind : uint8_t { kImu, kNavSat } kind = kImu;
+  std::string name, model, link, plugin_name, scoped_name;  // as LidarDesc's
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();   // in the link frame
+  nav_sensors::ImuParams imu;                               // kImu
+  nav_sensors::NavSatParams navsat;                         // kNavSat
+};
+
 struct LinkDesc {
   std::string name;                                        // model::link
   std::string short_name;                                  // link
@@ -84,6 +96,7 @@ struct LinkDesc {
   std::vector<VisualDesc> visuals;
   std::vector<CameraDesc> cameras;
   std::vector<LidarDesc> lidars;
+  std::vector<NavSensorDesc> nav_sensors;
 };
 
 struct AxisDesc {
@@ -174,6 +187,7 @@ struct WorldDesc {
   Rgba ambient{0.4f, 0.4f, 0.4f, 1}, background{0.7f, 0.7f, 0.7f, 1};
   bool shadows = true;  // <scene><shadows>
   bool world_plugin = false;
+  nav_sensors::GeoOrigin geo;  // <spherical_coordinates>
   std::vector<ModelDesc> models;
   std::vector<LightDesc> lights;
 };

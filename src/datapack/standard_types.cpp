@@ -1,5 +1,6 @@
 // The protobuf datapack types every Convoy program knows. One line per type.
 #include "convoy/datapacks.pb.h"
+#include "convoy/nav_sensors.pb.h"
 #include "convoy/point_cloud.pb.h"
 #include "convoy/road_users.pb.h"
 #include "datapack/nrp.h"
@@ -16,6 +17,8 @@ void register_standard_types(Registry& r) {
   r.add<data::RoadUser>("RoadUserDataPack");
   r.add<data::RoadUsers>("RoadUsersDataPack");
   r.add<data::PointCloud>("PointCloudDataPack");  // LiDAR (proto/convoy/point_cloud.proto)
+  r.add<data::Imu>("ImuDataPack");                // proto/convoy/nav_sensors.proto
+  r.add<data::NavSat>("NavSatDataPack");
   // NRP-Core's message set (datapack/nrp.h): Dump, EngineTest, Gazebo, NrpGenericProto,
   // Wrappers. Gazebo.Camera / Joint / Link travel as the three above, whose Python classes
   // keep the names GazeboCameraDataPack... (Registry::add: a named class wins).

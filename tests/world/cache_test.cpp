@@ -120,6 +120,41 @@ TEST_F(CacheTest, LidarsAreKept) {
   EXPECT_DOUBLE_EQ(d.lidar.noise_stddev, 0.02);
 }
 
+TEST_F(CacheTest, ImusGnssAndTheEarthFrameAreKept) {
+  write(world_,
+        "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
+        "<spherical_coordinates><surface_model>EARTH_WGS84</surface_model>"
+        "<latitude_deg>48.2</latitude_deg><longitude_deg>16.37</longitude_deg>"
+        "<elevation>171</elevation><heading_deg>10</heading_deg></spherical_coordinates>"
+        "<model name='car'><link name='roof'><inertial><mass>1</mass></inertial>"
+        "<sensor name='imu' type='imu'><pose>0 0.2 0 0 0 0</pose><update_rate>50</update_rate>"
+        "<imu><angular_velocity><z><noise type='gaussian'><stddev>0.01</stddev>"
+        "<dynamic_bias_stddev>0.002</dynamic_bias_stddev>"
+        "<dynamic_bias_correlation_time>400</dynamic_bias_correlation_time></noise></z>"
+        "</angular_velocity></imu></sensor>"
+        "<sensor name='gnss' type='navsat'><navsat><position_sensing><horizontal>"
+        "<noise type='gaussian'><stddev>1.5</stddev></noise></horizontal></position_sensing>"
+        "</navsat></sensor></link></model></world></sdf>");
+  CacheResult r;
+  const std::string parsed = serialize_world(load_world_cached(world_, {}, &r));
+  EXPECT_EQ(r, CacheResult::kMiss);
+  WorldDesc hit = load_world_cached(world_, {}, &r);
+  EXPECT_EQ(r, CacheResult::kHit);
+  EXPECT_EQ(serialize_world(hit), parsed);
+  EXPECT_DOUBLE_EQ(hit.geo.latitude_deg, 48.2);
+  EXPECT_DOUBLE_EQ(hit.geo.heading_deg, 10);
+  const auto& sensors = hit.models[0].links[0].nav_sensors;
+  ASSERT_EQ(sensors.size(), 2u);
+  EXPECT_EQ(sensors[0].kind, NavSensorDesc::kImu);
+  EXPECT_EQ(sensors[0].scoped_name, "car::roof::imu");
+  EXPECT_NEAR(sensors[0].pose.translation().y(), 0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(sensors[0].imu.update_rate, 50);
+  EXPECT_DOUBLE_EQ(sensors[0].imu.angular_velocity[2].stddev, 0.01);
+  EXPECT_DOUBLE_EQ(sensors[0].imu.angular_velocity[2].dynamic_bias_correlation_time, 400);
+  EXPECT_EQ(sensors[1].kind, NavSensorDesc::kNavSat);
+  EXPECT_DOUBLE_EQ(sensors[1].navsat.position_horizontal.stddev, 1.5);
+}
+
 TEST_F(CacheTest, ABadLidarNamesModelLinkAndSensor) {
   write(world_,
         "<?xml version='1.0'?><sdf version='1.7'><world name='w'>"
