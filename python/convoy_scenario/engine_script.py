@@ -429,6 +429,13 @@ class Script(EngineScript):
                                            ending=self.ending, reason=self.reason, transitions=[],
                                            running=[]))
 
+    def reset(self):
+        """NRP-Core's reset (convoy_gym's scenario episodes): the storyboard, the player and
+        every state again from the start, as after initialize()."""
+        self.shutdown()
+        self._datapacks = {}
+        self.initialize()
+
     def shutdown(self):
         if getattr(self, "odr", None) is not None:
             self.odr.close()
