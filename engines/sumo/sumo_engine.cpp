@@ -166,6 +166,7 @@ std::vector<engine::DataPackId> SumoEngine::initialize(const std::string& name, 
   for (auto& o : strings(config, "SumoOptions")) args_.push_back(o);
 
   vehicles_dp_ = config.at("VehiclesDataPack").get<std::string>();
+  persons_dp_ = config.at("PersonsDataPack").get<std::string>();
   lights_dp_ = config.at("TrafficLightsDataPack").get<std::string>();
   ext_users_dp_ = config.at("ExternalRoadUsersDataPack").get<std::string>();
   ext_lights_dp_ = config.at("ExternalTrafficLightsDataPack").get<std::string>();
@@ -174,11 +175,13 @@ std::vector<engine::DataPackId> SumoEngine::initialize(const std::string& name, 
 
   load();
 
-  std::vector<engine::DataPackId> ids(2);
+  std::vector<engine::DataPackId> ids(3);
   ids[0].set_name(vehicles_dp_);
   ids[0].set_type(std::string(datapack::type_name<data::RoadUsers>()));
   ids[1].set_name(lights_dp_);
   ids[1].set_type(std::string(datapack::kJsonType));
+  ids[2].set_name(persons_dp_);
+  ids[2].set_type(std::string(datapack::type_name<data::RoadUsers>()));
   for (auto& id : ids) id.set_engine_name(name);
   return ids;
 }
@@ -219,7 +222,9 @@ void SumoEngine::load() {
     }
     tls_links_[tls] = std::move(links);
   }
+  persons_ = PersonReader(name_ + "/", offset_);
   read_vehicles();
+  persons_.read(time_ns_, 0, persons_data_);
   read_traffic_lights();
 }
 
@@ -414,6 +419,7 @@ int64_t SumoEngine::step(int64_t duration_ns) {
     if (id.rfind(kExternalPrefix, 0) == 0) in_sumo_.erase(id.substr(std::strlen(kExternalPrefix)));
   }
   read_vehicles();
+  persons_.read(time_ns_, timestep_ns_ * 1e-9, persons_data_);
   read_traffic_lights();
   const auto t2 = std::chrono::steady_clock::now();
   sumo_s_ += std::chrono::duration<double>(t1 - t0).count();
@@ -482,6 +488,10 @@ void SumoEngine::set_datapack(const datapack::View& dp) {
 
 void SumoEngine::get_datapack(const engine::DataPackId& id, datapack::Builder& out) {
   if (!loaded_) return;
+  if (id.name() == persons_dp_) {
+    datapack::write_proto(out, persons_data_);
+    return;
+  }
   if (id.name() == vehicles_dp_) {
     const auto t0 = std::chrono::steady_clock::now();
     datapack::write_proto(out, vehicles_);
@@ -494,6 +504,7 @@ void SumoEngine::get_datapack(const engine::DataPackId& id, datapack::Builder& o
 void SumoEngine::reset() {
   shutdown();
   tracked_.clear();
+  persons_.reset();
   in_sumo_.clear();
   pending_users_.clear();
   pending_lights_.clear();

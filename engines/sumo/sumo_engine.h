@@ -11,6 +11,7 @@
 //   Seed                 SUMO's random seed (default 42): the same seed gives the same run
 //   SumoOptions          extra SUMO command-line options, e.g. ["--lateral-resolution", "0.8"]
 //   VehiclesDataPack     name of the RoadUsers datapack written (default "vehicles")
+//   PersonsDataPack      name of the RoadUsers datapack of SUMO's persons ("persons")
 //   TrafficLightsDataPack name of the traffic-light JSON datapack written ("traffic_lights")
 //   TrafficLightsLeader  "sumo" (SUMO runs its programs) | "external" (a datapack sets them)
 //   ExternalRoadUsersDataPack  name of the datapack of road users put into SUMO
@@ -26,6 +27,8 @@
 //                        RoadUser "<engine>/<sumo id>" in the map's frame; a vehicle that left
 //                        appears once with `absent`, then no more. External road users are
 //                        not in it (they publish themselves).
+//   <PersonsDataPack>    convoy.data.RoadUsers: every walking SUMO person, as a pedestrian
+//                        "<engine>/<person id>" (sumo_persons.h).
 //   <TrafficLightsDataPack> JSON {time_ns, leader, lights: {<tls id>: {state, phase, program,
 //                        links: [{index, from, to, via}]}}} (docs/architecture.md).
 // Datapacks read:
@@ -47,6 +50,7 @@
 #include "convoy/road_users.pb.h"
 #include "engine/engine.h"
 #include "sumo_net.h"
+#include "sumo_persons.h"
 
 namespace convoy::engines::sumo {
 
@@ -89,11 +93,13 @@ class SumoEngine final : public Engine {
   bool loaded_ = false;
   bool lights_external_ = false;
   double match_distance_ = 5.0;
-  std::string vehicles_dp_, lights_dp_, ext_users_dp_, ext_lights_dp_;
+  std::string vehicles_dp_, persons_dp_, lights_dp_, ext_users_dp_, ext_lights_dp_;
 
   std::unordered_map<std::string, TypeInfo> types_;
   std::map<std::string, Tracked> tracked_;  // SUMO's own vehicles seen so far
   data::RoadUsers vehicles_;
+  PersonReader persons_;  // SUMO's persons as pedestrians (sumo_persons.h)
+  data::RoadUsers persons_data_;
   nlohmann::json lights_;
   std::map<std::string, nlohmann::json> tls_links_;  // per TLS, its controlled links
 

@@ -288,6 +288,69 @@ class TrafficLights(SumoCase):
         self.assertNoEngineLeft()
 
 
+PERSONS_TF = """\
+import json
+from nrp_core import *
+
+_out = open({out!r}, "a")
+
+
+@EngineDataPack(keyword="p", id=DataPackIdentifier("persons", "sumo"))
+@TransceiverFunction("sumo")
+def record(p):
+    if not p.isEmpty():
+        _out.write(json.dumps({{"t": p.data.time_ns, "users": [
+            dict(id=u.id, category=u.category, model=u.model, absent=u.absent, x=u.x, y=u.y,
+                 yaw=u.yaw, speed=u.speed, length=u.length, width=u.width)
+            for u in p.data.users]}}) + "\\n")
+        _out.flush()
+    return []
+"""
+
+
+class Persons(SumoCase):
+    """SUMO's persons as pedestrians (PersonsDataPack, sumo_persons.h): a person walks two
+    edges of a grid with sidewalks and leaves."""
+
+    def test_a_walker_is_a_pedestrian_that_moves_then_leaves_once(self):
+        net = os.path.join(self.dir, "grid.net.xml")
+        subprocess.run(["netgenerate", "--grid", "--grid.number=2", "--grid.length=40",
+                        "--sidewalks.guess", "-o", net], check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        edges = [e.get("id") for e in ET.parse(net).getroot().iter("edge")
+                 if e.get("function") != "internal"]
+        self.assertIn("A0A1", edges)
+        self.write("walk.rou.xml", '<routes><vType id="walker" vClass="pedestrian" '
+                   'width="0.5" length="0.3"/><person id="p0" type="walker" depart="0">'
+                   '<walk edges="A0A1" speed="1.2"/></person></routes>')
+        out = os.path.join(self.dir, "persons.jsonl")
+        self.write("tf.py", PERSONS_TF.format(out=out))
+        self.write_config({"SimulationName": "persons", "SimulationTimeout": 45.0,
+                           "EngineConfigs": [{"EngineType": "sumo", "EngineName": "sumo",
+                                              "EngineTimestep": 0.5, "NetFile": "grid.net.xml",
+                                              "RouteFiles": ["walk.rou.xml"]}],
+                           "DataPackProcessingFunctions": [{"Name": "record",
+                                                            "FileName": "tf.py"}]})
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        rows = self.stream(out)
+        seen = [u for row in rows for u in row["users"] if not u["absent"]]
+        self.assertGreater(len(seen), 20)
+        first = seen[0]
+        self.assertEqual((first["id"], first["category"], first["model"]),
+                         ("sumo/p0", "pedestrian", "walker"))
+        self.assertAlmostEqual(first["width"], 0.5)
+        walking = [u for u in seen if u["speed"] > 0.5]
+        self.assertTrue(walking)
+        self.assertAlmostEqual(max(u["speed"] for u in walking), 1.2, delta=0.05)
+        ys = [u["y"] for u in walking]  # A0A1 runs north
+        self.assertGreater(ys[-1] - ys[0], 10)
+        self.assertEqual(ys, sorted(ys))
+        gone = [u for row in rows for u in row["users"] if u["absent"]]
+        self.assertEqual(len(gone), 1)  # once, after it arrived
+        self.assertEqual(rows[-1]["users"], [])
+
+
 class BadInput(SumoCase):
     def test_missing_net_file(self):
         self.experiment(sumo={"NetFile": "nowhere.net.xml"})
