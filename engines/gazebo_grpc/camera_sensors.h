@@ -105,6 +105,11 @@ class CameraSensors {
   // ground are 0).
   void instances_datapack(size_t i, datapack::Builder& out);
   void boxes_datapack(size_t i, datapack::Builder& out);
+  // A segmentation camera's latest label map as a convoy.data.Camera datapack (RGB, 8 bits):
+  // semantic: every channel the pixel's class label (class_label()); panoptic: the label, then
+  // the instance id's high and low byte (Gazebo's layout; the ids of "instances" above). With
+  // `colored`: the same as colours to look at (a colour per class; per instance if panoptic).
+  void segmentation_datapack(size_t i, bool colored, datapack::Builder& out);
 
  private:
   struct Camera {

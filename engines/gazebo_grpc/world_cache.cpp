@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', '9'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', 'A'};  // bump on format change
 
 using cache_io::Reader;
 using cache_io::Writer;
@@ -93,6 +93,7 @@ void put(Writer& w, const LinkDesc& l) {
     w.pod<int32_t>(c.width);
     w.pod<int32_t>(c.height);
     w.str(c.format);
+    w.str(c.segmentation);
     for (double d : {c.hfov, c.near_clip, c.far_clip, c.update_rate, c.noise_mean, c.noise_stddev})
       w.pod(d);
     w.pod<uint8_t>(c.noise);
@@ -131,6 +132,7 @@ void get(Reader& r, LinkDesc& l) {
     c.width = r.pod<int32_t>();
     c.height = r.pod<int32_t>();
     c.format = r.str();
+    c.segmentation = r.str();
     for (double* d :
          {&c.hfov, &c.near_clip, &c.far_clip, &c.update_rate, &c.noise_mean, &c.noise_stddev})
       *d = r.pod<double>();

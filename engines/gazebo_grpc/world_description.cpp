@@ -227,8 +227,15 @@ class Loader {
         ld.lidars.push_back(lidar_desc(sensor, model_name, l->Name(), file_));
       if (is_nav_sensor(sensor))
         ld.nav_sensors.push_back(nav_desc(sensor, model_name, l->Name(), file_));
-      if (sensor->Type() != sdf::SensorType::CAMERA) continue;
+      if (sensor->Type() != sdf::SensorType::CAMERA &&
+          sensor->Type() != sdf::SensorType::SEGMENTATION_CAMERA)
+        continue;
       ld.cameras.push_back(camera(sensor, ld.name));
+      const std::string& seg = ld.cameras.back().segmentation;
+      if (!seg.empty() && seg != "semantic" && seg != "panoptic")
+        throw std::runtime_error(
+            file_.string() + ": model '" + model_name + "' link '" + l->Name() + "' sensor '" +
+            sensor->Name() + "': <segmentation_type>: '" + seg + "' is not semantic or panoptic");
     }
     return ld;
   }
@@ -283,6 +290,8 @@ class Loader {
       cd.noise = n.Type() == sdf::NoiseType::GAUSSIAN;
       cd.noise_mean = n.Mean();
       cd.noise_stddev = n.StdDev();
+      if (sensor->Type() == sdf::SensorType::SEGMENTATION_CAMERA)
+        cd.segmentation = cam->HasSegmentationType() ? cam->SegmentationType() : "semantic";
     }
     cd.update_rate = sensor->UpdateRate();
     if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
@@ -398,6 +407,13 @@ const std::vector<std::string>& known_classes() {
       "car",   "truck", "bus",           "pedestrian", "cyclist", "building", "tree",
       "shrub", "pole",  "traffic_light", "sign",       "barrier", "other"};
   return classes;
+}
+
+uint8_t class_label(const std::string& cls) {
+  const auto& k = known_classes();
+  for (size_t i = 0; i < k.size(); ++i)
+    if (k[i] == cls) return static_cast<uint8_t>(i + 1);
+  return 0;
 }
 
 bool is_known_class(const std::string& cls) {

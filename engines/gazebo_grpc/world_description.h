@@ -62,6 +62,9 @@ struct CameraDesc {
   double hfov = 1.047, near_clip = 0.1, far_clip = 100, update_rate = 0;  // 0: every step
   bool noise = false;
   double noise_mean = 0, noise_stddev = 0;
+  // <sensor type="segmentation_camera">: its <segmentation_type>, "semantic" (the default) or
+  // "panoptic"; "" for an RGB camera.
+  std::string segmentation;
 };
 
 // A LiDAR: <sensor type="lidar|gpu_lidar|ray|gpu_ray"> (lidar_desc.h reads it).
@@ -196,6 +199,8 @@ struct WorldDesc {
 // cyclist) and scenery (building, tree, shrub, pole, sign, traffic_light, barrier, other).
 const std::vector<std::string>& known_classes();
 bool is_known_class(const std::string& cls);
+// A class's label in segmentation images: its place in known_classes() from 1; 0 for none.
+uint8_t class_label(const std::string& cls);
 // The class of a model without an annotation: its name without a trailing number
 // ("building_3" -> "building"), kept for worlds written before annotations.
 std::string class_of_name(const std::string& model_name);

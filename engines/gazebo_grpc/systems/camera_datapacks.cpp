@@ -20,7 +20,7 @@ void CameraDatapacks::configure(const WorldContext& ctx, const nlohmann::json& c
     std::vector<std::string> bases{cam.scoped_name};
     if (!cam.plugin_name.empty()) bases.insert(bases.begin(), cam.plugin_name + "::" + cam.name);
     for (const auto& base : bases) {
-      by_datapack_[base] = {c, kImage};
+      by_datapack_[base] = {c, cam.segmentation.empty() ? kImage : kLabels};
       by_datapack_[base + "::depth"] = {c, kDepth};
       by_datapack_[base + "::boxes"] = {c, kBoxes};
       by_datapack_[base + "::instances"] = {c, kInstances};
@@ -28,6 +28,9 @@ void CameraDatapacks::configure(const WorldContext& ctx, const nlohmann::json& c
       provided_.push_back({base + "::depth", "json"});
       provided_.push_back({base + "::boxes", "json"});
       provided_.push_back({base + "::instances", "json"});
+      if (cam.segmentation.empty()) continue;
+      by_datapack_[base + "::colored"] = {c, kColored};
+      provided_.push_back({base + "::colored", datapack::type_name<data::Camera>()});
     }
   }
   cameras.update(ctx.time_s());
@@ -44,6 +47,8 @@ void CameraDatapacks::get_datapack(const std::string& name, datapack::Builder& o
     cameras.depth_datapack(index, out);
   else if (kind == kInstances)
     cameras.instances_datapack(index, out);
+  else if (kind == kLabels || kind == kColored)
+    cameras.segmentation_datapack(index, kind == kColored, out);
   else
     cameras.boxes_datapack(index, out);
   sent_frames_[name] = cameras.frames(index);

@@ -7,6 +7,9 @@
 //   ...::depth      JSON {"width", "height", "depth": float32 ndarray (metres)}
 //   ...::boxes      JSON {"width", "height", "boxes": [...]}: ground truth of visible models
 //   ...::instances  JSON {"width", "height", "ids": uint32 ndarray, "instances": {...}}
+// A <sensor type="segmentation_camera">'s first datapack is its label map instead of the
+// image (GazeboCameraDataPack, CameraSensors::segmentation_datapack), and it has one more:
+//   ...::colored    GazeboCameraDataPack: the label map in colours
 // A camera datapack is unchanged() until the camera renders again. After every engine step
 // (after_step) the cameras that are due render.
 #pragma once
@@ -32,7 +35,7 @@ class CameraDatapacks final : public WorldSystem {
   void reset() override;
 
  private:
-  enum Output { kImage, kDepth, kBoxes, kInstances };
+  enum Output { kImage, kDepth, kBoxes, kInstances, kLabels, kColored };
   const WorldContext* ctx_ = nullptr;
   render::Shadows shadows_;
   std::unordered_map<std::string, std::pair<size_t, Output>> by_datapack_;
