@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "camera_desc.h"
 #include "lidar_desc.h"
 #include "nav_desc.h"
 #include "sdf_eigen.h"
@@ -227,15 +228,8 @@ class Loader {
         ld.lidars.push_back(lidar_desc(sensor, model_name, l->Name(), file_));
       if (is_nav_sensor(sensor))
         ld.nav_sensors.push_back(nav_desc(sensor, model_name, l->Name(), file_));
-      if (sensor->Type() != sdf::SensorType::CAMERA &&
-          sensor->Type() != sdf::SensorType::SEGMENTATION_CAMERA)
-        continue;
-      ld.cameras.push_back(camera(sensor, ld.name));
-      const std::string& seg = ld.cameras.back().segmentation;
-      if (!seg.empty() && seg != "semantic" && seg != "panoptic")
-        throw std::runtime_error(
-            file_.string() + ": model '" + model_name + "' link '" + l->Name() + "' sensor '" +
-            sensor->Name() + "': <segmentation_type>: '" + seg + "' is not semantic or panoptic");
+      if (!is_camera_sensor(sensor)) continue;
+      ld.cameras.push_back(camera_desc(sensor, model_name, l->Name(), file_));
     }
     return ld;
   }
@@ -271,35 +265,6 @@ class Loader {
   }
 
   // A camera sensor of the link named `link_name` (scoped).
-  static CameraDesc camera(const sdf::Sensor* sensor, const std::string& link_name) {
-    const sdf::Camera* cam = sensor->CameraSensor();
-    CameraDesc cd;
-    cd.name = sensor->Name();
-    cd.scoped_name = link_name + "::" + sensor->Name();
-    ignition::math::Pose3d sp;
-    sensor->SemanticPose().Resolve(sp);
-    cd.pose = to_eigen(sp);
-    if (cam) {
-      cd.width = static_cast<int>(cam->ImageWidth());
-      cd.height = static_cast<int>(cam->ImageHeight());
-      cd.format = cam->PixelFormatStr();
-      cd.hfov = cam->HorizontalFov().Radian();
-      cd.near_clip = cam->NearClip();
-      cd.far_clip = cam->FarClip();
-      const sdf::Noise& n = cam->ImageNoise();
-      cd.noise = n.Type() == sdf::NoiseType::GAUSSIAN;
-      cd.noise_mean = n.Mean();
-      cd.noise_stddev = n.StdDev();
-      if (sensor->Type() == sdf::SensorType::SEGMENTATION_CAMERA)
-        cd.segmentation = cam->HasSegmentationType() ? cam->SegmentationType() : "semantic";
-    }
-    cd.update_rate = sensor->UpdateRate();
-    if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
-      cd.plugin_name = attribute(e->GetElement("plugin"), "name");
-    }
-    return cd;
-  }
-
   JointDesc::Type joint_type(const sdf::Joint* j, const std::string& where) {
     switch (j->Type()) {
       case sdf::JointType::REVOLUTE:
