@@ -335,8 +335,10 @@ def pedestrian_behind_parked(weather=None, desc=""):
 
 
 def stopped_vehicle(desc=""):
+    # 60 s: the ego, past the car, reaches junction 100 on its approach's red at ~27 s and
+    # waits for the green at 40 s (as red_light)
     p = {"EgoS": ("double", "30"), "StoppedS": ("double", "110"), "RouteLength": ("double", "180"),
-         "Duration": ("double", "40")}
+         "Duration": ("double", "60")}
     init = {"Ego": ego_init() + [route("PassOnTheLeft", [lane_pos("1", "-2", "${$StoppedS - 30}"),
                                                          lane_pos("2", "-1", "20")])],
             "Stopped": [teleport(lane_pos("1", "-1", "$StoppedS")), hold("${$StoppedS - 250}", "-1.75", "0")]}
