@@ -5,7 +5,9 @@ planner_input_gt_tf.py or planner_input_det_tf.py) and publishes `target`
 ({"speed", "mode", "lead", "gap_m", "ttc_s"}): the target speed that motor_tf.py applies to
 the report's PID waypoint follower. The parameters come from a JSON file: the environment's
 CONVOY_EGO_PLANNER_CONFIG (set it with EngineEnvParams), default ego_planner.json, relative to
-this script's folder. At shutdown it writes its result (ego_stops_for_pedestrians, distances,
+this script's folder. With CONVOY_EGO_ROUTE (a route CSV with columns x, y: the one the
+follower drives) the planner's path is that route ahead (convoy_traffic.route_path), else the
+ego's current curvature. At shutdown it writes its result (ego_stops_for_pedestrians, distances,
 speed trace) to $CONVOY_RUN_DIR/<Output>.
 """
 import json
@@ -14,6 +16,7 @@ import os
 from nrp_core.engines.python_json import EngineScript
 
 from convoy_traffic.ego_planner import Planner, parse_config, SOURCE_LABELS
+from convoy_traffic.route_path import RoutePath
 
 
 class Script(EngineScript):
@@ -29,14 +32,23 @@ class Script(EngineScript):
         except ValueError as e:
             raise RuntimeError("%s: %s is not valid JSON: %s" % (engine, path, e))
         self.params = parse_config(cfg, engine="%s, %s" % (engine, path))
-        self.planner = Planner(self.params)
+        route = None
+        route_csv = os.environ.get("CONVOY_EGO_ROUTE")
+        if route_csv:
+            try:
+                route = RoutePath.from_csv(route_csv)
+            except (OSError, KeyError, ValueError) as e:
+                raise RuntimeError("%s: CONVOY_EGO_ROUTE %s: %s" % (engine, route_csv, e))
+        self.planner = Planner(self.params, route)
         self.engine = engine
         self.run_dir = os.environ.get("CONVOY_RUN_DIR", ".")
         self._registerDataPack("planner_input")
         self._registerDataPack("target")
         self._setDataPack("target", {"speed": 0.0, "mode": "wait", "lead": None, "gap_m": None,
                                      "ttc_s": None, "input": self.params["Input"]})
-        print("%s: input %s (%s)" % (engine, self.params["Input"], SOURCE_LABELS[self.params["Input"]]),
+        print("%s: input %s (%s), path: %s" % (engine, self.params["Input"],
+                                                SOURCE_LABELS[self.params["Input"]],
+                                                "route " + route_csv if route else "curvature"),
               flush=True)
 
     def runLoop(self, timestep_ns):

@@ -181,7 +181,8 @@ def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0
         {"EngineType": "python_json", "EngineName": "planner",
          "PythonFileName": os.path.join(REPO, "experiments", "ego_planner", "ego_planner_engine.py"),
          "EngineTimestep": WORLD_DT,
-         "EngineEnvParams": ["CONVOY_EGO_PLANNER_CONFIG=" + os.path.join(CITY, "ego_planner.json")]},
+         "EngineEnvParams": ["CONVOY_EGO_PLANNER_CONFIG=" + os.path.join(CITY, "ego_planner.json"),
+                             "CONVOY_EGO_ROUTE=" + route_csv]},
         {"EngineType": "detector", "EngineName": "yolo_detector", "Backend": "convoy",
          "EngineTimestep": DETECTOR_DT},
     ]

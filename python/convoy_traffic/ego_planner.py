@@ -213,9 +213,16 @@ class Tracker:
         return [new[k] for k in sorted(new)]
 
 
+NEAR_FIELD_M = 5.0  # gap within which the ego's own heading decides, route or not
+
+
 class Planner:
-    def __init__(self, params):
+    def __init__(self, params, route=None):
+        """`route`: a route_path.RoutePath in the world frame, or None: the path is then the
+        ego's current curvature (its yaw rate over its speed)."""
         self.p = params
+        self.route = route
+        self._route_s = None  # the ego's last arc length on the route
         self.v_cmd = None
         self.stop_events = []       # ego stopped / AEB-braked because of a pedestrian
         self._episode_last = None   # last time a pedestrian led in the current stop episode
@@ -239,17 +246,45 @@ class Planner:
             return False, gap
         kappa = ego["yaw_rate"] / ego["speed"] if ego["speed"] > 1.0 else 0.0
         lat = o["lat"] - kappa * o["lon"] ** 2 / 2  # the ego's path bends with its yaw rate
+        v_lat = o["v_lat"]
+        if self.route is not None and gap > NEAR_FIELD_M:
+            gap, lat, v_lat = self._on_route(ego, o, front)
+            if gap is None:
+                return False, o["lon"] - o["length"] / 2 - front
         half = (ego["width"] or 1.8) / 2 + p["LateralMargin"]
         clearance = abs(lat) - o["width"] / 2 - half
         if clearance <= 0:
             return True, gap
-        toward = -o["v_lat"] if lat > 0 else o["v_lat"]
+        toward = -v_lat if lat > 0 else v_lat
         if toward < max(p["MinCrossingSpeed"], 0.01):
             return False, gap
         # it enters the corridor soon, and before the ego has passed it (1 s of slack)
         t_enter = clearance / toward
         closing = max(ego["speed"] - o["v_lon"], 0.1)
         return t_enter <= min(p["CrossingHorizon"], max(gap, 0.0) / closing + 1.0), gap
+
+    def route_position(self, ego):
+        """The ego's arc length on the route, followed from step to step."""
+        if self._route_s is None:
+            s, _ = self.route.locate(ego["x"], ego["y"])
+        else:
+            s, _ = self.route.locate(ego["x"], ego["y"], self._route_s - 5.0, self._route_s + 50.0)
+        self._route_s = s
+        return s
+
+    def _on_route(self, ego, o, front):
+        """(gap along the route, distance from it, speed towards its left) of object `o` (in
+        the ego's frame), or (None, None, None) when it is not on the route ahead."""
+        c, sn = math.cos(ego["yaw"]), math.sin(ego["yaw"])
+        ox = ego["x"] + c * o["lon"] - sn * o["lat"]
+        oy = ego["y"] + sn * o["lon"] + c * o["lat"]
+        s_ego = self.route_position(ego)
+        s_obj, d = self.route.locate(ox, oy, s_ego - 1.0, s_ego + self.p["Range"] + 20.0)
+        if s_obj <= s_ego or s_obj >= self.route.length:
+            return None, None, None
+        h = self.route.heading(s_obj) - ego["yaw"]
+        v_left = -math.sin(h) * o["v_lon"] + math.cos(h) * o["v_lat"]
+        return s_obj - s_ego - o["length"] / 2 - front, d, v_left
 
     def step(self, t, ego, objects):
         p = self.p
@@ -340,6 +375,7 @@ class Planner:
         src = self.p["Input"]
         return {"input": src, "input_label": SOURCE_LABELS[src],
                 "ground_truth": src == "ground_truth",
+                "path": "route" if self.route is not None else "curvature",
                 "ego_stops_for_pedestrians": len(self.stop_events),
                 "pedestrian_stop_events": self.stop_events,
                 "min_distance_to_pedestrian_m": self.min_ped_distance,
