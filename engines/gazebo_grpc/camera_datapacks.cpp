@@ -45,13 +45,17 @@ double visible_fraction(const render::BoundingBox& b) {
 }
 }  // namespace
 
-void CameraSensors::instances_datapack(size_t i, datapack::Builder& out) {
-  Camera& cam = cameras_[i];
+void CameraSensors::ensure_ids(Camera& cam) {
   cam.want_ids = true;
   if (!cam.rendered)
     first_render(cam);
   else if (!cam.has_ids)
     render(cam);
+}
+
+void CameraSensors::instances_datapack(size_t i, datapack::Builder& out) {
+  Camera& cam = cameras_[i];
+  ensure_ids(cam);
   const size_t pixels = static_cast<size_t>(cam.frame.width) * cam.frame.height;
   ids_.resize(pixels);
   for (size_t p = 0; p < pixels && p < cam.frame.model_ids.size(); ++p) {

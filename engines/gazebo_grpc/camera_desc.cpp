@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "sdf_eigen.h"
-#include "world_plugins.h"
+#include "sensor_sdf.h"
 
 namespace convoy::world {
 
@@ -37,13 +37,11 @@ CameraDesc camera_desc(const sdf::Sensor* sensor, const std::string& model, cons
       cd.segmentation = cam->HasSegmentationType() ? cam->SegmentationType() : "semantic";
   }
   cd.update_rate = sensor->UpdateRate();
-  if (auto e = sensor->Element(); e && e->HasElement("plugin"))
-    cd.plugin_name = attribute(e->GetElement("plugin"), "name");
+  cd.plugin_name = sensor_plugin_name(sensor);
   const std::string& seg = cd.segmentation;
   if (!seg.empty() && seg != "semantic" && seg != "panoptic")
-    throw std::runtime_error(file.string() + ": model '" + model + "' link '" + link +
-                             "' sensor '" + cd.name + "': <segmentation_type>: '" + seg +
-                             "' is not semantic or panoptic");
+    throw std::runtime_error(sensor_where(file, model, link, cd.name) + "<segmentation_type>: '" +
+                             seg + "' is not semantic or panoptic");
   return cd;
 }
 

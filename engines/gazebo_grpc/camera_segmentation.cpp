@@ -36,11 +36,7 @@ std::array<uint8_t, 3> instance_colour(uint32_t id) {  // a fixed colour per ins
 
 void CameraSensors::segmentation_datapack(size_t i, bool colored, datapack::Builder& out) {
   Camera& cam = cameras_[i];
-  cam.want_ids = true;
-  if (!cam.rendered)
-    first_render(cam);
-  else if (!cam.has_ids)
-    render(cam);
+  ensure_ids(cam);
   const bool panoptic = cam.desc->segmentation == "panoptic";
   const auto w = static_cast<uint32_t>(cam.frame.width),
              h = static_cast<uint32_t>(cam.frame.height);

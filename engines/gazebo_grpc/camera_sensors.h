@@ -171,6 +171,7 @@ class CameraSensors {
                    Tracked* tracked, bool world = false);
   void render(Camera& cam);
   void first_render(Camera& cam);  // on the first request: render now, schedule the next
+  void ensure_ids(Camera& cam);    // the current frame with its instance ids (asked for once)
   void draw_noise(Camera& cam);
   // The frame's pixels (RGB or grey, with its noise) into `dst`.
   void convert(const Camera& cam, std::span<uint8_t> dst) const;

@@ -4,17 +4,9 @@
 #include <stdexcept>
 
 #include "sdf_eigen.h"
+#include "sensor_sdf.h"
 
 namespace convoy::world {
-
-namespace {
-
-std::string sensor_type(const sdf::Sensor* sensor) {
-  const sdf::ElementPtr e = sensor->Element();
-  return e && e->HasAttribute("type") ? e->GetAttribute("type")->GetAsString() : "";
-}
-
-}  // namespace
 
 bool is_lidar_sensor(const sdf::Sensor* sensor) {
   return sensor && lidar::is_lidar_type(sensor_type(sensor));
@@ -27,8 +19,7 @@ LidarDesc lidar_desc(const sdf::Sensor* sensor, const std::string& model, const 
   d.model = model;
   d.link = link;
   d.scoped_name = model + "::" + link + "::" + sensor->Name();
-  const std::string where =
-      file.string() + ": model '" + model + "' link '" + link + "' sensor '" + d.name + "': ";
+  const std::string where = sensor_where(file, model, link, d.name);
   try {
     d.lidar = lidar::parse_lidar(sensor->Element());
   } catch (const std::invalid_argument& e) {
@@ -38,10 +29,7 @@ LidarDesc lidar_desc(const sdf::Sensor* sensor, const std::string& model, const 
   if (!sensor->SemanticPose().Resolve(pose).empty())
     throw std::runtime_error(where + "its pose cannot be resolved");
   d.pose = to_eigen(pose);
-  if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
-    auto p = e->GetElement("plugin");
-    if (p->HasAttribute("name")) d.plugin_name = p->GetAttribute("name")->GetAsString();
-  }
+  d.plugin_name = sensor_plugin_name(sensor);
   return d;
 }
 

@@ -6,17 +6,13 @@
 #include <stdexcept>
 
 #include "sdf_eigen.h"
+#include "sensor_sdf.h"
 
 namespace convoy::world {
 
 namespace {
 
 using nav_sensors::NoiseParams;
-
-std::string sensor_type(const sdf::Sensor* sensor) {
-  const sdf::ElementPtr e = sensor->Element();
-  return e && e->HasAttribute("type") ? e->GetAttribute("type")->GetAsString() : "";
-}
 
 NoiseParams noise(const sdf::Noise& n, const std::string& field) {
   NoiseParams p;
@@ -90,8 +86,7 @@ NavSensorDesc nav_desc(const sdf::Sensor* sensor, const std::string& model, cons
   d.model = model;
   d.link = link;
   d.scoped_name = model + "::" + link + "::" + sensor->Name();
-  const std::string where =
-      file.string() + ": model '" + model + "' link '" + link + "' sensor '" + d.name + "': ";
+  const std::string where = sensor_where(file, model, link, d.name);
   try {
     if (sensor_type(sensor) == "imu")
       read_imu(sensor, d);
@@ -107,10 +102,7 @@ NavSensorDesc nav_desc(const sdf::Sensor* sensor, const std::string& model, cons
   if (!sensor->SemanticPose().Resolve(pose).empty())
     throw std::runtime_error(where + "its pose cannot be resolved");
   d.pose = to_eigen(pose);
-  if (auto e = sensor->Element(); e && e->HasElement("plugin")) {
-    auto p = e->GetElement("plugin");
-    if (p->HasAttribute("name")) d.plugin_name = p->GetAttribute("name")->GetAsString();
-  }
+  d.plugin_name = sensor_plugin_name(sensor);
   return d;
 }
 
