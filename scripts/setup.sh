@@ -18,7 +18,7 @@ PACKAGES=(
   sumo sumo-tools
   python3-torch
   slurm-wlm slurmctld slurmd slurm-client munge
-  zlib1g-dev libzstd-dev libembree-dev libboost-dev
+  zlib1g-dev libzstd-dev libembree-dev libboost-dev libboost-python-dev
   ffmpeg
   chromium
   ros-core-dev python3-rospy python3-rosmaster python3-genpy python3-gencpp

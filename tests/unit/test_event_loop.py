@@ -133,8 +133,8 @@ class ApiTest(unittest.TestCase):
         with self.assertRaisesRegex(TypeError, "cache_policy"):
             el.FromEngine("a", "/e/d", node_policies.input_node.msg_publish.all)
 
-    def test_factory_module_not_supported(self):
-        with self.assertRaisesRegex(ComputationalGraphError, "not supported"):
+    def test_factory_module_missing(self):  # C++ nodes: test_event_loop_cpp.py
+        with self.assertRaisesRegex(ComputationalGraphError, "could not be loaded: not found"):
             el.createFNFromFactoryModule("libFNFactoryModule.so", "f", "n",
                                          node_policies.functional_node.exec_policy.always)
 

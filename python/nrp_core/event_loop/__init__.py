@@ -15,7 +15,8 @@ A CG file, as in NRP-Core:
 The coordinator loads the config's ComputationalGraph files with load_computational_graph()
 and runs the graph with an EventLoop (SimulationLoop "EventLoop") or an FTIStep (FTILoop with
 DataPackProcessor "cg"); engine datapacks move through an EngineLink, MQTT and ROS through
-the Transports it provides (see _transport.py).
+the Transports it provides (see _transport.py; RospyInterface is the ROS one, on rospy).
+C++ functional nodes: createFNFromFactoryModule (see _factory_module.py).
 """
 from ._codec import JSON_DATAPACK_TYPE  # noqa: F401
 from ._decorators import (Clock, FromEngine, FromFunctionalNode, FromSpinnaker,  # noqa: F401
@@ -26,6 +27,7 @@ from ._graph import ComputationalGraph  # noqa: F401
 from ._loader import load_computational_graph  # noqa: F401
 from ._loop import EventLoop, EventLoopInterface, FTIStep  # noqa: F401
 from ._policies import ComputationalGraphError, ExecutionMode, node_policies  # noqa: F401
+from ._rospy_transport import RospyInterface  # noqa: F401  (imports rospy when constructed)
 from ._transport import (DataPackSink, DataPackSource, EngineLink, MQTTClient,  # noqa: F401
                          ROSInterface, Transports)
 

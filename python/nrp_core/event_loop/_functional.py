@@ -11,6 +11,7 @@ None; with exec_policy.always, in every cycle. It returns None or a list with on
 declared output.
 """
 import inspect
+import os
 import traceback
 
 from . import _graph
@@ -19,6 +20,19 @@ from ._policies import ALWAYS, ON_NEW_MESSAGE, ComputationalGraphError, check_po
     node_policies
 
 MAX_PORTS = 10  # inputs and outputs of one node (NRP-Core's PythonFunctionalNode)
+PY_OBJECT_TYPE = "N5boost6python3api6objectE"  # typeid(boost::python::object).name()
+
+
+def _check_types(source, output, target, keyword):
+    """An edge between functional nodes joins ports of the same C++ type (NRP-Core's
+    createEdge): what matters only when a C++ node (createFNFromFactoryModule) is on it."""
+    out_id, out_type = source.port_type(output, False)
+    in_id, in_type = target.port_type(keyword, True)
+    if out_id != in_id:
+        raise ComputationalGraphError(
+            "In Functional node '%s'. Error While creating edge to port '%s'. Attempt to connect "
+            "to port '%s' of node '%s', but they are of different types (%s and %s)."
+            % (target.id, keyword, output, source.id, out_type, in_type))
 
 
 class FunctionalNode(Node):
@@ -107,6 +121,7 @@ class FunctionalNode(Node):
                     "node '%s' doesn't have a declared output '%s'. Be sure that the edge address "
                     "is correctly formatted and the specified output exists."
                     % (full, keyword, self.id, node_id, port))
+            _check_types(other, port, self, keyword)
             self.connect_input(keyword, "'%s'" % full)
             other.add_subscriber(port, self, keyword)
             graph.add_edge(other, self)
@@ -115,6 +130,11 @@ class FunctionalNode(Node):
         """(inputs, outputs) with no connection, for the graph's warnings."""
         return ([k for k in self.inputs if k not in self._sources],
                 [o for o in self.outputs if not self._subscribers[o]])
+
+    def port_type(self, port, is_input):
+        """(C++ type id, type as written) of a port: a Python node's are boost::python
+        objects, as in NRP-Core."""
+        return PY_OBJECT_TYPE, "boost::python::object"
 
     # ------------------------------------------------------------------------------ running
     def receive(self, keyword, value):
@@ -154,9 +174,14 @@ class FunctionalNode(Node):
 
 
 def createFNFromFactoryModule(module_name, function_name, node_name, exec_policy):  # noqa: N802
-    """NRP-Core's C++ functional nodes (a libFNFactoryModule.so built with
-    build_fn_factory_module.sh): not supported by Convoy yet."""
-    raise ComputationalGraphError(
-        'createFNFromFactoryModule("%s", "%s", "%s"): C++ functional nodes built from an NRP-Core '
-        "FN factory module are not supported by Convoy; write the node as a Python "
-        "@FunctionalNode" % (module_name, function_name, node_name))
+    """NRP-Core's C++ functional node: a node named `node_name` running C++ function
+    `function_name` of FN factory module `module_name` (a libFNFactoryModule.so built with
+    build_fn_factory_module.sh, looked for in the calling graph file's folder, the current
+    folder, then LD_LIBRARY_PATH). Returns the node, for FromFunctionalNode(...)(fn) etc."""
+    import sys
+    from ._factory_module import create_node
+    exec_policy = check_policy(exec_policy, node_policies.functional_node.exec_policy,
+                               "exec_policy")
+    caller = sys._getframe(1).f_code.co_filename
+    caller_dir = os.path.dirname(os.path.abspath(caller)) if os.path.isfile(caller) else None
+    return create_node(module_name, function_name, node_name, exec_policy, caller_dir)

@@ -418,6 +418,9 @@ class OutputROSNode(OutputNode):
         if self._ros is None:
             raise ComputationalGraphError('RosPublisher "%s": the experiment has no ROS node; '
                                           'add "ROSNode": {} to its configuration' % self.address)
+        advertise = getattr(self._ros, "advertise", None)
+        if advertise is not None:  # publishers up before the first message (RospyInterface)
+            advertise(self.address, self.msg_type)
 
     def send(self, port, value):
         if not isinstance(value, self.msg_type):
