@@ -41,7 +41,20 @@ minutes of the same road users respawning at their starts and SUMO's flows doubl
 Prints the collisions among participants (target 0), red-light violations, the road users
 seen and the real-time factor.
 
-  --sections sumo,agents,city,density   which sections to run (default all)
+Section "pooled": the road_user_pool engine (issue 26): N vehicles in ONE engine process with
+IDM, MOBIL, junction yielding and traffic lights at 20 Hz on a 10x10 grid network made at run
+time (netgenerate --grid --grid.number=10 --grid.length=--pool-grid-length --default.lanenumber 2
+--tls.guess true, then netconvert --opendrive-output; deterministic). For N in --pooled:
+  - the pool's step alone (benchmarks/traffic_pool/traffic_pool_bench.cpp, --pool-end simulated
+    seconds): ms per step, vehicle updates per wall second, the real-time factor, collisions;
+  - inside the coordinator loop: `convoy run` of the engine (EngineTimestep 0.05, Count N) with a
+    TF reading the whole convoy.data.RoadUsers datapack (binary protobuf) each step: the
+    real-time factor of the loop (summary.json, start-up excluded; median of --runs).
+Last line: `pooled road users at real time: N`, the largest N at >= 1x in the loop. With
+--pool-collision-count K (default 1000) it also runs K vehicles for 600 simulated s alone and
+prints the collisions among them (target 0).
+
+  --sections sumo,agents,city,density,pooled   which sections to run (default all but pooled)
 """
 import argparse
 import json
@@ -259,6 +272,7 @@ def section_agents(args):
                 best = max(best, n)
     finally:
         shutil.rmtree(work, ignore_errors=True)
+    args.agents_best = best
     print("participants at real time: %d" % best)
 
 
@@ -335,6 +349,87 @@ def section_density(args):
         shutil.rmtree(work, ignore_errors=True)
 
 
+POOL_TF = textwrap.dedent("""\
+    from nrp_core import *
+
+
+    @EngineDataPack(keyword="v", id=DataPackIdentifier("road_users", "pool"))
+    @TransceiverFunction("pool")
+    def read_pool(v):
+        if not v.isEmpty():
+            len(v.data.users)
+        return []
+    """)
+
+
+def make_pool_grid(work, length):
+    env = dict(os.environ, SUMO_HOME=SUMO_HOME)
+    net = os.path.join(work, "pool_grid.net.xml")
+    xodr = os.path.join(work, "pool_grid.xodr")
+    run(["netgenerate", "--grid", "--grid.number=10", "--grid.length=%g" % length,
+         "--default.lanenumber", "2", "--tls.guess", "true", "-o", net], env=env)
+    run(["netconvert", "-s", net, "--opendrive-output", xodr], env=env)
+    return xodr
+
+
+def pooled_loop_run(work, xodr, n, end, i, build):
+    exp = os.path.join(work, "pool%d_%d" % (n, i))
+    os.makedirs(exp)
+    with open(os.path.join(exp, "tf.py"), "w") as f:
+        f.write(POOL_TF)
+    with open(os.path.join(exp, "simulation_config.json"), "w") as f:
+        json.dump({"SimulationName": "traffic_bench_pooled", "SimulationTimeout": end,
+                   "EngineConfigs": [{"EngineType": "road_user_pool", "EngineName": "pool",
+                                      "EngineTimestep": 0.05, "Map": xodr, "Count": n,
+                                      "Seed": 1}],
+                   "DataPackProcessingFunctions": [{"Name": "read_pool", "FileName": "tf.py"}]},
+                  f)
+    run_dir = os.path.join(exp, "run")
+    run([os.path.join(build, "bin", "convoy"), "run", "-q", "-c",
+         os.path.join(exp, "simulation_config.json"), "--run-dir", run_dir])
+    with open(os.path.join(run_dir, "summary.json")) as f:
+        summary = json.load(f)
+    shutil.rmtree(exp, ignore_errors=True)
+    return summary["real_time_factor"]
+
+
+def section_pooled(args):
+    bench = os.path.join(args.build, "benchmarks", "traffic_pool_bench")
+    if not os.path.exists(os.path.join(args.build, "bin", "convoy-engine-road_user_pool")) \
+            or not os.path.exists(bench):
+        print("pooled: convoy-engine-road_user_pool or traffic_pool_bench is not built")
+        return
+    work = tempfile.mkdtemp(prefix="convoy-trafficbench-pooled-")
+    best = 0
+    try:
+        xodr = make_pool_grid(work, args.pool_grid_length)
+        print("pooled: road_user_pool, 10x10 grid x %g m, 2 lanes a direction, lights where "
+              "netgenerate guessed them, 20 Hz, %g s simulated, %d run(s) in the loop"
+              % (args.pool_grid_length, args.pool_end, args.runs), flush=True)
+        alone = run([bench, xodr, "--counts", args.pooled, "--seconds", str(args.pool_end)])
+        print("  the pool's step alone (traffic_pool_bench):")
+        for line in alone.stdout.splitlines():
+            print("    " + line.strip())
+        if args.pool_collision_count > 0:
+            col = run([bench, xodr, "--counts", str(args.pool_collision_count),
+                       "--seconds", "600"])
+            print("  collisions, %d vehicles for 600 simulated s:" % args.pool_collision_count)
+            for line in col.stdout.splitlines()[1:-1]:
+                print("    " + line.strip())
+        print("  inside the coordinator loop (engine + a TF reading every vehicle each step):")
+        for n in [int(x) for x in args.pooled.split(",")]:
+            rtfs = [pooled_loop_run(work, xodr, n, args.pool_end, i, args.build)
+                    for i in range(args.runs)]
+            rtf = statistics.median(rtfs)
+            print("    N = %6d: real-time factor %.2fx (runs: %s)"
+                  % (n, rtf, ", ".join("%.2f" % r for r in rtfs)), flush=True)
+            if rtf >= 1.0:
+                best = max(best, n)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    print("pooled road users at real time: %d" % best)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -350,6 +445,14 @@ def main():
                     help="simulated seconds of the density run")
     ap.add_argument("--agent-end", type=float, default=10.0,
                     help="simulated seconds of each agents run")
+    ap.add_argument("--pooled", default="1000,5000,10000,20000,40000",
+                    help="pooled vehicle counts, comma-separated")
+    ap.add_argument("--pool-end", type=float, default=20.0,
+                    help="simulated seconds of each pooled run")
+    ap.add_argument("--pool-grid-length", type=float, default=400.0,
+                    help="m between the grid's junctions")
+    ap.add_argument("--pool-collision-count", type=int, default=1000,
+                    help="vehicles of the 600 s collision run (0: none)")
     args = ap.parse_args()
     sections = args.sections.split(",")
     if "sumo" in sections:
@@ -360,6 +463,10 @@ def main():
         section_city(args)
     if "density" in sections:
         section_density(args)
+    if "pooled" in sections:
+        section_pooled(args)
+    if "agents" in sections and "pooled" in sections:
+        print("participants at real time: %d" % getattr(args, "agents_best", 0))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,186 @@
+// EngineType "road_user_pool": N vehicles in one engine process (issue 26's pooled host), each
+// with its own parameters, seed and policy. The behaviour (IDM, MOBIL, junctions, lights, the
+// neighbour grid) is src/traffic_pool; this file only reads the config and writes the datapack.
+//
+// Config keys (schema.json): Map, Vehicles (listed), Count + Seed + Policy + DesiredSpeed
+// (spawned), RoadUsersDataPack. Datapack: <RoadUsersDataPack> convoy.data.RoadUsers, every
+// vehicle's state after the last step (reference point: the rear axle, a quarter of the length
+// ahead of the rear bumper), ids "<engine>/<id>"; protobuf's binary form, not JSON.
+// Bad input (an unknown policy, two road users on one spot, a count the map cannot hold, a
+// destination with no path) fails initialize with one message naming the road user.
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "convoy/road_users.pb.h"
+#include "datapack/proto.h"
+#include "datapack/registry.h"
+#include "engine/engine.h"
+#include "opendrive/lane_graph.h"
+#include "opendrive/parser.h"
+#include "traffic_pool/pool.h"
+
+namespace convoy::engines::road_user_pool {
+
+namespace tp = convoy::traffic_pool;
+using nlohmann::json;
+
+namespace {
+constexpr double kRearAxleFraction = 0.25;
+
+double number(const json& v, const char* key, double fallback, const std::string& who) {
+  if (!v.contains(key)) return fallback;
+  if (!v.at(key).is_number()) {
+    throw std::runtime_error(who + ": " + key + " must be a number, got " + v.at(key).dump());
+  }
+  return v.at(key).get<double>();
+}
+
+tp::VehicleSpec listed(const json& v, size_t k) {
+  const std::string where = "Vehicles[" + std::to_string(k) + "]";
+  if (!v.is_object()) throw std::runtime_error(where + " must be an object");
+  tp::VehicleSpec s;
+  if (!v.contains("Id") || !v.at("Id").is_string()) {
+    throw std::runtime_error(where + ": Id (a string) is required");
+  }
+  s.id = v.at("Id").get<std::string>();
+  const std::string who = "road user '" + s.id + "'";
+  if (!v.contains("Road") || !v.contains("Lane")) {
+    throw std::runtime_error(who + ": Road and Lane are required");
+  }
+  s.road = v.at("Road").is_string() ? v.at("Road").get<std::string>() : v.at("Road").dump();
+  s.lane = static_cast<int>(number(v, "Lane", 0, who));
+  s.s = number(v, "S", 10, who);
+  s.speed = number(v, "Speed", 0, who);
+  if (v.contains("Policy"))
+    s.policy =
+        v.at("Policy").is_string() ? v.at("Policy").get<std::string>() : v.at("Policy").dump();
+  s.seed = static_cast<uint64_t>(number(v, "Seed", static_cast<double>(k), who));
+  s.length = number(v, "Length", s.length, who);
+  s.width = number(v, "Width", s.width, who);
+  s.idm.v0 = number(v, "DesiredSpeed", s.idm.v0, who);
+  s.idm.T = number(v, "TimeHeadway", s.idm.T, who);
+  s.idm.s0 = number(v, "MinGap", s.idm.s0, who);
+  s.idm.a = number(v, "MaxAcceleration", s.idm.a, who);
+  s.idm.b = number(v, "ComfortableDeceleration", s.idm.b, who);
+  s.mobil.politeness = number(v, "Politeness", s.mobil.politeness, who);
+  if (v.contains("To")) {
+    const json& to = v.at("To");
+    if (!to.is_object() || !to.contains("Road") || !to.contains("Lane")) {
+      throw std::runtime_error(who + ": To must be {\"Road\": ..., \"Lane\": ...}");
+    }
+    s.to = std::make_pair(
+        to.at("Road").is_string() ? to.at("Road").get<std::string>() : to.at("Road").dump(),
+        static_cast<int>(number(to, "Lane", 0, who)));
+  }
+  return s;
+}
+}  // namespace
+
+class RoadUserPoolEngine final : public Engine {
+ public:
+  std::vector<engine::DataPackId> initialize(const std::string& name, const json& config,
+                                             int64_t timestep_ns) override {
+    name_ = name;
+    config_ = config;
+    dp_name_ = config.value("RoadUsersDataPack", "road_users");
+    try {
+      map_ = std::make_unique<opendrive::Network>(opendrive::load(config.at("Map")));
+      graph_ = std::make_unique<opendrive::LaneGraph>(*map_);
+      net_ = std::make_unique<tp::PoolNetwork>(*graph_);
+      build();
+    } catch (const std::exception& e) {
+      throw std::runtime_error("road_user_pool engine '" + name + "': " + e.what());
+    }
+    (void)timestep_ns;
+    std::vector<engine::DataPackId> ids(1);
+    ids[0].set_name(dp_name_);
+    ids[0].set_type(std::string(datapack::type_name<data::RoadUsers>()));
+    ids[0].set_engine_name(name);
+    return ids;
+  }
+
+  int64_t step(int64_t duration_ns) override {
+    pool_->step(duration_ns * 1e-9);
+    time_ns_ += duration_ns;
+    publish();
+    return time_ns_;
+  }
+
+  void set_datapack(const datapack::View&) override {}
+
+  void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
+    if (id.name() == dp_name_) datapack::write_proto(out, users_);
+  }
+
+  void reset() override {
+    time_ns_ = 0;
+    build();
+  }
+
+ private:
+  void build() {
+    std::vector<tp::VehicleSpec> specs;
+    const json& list = config_.value("Vehicles", json::array());
+    if (!list.is_array()) throw std::runtime_error("Vehicles must be a list");
+    for (size_t k = 0; k < list.size(); ++k) specs.push_back(listed(list[k], k));
+    const size_t count = config_.value("Count", 0);
+    if (count > 0) {
+      tp::VehicleSpec base;
+      base.policy = config_.value("Policy", "idm_mobil");
+      base.idm.v0 = config_.value("DesiredSpeed", 13.9);
+      auto more = tp::spawn(*net_, count, config_.value("Seed", 1), base);
+      specs.insert(specs.end(), more.begin(), more.end());
+    }
+    pool_ = std::make_unique<tp::Pool>(*net_, std::move(specs));
+    users_.Clear();
+    for (size_t i = 0; i < pool_->size(); ++i) {
+      const tp::VehicleSpec& s = pool_->spec(i);
+      data::RoadUser* u = users_.add_users();
+      u->set_id(name_ + "/" + s.id);
+      u->set_category("car");
+      u->set_model("sedan");
+      u->set_length(s.length);
+      u->set_width(s.width);
+      u->set_height(1.45);
+      u->set_length_offset(s.length * (0.5 - kRearAxleFraction));
+    }
+    publish();
+  }
+
+  void publish() {
+    users_.set_time_ns(time_ns_);
+    for (size_t i = 0; i < pool_->size(); ++i) {
+      data::RoadUser* u = users_.mutable_users(static_cast<int>(i));
+      const double yaw = pool_->yaw(i), c = std::cos(yaw), sn = std::sin(yaw);
+      const double back = u->length_offset(), v = pool_->speed(i);
+      u->set_x(pool_->x(i) - back * c);
+      u->set_y(pool_->y(i) - back * sn);
+      u->set_yaw(yaw);
+      u->set_speed(v);
+      u->set_acceleration(pool_->acceleration(i));
+      u->set_vx(v * c);
+      u->set_vy(v * sn);
+      u->set_lights(pool_->acceleration(i) < -0.5 ? data::RoadUser::BRAKE : 0);
+      const tp::PoolLane& lane = net_->lane(pool_->lane(i));
+      const opendrive::LaneNode& node = graph_->lane(lane.graph_lane);
+      u->set_road(lane.road_id);
+      u->set_lane(lane.lane_id);
+      u->set_s(node.forward ? node.s0 + pool_->s(i) : node.s1 - pool_->s(i));
+      u->set_time_ns(time_ns_);
+    }
+  }
+
+  std::string name_, dp_name_;
+  json config_;
+  std::unique_ptr<opendrive::Network> map_;
+  std::unique_ptr<opendrive::LaneGraph> graph_;
+  std::unique_ptr<tp::PoolNetwork> net_;
+  std::unique_ptr<tp::Pool> pool_;
+  data::RoadUsers users_;
+  int64_t time_ns_ = 0;
+};
+
+CONVOY_REGISTER_ENGINE("road_user_pool", RoadUserPoolEngine);
+
+}  // namespace convoy::engines::road_user_pool

@@ -1,0 +1,75 @@
+// The pool's view of a lane graph: every driving lane as a polyline with its successors, its
+// same-direction neighbours, its speed limit, the junction it is in or leads into, the light
+// group of its approach and, for lanes inside a junction, the junction lanes it crosses or
+// merges with. Built once from an opendrive::LaneGraph (any OpenDRIVE map), then read-only.
+//
+// Lights: a junction has lights when the map gives it signals (LaneGraph::junction_signals).
+// The pool runs them itself on a fixed cycle: approaches heading mostly east-west (group 0) and
+// mostly north-south (group 1) take turns: green, yellow, all red (LightCycle).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "opendrive/geometry.h"
+#include "opendrive/lane_graph.h"
+#include "road_users/lights.h"
+
+namespace convoy::traffic_pool {
+
+inline constexpr uint32_t kNone = UINT32_MAX;
+
+struct PoolLane {
+  opendrive::LaneIndex graph_lane = opendrive::kNoLane;
+  std::string road_id;
+  int lane_id = 0;
+  std::vector<opendrive::Pose2> poses;  // along the driving direction, ds apart (last: the end)
+  double ds = 1.0, length = 0;
+  double limit = 13.9;                   // m/s (the map's, else 50 km/h)
+  std::vector<uint32_t> next;            // pool lanes that follow
+  uint32_t left = kNone, right = kNone;  // same-direction neighbours a change may go to
+  int junction = -1;                     // the junction the lane is inside
+  int approach = -1;                    // the junction the lane leads into (its end is a stop line)
+  int group = -1;                       // light group of that approach (-1: no lights)
+  std::vector<uint32_t> conflicts;      // junction lanes: those it crosses or merges with
+  bool u_turn = false;                  // turns back (heading change > 150 degrees)
+  opendrive::Pose2 at(double s) const;  // s from the lane's start in its driving direction
+};
+
+struct PoolJunction {
+  std::string id;
+  bool lights = false;
+  double offset_s = 0;  // of its light cycle
+};
+
+struct LightCycle {
+  double green_s = 25, yellow_s = 3, all_red_s = 2;
+  double period() const { return 2 * (green_s + yellow_s + all_red_s); }
+  road_users::Light state(double t, double offset_s, int group) const;
+};
+
+class PoolNetwork {
+ public:
+  explicit PoolNetwork(const opendrive::LaneGraph& graph, double ds = 1.0);
+  const opendrive::LaneGraph& graph() const { return *graph_; }
+  const std::vector<PoolLane>& lanes() const { return lanes_; }
+  const PoolLane& lane(uint32_t i) const { return lanes_[i]; }
+  const std::vector<PoolJunction>& junctions() const { return junctions_; }
+  uint32_t pool_lane(opendrive::LaneIndex graph_lane) const;  // kNone: not a driving lane
+  const LightCycle& cycle() const { return cycle_; }
+  road_users::Light light(uint32_t approach_lane, double t) const;
+  double min_x = 0, min_y = 0, max_x = 0, max_y = 0;  // bounding box of the lanes
+
+ private:
+  void add_lanes(double ds);
+  void link();
+  void find_conflicts();
+  const opendrive::LaneGraph* graph_;
+  std::vector<PoolLane> lanes_;
+  std::vector<uint32_t> by_graph_lane_;
+  std::vector<PoolJunction> junctions_;
+  LightCycle cycle_;
+};
+
+}  // namespace convoy::traffic_pool

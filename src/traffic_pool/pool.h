@@ -1,0 +1,133 @@
+// N vehicles in one process (issue 26's pooled host), each with its own parameters, seed and
+// policy: IDM car following (road_users::Idm), MOBIL lane changes (road_users::Mobil), yielding
+// at junctions (a vehicle claims its junction lane before entering; it waits while a crossing
+// or merging lane is claimed or occupied, and while its exit lane has no room) and the pool's
+// traffic lights (PoolNetwork). State is kept in arrays, one entry per vehicle; neighbours off
+// the lane (vehicles in junctions, and the collision check) are found in a uniform grid.
+//
+// Bad input throws PoolError naming the road user: an unknown policy, a start off the driving
+// lanes, two road users on one spot, a destination with no path, a count that does not fit.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "road_users/idm.h"
+#include "road_users/mobil.h"
+#include "traffic_pool/network.h"
+
+namespace convoy::traffic_pool {
+
+class PoolError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Policies: "idm_mobil" (car following, lane changes, junctions, lights) and "idm" (the same
+// without lane changes).
+inline constexpr const char* kPolicies[] = {"idm_mobil", "idm"};
+
+struct VehicleSpec {
+  std::string id;
+  std::string policy = "idm_mobil";
+  std::string road;  // start: road, lane, s along the lane's driving direction (its front)
+  int lane = 0;
+  double s = 10, speed = 0;
+  std::optional<std::pair<std::string, int>> to;  // destination road and lane (then onward)
+  road_users::Idm idm;
+  road_users::Mobil mobil;
+  double length = 4.5, width = 1.8;
+  uint64_t seed = 0;           // its choices at forks
+  uint32_t pool_lane = kNone;  // spawned: the PoolNetwork lane itself (road/lane/s are shown)
+};
+
+// `count` vehicles like `base` (ids "<prefix><k>", seeds seed + k) on free slots of the
+// network's driving lanes outside junctions, spaced at least base.length + base.idm.s0 + 2 m,
+// drawn by `seed`. Throws PoolError when the network has fewer slots than `count`.
+std::vector<VehicleSpec> spawn(const PoolNetwork& net, size_t count, uint64_t seed,
+                               const VehicleSpec& base, const std::string& prefix = "pool/");
+
+struct PoolStats {
+  uint64_t lane_changes = 0, junction_entries = 0, respawns = 0;
+};
+
+class Pool {
+ public:
+  Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m = 20);
+  void step(double dt);  // s
+  size_t size() const { return specs_.size(); }
+  double time() const { return t_; }
+  const VehicleSpec& spec(size_t i) const { return specs_[i]; }
+  // The centre of its box, its heading, speed and acceleration.
+  double x(size_t i) const { return x_[i]; }
+  double y(size_t i) const { return y_[i]; }
+  double yaw(size_t i) const { return yaw_[i]; }
+  double speed(size_t i) const { return v_[i]; }
+  double acceleration(size_t i) const { return acc_[i]; }
+  uint32_t lane(size_t i) const { return lane_[i]; }
+  double s(size_t i) const { return s_[i]; }
+  const PoolStats& stats() const { return stats_; }
+  // Pairs of vehicles whose boxes overlap now (found through the grid).
+  std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
+
+ private:
+  void validate();
+  void place(size_t i);
+  void index_lanes();
+  void build_grid();
+  double accel_of(size_t i);
+  double leader_gap(size_t i, double& vl) const;
+  double junction_gap(size_t i);
+  double grid_gap(size_t i, double& vl) const;
+  bool conflict_free(uint32_t junction_lane, size_t me) const;
+  bool exit_has_room(uint32_t exit_lane, double need) const;
+  void consider_lane_change(size_t i);
+  void advance(size_t i, double dt);
+  uint32_t choose(size_t i, uint32_t lane);
+  void respawn(size_t i);
+  void update_pose(size_t i);
+  template <class F>
+  void for_near(double x, double y, double r, F&& f) const;
+
+  const PoolNetwork& net_;
+  std::vector<VehicleSpec> specs_;
+  double t_ = 0;
+  // Per vehicle.
+  std::vector<uint32_t> lane_, prev_, next_, next2_, claim_;
+  std::vector<double> s_, v_, acc_, x_, y_, yaw_;
+  std::vector<uint64_t> rng_;
+  std::vector<std::vector<uint32_t>> route_;  // lanes still to drive (destination given)
+  std::vector<uint8_t> mobil_;
+  // Per lane: vehicles on it by s (rebuilt each step), claims of junction lanes, changes in.
+  std::vector<uint32_t> order_, lane_begin_, rank_;
+  std::vector<uint16_t> claims_;
+  std::vector<uint8_t> changed_into_;
+  // The grid: cell heads and a chain through the vehicles.
+  double cell_ = 20;
+  int gx_ = 1, gy_ = 1;
+  std::vector<uint32_t> cell_head_, cell_next_;
+  PoolStats stats_;
+};
+
+template <class F>
+inline void Pool::for_near(double x, double y, double r, F&& f) const {
+  const int x0 = std::max(0, static_cast<int>((x - r - net_.min_x + 20) / cell_));
+  const int x1 = std::min(gx_ - 1, static_cast<int>((x + r - net_.min_x + 20) / cell_));
+  const int y0 = std::max(0, static_cast<int>((y - r - net_.min_y + 20) / cell_));
+  const int y1 = std::min(gy_ - 1, static_cast<int>((y + r - net_.min_y + 20) / cell_));
+  for (int cy = y0; cy <= y1; ++cy) {
+    for (int cx = x0; cx <= x1; ++cx) {
+      for (uint32_t k = cell_head_[static_cast<size_t>(cy) * gx_ + cx]; k != kNone;
+           k = cell_next_[k]) {
+        f(k);
+      }
+    }
+  }
+}
+
+}  // namespace convoy::traffic_pool

@@ -1,0 +1,251 @@
+// The pool's set-up: checking and placing the road users, spawning a count of them, putting a
+// vehicle that reached a dead end back on the network, and the box overlap test.
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "traffic_pool/pool.h"
+
+namespace convoy::traffic_pool {
+
+namespace {
+std::string who(const VehicleSpec& v) { return "road user '" + v.id + "'"; }
+
+bool boxes_overlap(double ax, double ay, double ayaw, double al, double aw, double bx, double by,
+                   double byaw, double bl, double bw) {
+  const double axes[4][2] = {{std::cos(ayaw), std::sin(ayaw)},
+                             {-std::sin(ayaw), std::cos(ayaw)},
+                             {std::cos(byaw), std::sin(byaw)},
+                             {-std::sin(byaw), std::cos(byaw)}};
+  const double dx = bx - ax, dy = by - ay;
+  for (const auto& u : axes) {
+    auto extent = [&](double yaw, double l, double w) {
+      return 0.5 * l * std::abs(u[0] * std::cos(yaw) + u[1] * std::sin(yaw)) +
+             0.5 * w * std::abs(-u[0] * std::sin(yaw) + u[1] * std::cos(yaw));
+    };
+    if (std::abs(dx * u[0] + dy * u[1]) > extent(ayaw, al, aw) + extent(byaw, bl, bw)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+uint64_t mix(uint64_t z) {
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+}  // namespace
+
+Pool::Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m)
+    : net_(net), specs_(std::move(specs)), cell_(cell_m) {
+  const size_t n = specs_.size();
+  lane_.assign(n, kNone);
+  prev_.assign(n, kNone);
+  next_.assign(n, kNone);
+  next2_.assign(n, kNone);
+  claim_.assign(n, kNone);
+  s_.assign(n, 0);
+  v_.assign(n, 0);
+  acc_.assign(n, 0);
+  x_.assign(n, 0);
+  y_.assign(n, 0);
+  yaw_.assign(n, 0);
+  rng_.assign(n, 0);
+  route_.assign(n, {});
+  mobil_.assign(n, 0);
+  claims_.assign(net_.lanes().size(), 0);
+  validate();
+  for (size_t i = 0; i < n; ++i) place(i);
+  build_grid();
+  const auto o = overlaps();
+  if (!o.empty()) {
+    const VehicleSpec& a = specs_[o[0].first];
+    const VehicleSpec& b = specs_[o[0].second];
+    std::ostringstream m;
+    m << who(a) << " and road user '" << b.id << "' are on one spot (road " << a.road << " lane "
+      << a.lane << " s " << a.s << ", road " << b.road << " lane " << b.lane << " s " << b.s
+      << "): their boxes overlap";
+    throw PoolError(m.str());
+  }
+}
+
+void Pool::validate() {
+  std::set<std::string> ids;
+  for (const VehicleSpec& v : specs_) {
+    if (v.id.empty()) throw PoolError("a road user has no id");
+    if (!ids.insert(v.id).second) throw PoolError(who(v) + " is listed twice");
+    if (std::find_if(std::begin(kPolicies), std::end(kPolicies),
+                     [&](const char* p) { return v.policy == p; }) == std::end(kPolicies)) {
+      throw PoolError(who(v) + ": unknown policy '" + v.policy + "' (known: idm_mobil, idm)");
+    }
+    if (!(v.length > 0.5 && v.width > 0.3)) {
+      throw PoolError(who(v) + ": length and width must be > 0.5 m and > 0.3 m");
+    }
+    if (!(v.idm.v0 > 0 && v.idm.a > 0 && v.idm.b > 0 && v.idm.T >= 0 && v.idm.s0 >= 0)) {
+      throw PoolError(who(v) + ": IDM parameters must be positive (v0, a, b; T, s0 >= 0)");
+    }
+  }
+}
+
+// Puts vehicle i at its start (road, lane, s along the driving direction), walking on through
+// the lanes that follow while s is beyond a lane's end, and plans its route.
+void Pool::place(size_t i) {
+  const VehicleSpec& v = specs_[i];
+  const opendrive::LaneGraph& g = net_.graph();
+  opendrive::LaneIndex gl = opendrive::kNoLane;
+  try {
+    gl = g.entry_lane(v.road, v.lane);
+  } catch (const std::exception&) {
+  }
+  uint32_t l = gl == opendrive::kNoLane ? kNone : net_.pool_lane(gl);
+  if (v.pool_lane < net_.lanes().size()) l = v.pool_lane;
+  if (l == kNone) {
+    throw PoolError(who(v) + ": road '" + v.road + "' lane " + std::to_string(v.lane) +
+                    " is not a driving lane of the map");
+  }
+  double s = v.s;
+  if (!(s >= 0)) throw PoolError(who(v) + ": s must be >= 0");
+  if (l == v.pool_lane && s > net_.lane(l).length) {
+    throw PoolError(who(v) + ": s is beyond its lane");
+  }
+  while (s > net_.lane(l).length) {
+    s -= net_.lane(l).length;
+    const PoolLane& cur = net_.lane(l);
+    if (cur.next.empty() || net_.lane(cur.next[0]).road_id != v.road) {
+      throw PoolError(who(v) + ": s " + std::to_string(v.s) + " is beyond road '" + v.road +
+                      "' lane " + std::to_string(v.lane));
+    }
+    l = cur.next[0];
+  }
+  lane_[i] = l;
+  s_[i] = s;
+  v_[i] = std::max(0.0, v.speed);
+  rng_[i] = mix(v.seed);
+  mobil_[i] = v.policy == "idm_mobil" && !v.to;
+  if (v.to) {
+    opendrive::LaneIndex to = opendrive::kNoLane;
+    try {
+      to = g.exit_lane(v.to->first, v.to->second);
+    } catch (const std::exception&) {
+    }
+    const PoolLane& pl = net_.lane(l);
+    const opendrive::LaneNode& n = g.lane(pl.graph_lane);
+    opendrive::RouteOptions opt;
+    opt.lane_changes = false;
+    std::optional<opendrive::LaneRoute> r;
+    if (to != opendrive::kNoLane) {
+      const opendrive::LaneNode& tn = g.lane(to);
+      r = g.route(pl.graph_lane, n.forward ? n.s0 + s : n.s1 - s, to, tn.forward ? tn.s1 : tn.s0,
+                  opt);
+    }
+    if (!r) {
+      throw PoolError(who(v) + ": no path from road '" + v.road + "' lane " +
+                      std::to_string(v.lane) + " to road '" + v.to->first + "' lane " +
+                      std::to_string(v.to->second));
+    }
+    for (size_t k = r->segments.size(); k-- > 1;) {
+      const uint32_t p = net_.pool_lane(r->segments[k].lane);
+      if (p != kNone) route_[i].push_back(p);
+    }
+  }
+  next_[i] = choose(i, l);
+  next2_[i] = choose(i, next_[i]);
+  update_pose(i);
+}
+
+// A vehicle at a dead end starts again, standing, at the start of a lane drawn by its seed
+// whose first metres are free; it waits at the dead end while none of 16 draws is.
+void Pool::respawn(size_t i) {
+  const VehicleSpec& v = specs_[i];
+  const size_t nl = net_.lanes().size();
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    const uint32_t l = static_cast<uint32_t>(mix(rng_[i] += 0x51ed27) % nl);
+    const PoolLane& lane = net_.lane(l);
+    // One entry into a lane per step (lane changes and respawns): the lists are the step's.
+    if (lane.junction >= 0 || lane.length < 2 * v.length + 20 || changed_into_[l]) continue;
+    const double s = v.length + 1;
+    bool free = true;
+    if (lane_begin_[l + 1] > lane_begin_[l]) {
+      const uint32_t j = order_[lane_begin_[l]];
+      free = s_[j] - specs_[j].length > s + v.idm.s0 + 5;
+    }
+    const opendrive::Pose2 p = lane.at(s - 0.5 * v.length);
+    for_near(p.x, p.y, 12, [&](uint32_t k) {
+      if (k != i && std::hypot(x_[k] - p.x, y_[k] - p.y) < 12) free = false;
+    });
+    if (!free) continue;
+    if (claim_[i] != kNone) --claims_[claim_[i]];
+    claim_[i] = kNone;
+    route_[i].clear();
+    changed_into_[l] = 1;
+    lane_[i] = l;
+    prev_[i] = kNone;
+    s_[i] = s;
+    v_[i] = 0;
+    next_[i] = choose(i, l);
+    next2_[i] = choose(i, next_[i]);
+    ++stats_.respawns;
+    return;
+  }
+  s_[i] = net_.lane(lane_[i]).length;
+  v_[i] = 0;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> Pool::overlaps() const {
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  for (uint32_t i = 0; i < size(); ++i) {
+    const VehicleSpec& a = specs_[i];
+    for_near(x_[i], y_[i], 0.5 * a.length + 8, [&](uint32_t k) {
+      if (k <= i) return;
+      const VehicleSpec& b = specs_[k];
+      if (boxes_overlap(x_[i], y_[i], yaw_[i], a.length, a.width, x_[k], y_[k], yaw_[k], b.length,
+                        b.width)) {
+        out.emplace_back(i, k);
+      }
+    });
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<VehicleSpec> spawn(const PoolNetwork& net, size_t count, uint64_t seed,
+                               const VehicleSpec& base, const std::string& prefix) {
+  const double spacing = base.length + base.idm.s0 + 2;
+  std::vector<std::pair<uint32_t, double>> slots;
+  for (uint32_t l = 0; l < net.lanes().size(); ++l) {
+    const PoolLane& lane = net.lane(l);
+    if (lane.junction >= 0) continue;
+    for (double s = base.length + 1; s <= lane.length - 1; s += spacing) slots.emplace_back(l, s);
+  }
+  if (count > slots.size()) {
+    std::ostringstream m;
+    m << "road user '" << prefix << slots.size() << "': a count of " << count
+      << " cannot fit the network: its driving lanes outside junctions hold at most "
+      << slots.size() << " vehicles " << spacing << " m apart";
+    throw PoolError(m.str());
+  }
+  uint64_t state = seed;
+  for (size_t k = slots.size(); k > 1; --k) {  // Fisher-Yates, by the seed
+    state = mix(state);
+    std::swap(slots[k - 1], slots[state % k]);
+  }
+  std::vector<VehicleSpec> out;
+  out.reserve(count);
+  for (size_t k = 0; k < count; ++k) {
+    VehicleSpec v = base;
+    const PoolLane& lane = net.lane(slots[k].first);
+    v.id = prefix + std::to_string(k);
+    v.seed = seed + k;
+    v.road = lane.road_id;
+    v.lane = lane.lane_id;
+    v.s = slots[k].second;
+    v.pool_lane = slots[k].first;
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+}  // namespace convoy::traffic_pool

@@ -1,0 +1,101 @@
+"""The road_user_pool engine (issue 26's pooled host): N vehicles in one engine process.
+
+Runs: a pool of spawned and listed vehicles on tests/traffic_pool/data/grid3.xodr publishes one
+convoy.data.RoadUsers datapack with every vehicle each step, which a TF reads.
+BadInput: an unknown policy, two road users on one spot, a count the map cannot hold and a
+destination with no path each stop the run with one message naming the road user, and leave
+no engine process behind.
+"""
+
+import json
+import os
+import textwrap
+import unittest
+
+from e2e_util import REPO, E2ETestCase
+
+GRID = os.path.join(REPO, "tests", "traffic_pool", "data", "grid3.xodr")
+
+TF = textwrap.dedent("""\
+    import json
+    from nrp_core import *
+
+    _seen = {"steps": 0}
+
+
+    @EngineDataPack(keyword="v", id=DataPackIdentifier("road_users", "pool"))
+    @TransceiverFunction("pool")
+    def count(v):
+        if v.isEmpty():
+            return []
+        users = v.data.users
+        _seen["steps"] += 1
+        _seen["n"] = len(users)
+        _seen["ids"] = len(set(u.id for u in users))
+        _seen["mine"] = [[u.x, u.y, u.speed, u.road, u.lane] for u in users if u.id == "pool/mine"]
+        _seen["moving"] = sum(1 for u in users if u.speed > 0.5)
+        with open(OUT, "w") as f:
+            json.dump(_seen, f)
+        return []
+    """)
+
+
+def pool_config(**engine):
+    e = {"EngineType": "road_user_pool", "EngineName": "pool", "EngineTimestep": 0.05,
+         "Map": GRID}
+    e.update(engine)
+    return {"SimulationName": "pool", "SimulationTimeout": 3.0, "EngineConfigs": [e]}
+
+
+class Runs(E2ETestCase):
+    def test_pool_publishes_every_vehicle(self):
+        out = os.path.join(self.dir, "seen.json")
+        self.write("tf.py", TF.replace("OUT", repr(out)))
+        cfg = pool_config(Count=40, Seed=3,
+                          Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
+                                     "Speed": 5, "Policy": "idm"}])
+        cfg["DataPackProcessingFunctions"] = [{"Name": "count", "FileName": "tf.py"}]
+        self.write_config(cfg)
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        with open(out) as f:
+            seen = json.load(f)
+        self.assertGreaterEqual(seen["steps"], 50)
+        self.assertEqual(seen["n"], 41)
+        self.assertEqual(seen["ids"], 41)
+        self.assertEqual(len(seen["mine"]), 1)
+        self.assertGreater(seen["moving"], 10)
+        self.assertNoEngineLeft()
+
+
+class BadInput(E2ETestCase):
+    def bad(self, *needles, **engine):
+        self.write_config(pool_config(**engine))
+        r = self.run_convoy()
+        # An engine's Initialize failing is `convoy run`'s exit 3 (engine error).
+        self.assertExit(r, 3)
+        self.assertOneError(r)
+        self.assertStderrHas(r, "road_user_pool engine 'pool'", *needles)
+        self.assertNoEngineLeft()
+
+    def test_unknown_policy(self):
+        self.bad("road user 'v1': unknown policy 'teleport'",
+                 Vehicles=[{"Id": "v1", "Road": "90", "Lane": -1, "S": 20,
+                            "Policy": "teleport"}])
+
+    def test_two_on_one_spot(self):
+        self.bad("road user 'a' and road user 'b' are on one spot",
+                 Vehicles=[{"Id": "a", "Road": "90", "Lane": -1, "S": 20},
+                           {"Id": "b", "Road": "90", "Lane": -1, "S": 21}])
+
+    def test_count_that_cannot_fit(self):
+        self.bad("a count of 5000 cannot fit the network", Count=5000)
+
+    def test_route_with_no_path(self):
+        self.bad("road user 'bus': no path from road '90' lane -1 to road 'nowhere' lane -1",
+                 Vehicles=[{"Id": "bus", "Road": "90", "Lane": -1, "S": 20,
+                            "To": {"Road": "nowhere", "Lane": -1}}])
+
+
+if __name__ == "__main__":
+    unittest.main()
