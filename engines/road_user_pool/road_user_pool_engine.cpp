@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "convoy/road_users.pb.h"
+#include "core/error.h"
 #include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "engine/engine.h"
@@ -89,8 +90,8 @@ class RoadUserPoolEngine final : public Engine {
       graph_ = std::make_unique<opendrive::LaneGraph>(*map_);
       net_ = std::make_unique<tp::PoolNetwork>(*graph_);
       build();
-    } catch (const std::exception& e) {
-      throw std::runtime_error("road_user_pool engine '" + name + "': " + e.what());
+    } catch (const std::exception& e) {  // the map or the road users given: exit 2
+      throw UserError("road_user_pool engine '" + name + "': " + e.what());
     }
     (void)timestep_ns;
     std::vector<engine::DataPackId> ids(1);

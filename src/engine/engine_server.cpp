@@ -14,6 +14,7 @@
 
 #include "convoy/engine.grpc.pb.h"
 #include "core/clock.h"
+#include "core/error.h"
 #include "core/memory.h"
 #include "core/utf8.h"
 #include "transport/blobs.h"
@@ -125,6 +126,7 @@ bool EngineServer::handle(const engine::Request& request, engine::Reply* reply) 
     // `error` is a protobuf string: bytes that are not UTF-8 would make the whole reply
     // unreadable to the coordinator, which would then report a dead engine instead.
     reply->set_error(valid_utf8(e.what()));
+    reply->set_user_error(dynamic_cast<const UserError*>(&e) != nullptr);
     if (request.kind_case() == engine::Request::kShutdown) return false;
   }
   return true;
@@ -305,7 +307,10 @@ class GrpcService final : public engine::Engine::Service {
     }
     std::lock_guard<std::mutex> lock(mutex_);  // one call at a time, in arrival order
     engine::Reply reply = queue_.submit(request);
-    if (!reply.error().empty()) return grpc::Status(grpc::StatusCode::INTERNAL, reply.error());
+    if (!reply.error().empty())  // a user's input fault travels as INVALID_ARGUMENT
+      return grpc::Status(reply.user_error() ? grpc::StatusCode::INVALID_ARGUMENT
+                                             : grpc::StatusCode::INTERNAL,
+                          reply.error());
     take(reply);
     return grpc::Status::OK;
   }

@@ -52,7 +52,9 @@ void EngineHandle::finish(engine::Reply* reply) {
   switch (status) {
     case transport::CallStatus::kOk:
       if (!reply->error().empty()) {
-        throw EngineError(name(), prefix + "failed in " + what_ + ":\n" + reply->error());
+        const std::string message = prefix + "failed in " + what_ + ":\n" + reply->error();
+        if (reply->user_error()) throw UserError(message);  // its input's fault: exit 2
+        throw EngineError(name(), message);
       }
       return;
     case transport::CallStatus::kClosed: {

@@ -66,6 +66,7 @@ class GrpcChannel final : public EngineChannel {
                        status.error_message() + " (AuthToken, or $" + kTokenEnv + ")");
     } else if (!status.ok()) {
       reply->set_error(status.error_message());
+      reply->set_user_error(status.error_code() == grpc::StatusCode::INVALID_ARGUMENT);
     }
     return CallStatus::kOk;
   }

@@ -72,8 +72,7 @@ class BadInput(E2ETestCase):
     def bad(self, *needles, **engine):
         self.write_config(pool_config(**engine))
         r = self.run_convoy()
-        # An engine's Initialize failing is `convoy run`'s exit 3 (engine error).
-        self.assertExit(r, 3)
+        self.assertExit(r, 2)  # the user's input: UserError in the engine
         self.assertOneError(r)
         self.assertStderrHas(r, "road_user_pool engine 'pool'", *needles)
         self.assertNoEngineLeft()
