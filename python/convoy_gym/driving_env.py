@@ -10,18 +10,24 @@
             if terminated or truncated:
                 break
 
-The simulation is experiments/rl_parkring (or any config with its conventions): a
-python_json engine "agent" holding the datapack "action" = {"steer": rad, "speed": m/s},
-which a transceiver function turns into the car's joint targets, and a status function
+The simulation is experiments/rl_parkring's gym_config.json (or any config with its
+conventions): the world engine "gazebo" with the smart car, whose joint targets the client
+sets itself every step (CAR_JOINTS: the front wheels' steering angle, the rear wheels' speed
+over WHEEL_RADIUS), and a status function
 returning done=True and one JSON observation every step with the keys t, x, y, yaw, speed,
 heading_error, off_path, waypoint, waypoints, episode_over and (optionally) ahead, a list of
 [forward, left] route points in the car's frame. One step() is one run_loop(1), i.e. one
-step of the smallest EngineTimestep (0.05 s on the Parkring). With camera=(H, W), the
+step of the smallest EngineTimestep (0.05 s on the Parkring), at a 5 ms physics step
+(PHYSICS_STEP; physics_step=None keeps the world's own, 1 ms). A config with a python_json
+engine "agent" (rl_parkring's simulation_config.json) gets the action as its datapack
+"action" = {"steer": rad, "speed": m/s} instead, for a transceiver function to turn into the
+joint targets (one more process and one more step of delay). With camera=(H, W), the
 observation is a Dict {"state": that Box, "camera": uint8 H x W x 3}: the ego camera's frame
 of the step, rendered at H x W by the world engine in a copy of the world (world_variant.py)
 and returned by the status function `<name>_camera.py` (rl_parkring's observe_camera.py).
 See docs/gym.md.
 """
+import json
 import os
 import shutil
 import socket
@@ -36,7 +42,8 @@ from nrp_client import NrpCore
 __all__ = ["DrivingEnv", "default_reward", "OBSERVATION_KEYS"]
 
 _REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DEFAULT_CONFIG = os.path.join(_REPO, "experiments", "rl_parkring", "simulation_config.json")
+DEFAULT_CONFIG = os.path.join(_REPO, "experiments", "rl_parkring", "gym_config.json")
+PHYSICS_STEP = 0.005  # s: the world's physics step by default (the Parkring world's own: 1 ms)
 
 MAX_STEER = 0.55   # rad, the smart car's steering limit (drive_tf.py clamps to it too)
 MAX_SPEED = 15.0   # m/s
@@ -46,6 +53,15 @@ OBSERVATION_KEYS = ("x", "y", "yaw", "speed", "heading_error", "off_path") + tup
 ACTION_NAMES = ("steer", "speed")
 OFF_TRACK_PENALTY = 10.0
 STOP = {"steer": 0.0, "speed": 0.0}
+# Without an "agent" engine: the smart car's joint datapacks the action sets (drive_tf.py's)
+WORLD_ENGINE = "gazebo"
+STEERING_JOINTS = ("smart_car_joint_plugin::front_left_steering_joint",
+                   "smart_car_joint_plugin::front_right_steering_joint")
+WHEEL_JOINTS = ("smart_car_joint_plugin::rear_left_wheel_joint",
+                "smart_car_joint_plugin::rear_right_wheel_joint")
+CAR_JOINTS = STEERING_JOINTS + WHEEL_JOINTS
+WHEEL_RADIUS = 0.3  # m
+JOINT_TYPE = "convoy.data.Joint"  # GazeboJointDataPack's message
 
 
 def default_reward(before, after, action):
@@ -76,30 +92,43 @@ class DrivingEnv(ClosesOnExit):
     the ego camera's frame at the end of the step (rendered H x W, one frame per step).
     Action: Box float32 (2,) = [steer in [-0.55, 0.55] rad, target speed in [0, 15] m/s].
     An action outside it raises ValueError.
+
+    DrivingEnv(scenario="X.xosc", ...) is a ScenarioDrivingEnv instead: one OpenSCENARIO run an
+    episode (scenario_env.py; docs/gym.md, "Scenario episodes").
     """
+
+    def __new__(cls, *args, scenario=None, **kwargs):
+        if scenario is not None:
+            from convoy_gym.scenario_env import ScenarioDrivingEnv
+            return ScenarioDrivingEnv(scenario, **kwargs)
+        return super().__new__(cls)
 
     metadata = {"render_modes": []}
     render_mode = None
 
     def __init__(self, config=DEFAULT_CONFIG, max_steps=1000, reward_fn=None,
-                 start_steps=20, start_speed=6.0, start_steer=0.05, physics_step=None,
-                 args="", address=None, log_output="", camera=None):
+                 start_steps=20, start_speed=6.0, start_steer=0.05, physics_step=PHYSICS_STEP,
+                 args="", address=None, log_output="", camera=None, shadows=True):
         """:param config: the simulation config; its folder is the experiment folder
         :param max_steps: steps per episode before `truncated`
         :param reward_fn: reward_fn(before, after, action) -> float; default_reward if None
         :param start_steps, start_speed, start_steer: reset(seed) drives 1 to start_steps
             steps at a speed in [0, start_speed] m/s and a steer in +-start_steer rad, all
             drawn from the seed, so each seed starts the episode from its own state
-        :param physics_step: the Gazebo world's physics step in s (None: the world's own,
-            1 ms on the Parkring); 0.005 runs about 3x faster, with coarser physics
+        :param physics_step: the Gazebo world's physics step in s (default PHYSICS_STEP,
+            5 ms; None: the world's own, 1 ms on the Parkring, about 2.5x slower)
         :param args: more NRPCoreSim options, e.g. "-o SimulationTimeout=600"
         :param address: HOST:PORT for the server (default: a free loopback port)
         :param log_output: file in the experiment folder for the server's output ("" none)
         :param camera: None, or (H, W): the observation also holds the ego camera's frame,
-            rendered H x W pixels once per step (see the class's docstring)
+            rendered H x W pixels once per step (see the class's docstring), with the sun's
+            shadow map sized to it (world_variant.shadow_map_size)
+        :param shadows: with a camera, False renders it without the sun's shadows (about
+            1.6x the steps/s at 84 x 84 on a CPU renderer)
         """
         self._nrp = None
         self._tmp = None
+        self._joint = None
         config = os.path.abspath(config)
         if not os.path.isfile(config):
             raise FileNotFoundError("DrivingEnv: config %s not found" % config)
@@ -117,6 +146,8 @@ class DrivingEnv(ClosesOnExit):
             high=np.array([inf, inf, np.pi, inf, np.pi, inf] + [inf] * (2 * N_AHEAD)),
             dtype=np.float32)
         self.observation_space = self.state_space
+        self._bounds = (self.state_space.low.astype(np.float32),
+                        self.state_space.high.astype(np.float32))
         self.camera = None
         if camera is not None:
             self.camera = check_camera(camera)
@@ -130,13 +161,19 @@ class DrivingEnv(ClosesOnExit):
         self._raw = None
         self._steps = 0
         run_config = config
+        with open(config) as f:
+            engines = json.load(f).get("EngineConfigs", [])
+        self._agent = any(e.get("EngineName") == "agent" for e in engines)
         if physics_step is not None or camera is not None:
-            run_config, self._tmp = variant_config(config, physics_step, self.camera)
+            run_config, self._tmp = variant_config(config, physics_step, self.camera,
+                                                   shadows=bool(shadows))
+        self._nrp_config = run_config  # the config the server runs
         try:
             self._nrp = NrpCore(address or _free_address(),
                                 experiment_folder=os.path.dirname(config),
                                 config_file=run_config, args=args, log_output=log_output)
             self._nrp.initialize()
+            self._joint = None if self._agent else self._nrp._message_class(JOINT_TYPE)
         except BaseException:
             self.close()
             raise
@@ -161,11 +198,11 @@ class DrivingEnv(ClosesOnExit):
         speed = float(options.get("start_speed", rng.uniform(0.0, max_speed)))
         steer = float(options.get("start_steer", rng.uniform(-max_steer, max_steer)))
         if self._needs_reset:
-            self._nrp.set_json_datapack("action", "agent", dict(STOP))
+            self._set_action(STOP["steer"], STOP["speed"])
             self._nrp.reset()
         self._needs_reset = True
         for _ in range(max(n, 1)):
-            self._raw = self._run({"steer": steer, "speed": speed})
+            self._raw = self._run(steer, speed)
         self._steps = 0
         info = self._info()
         info["start"] = {"steps": n, "speed": speed, "steer": steer}
@@ -180,7 +217,7 @@ class DrivingEnv(ClosesOnExit):
             raise RuntimeError("DrivingEnv.step() before reset()")
         a = self._check_action(action)
         before = self._raw
-        self._raw = self._run({"steer": float(a[0]), "speed": float(a[1])})
+        self._raw = self._run(float(a[0]), float(a[1]))
         self._steps += 1
         reward = float(self.reward_fn(before, self._raw, a))
         terminated = bool(self._raw["episode_over"])
@@ -231,8 +268,22 @@ class DrivingEnv(ClosesOnExit):
                                  % (i, name, a[i], high))
         return a
 
-    def _run(self, action):
-        self._nrp.set_json_datapack("action", "agent", action)
+    def _set_action(self, steer, speed):
+        """The action for the next run_loop() / reset(): the agent engine's datapack, or the
+        car's joint targets (drive_tf.py's: steer clamped to MAX_STEER, speed / radius)."""
+        nrp = self._nrp
+        if self._agent:
+            nrp.set_json_datapack("action", "agent", {"steer": steer, "speed": speed})
+            return
+        steer = max(-MAX_STEER, min(MAX_STEER, steer))
+        for name in STEERING_JOINTS:
+            nrp.set_proto_datapack(name, WORLD_ENGINE, self._joint(position=steer))
+        omega = speed / WHEEL_RADIUS
+        for name in WHEEL_JOINTS:
+            nrp.set_proto_datapack(name, WORLD_ENGINE, self._joint(velocity=omega))
+
+    def _run(self, steer, speed):
+        self._set_action(steer, speed)
         _, observations = self._nrp.run_loop(1)
         dicts = [o for o in observations if isinstance(o, dict)]
         if self.camera is not None and (dicts or self._frame is None):
@@ -277,7 +328,9 @@ class DrivingEnv(ClosesOnExit):
         for i in range(N_AHEAD):
             values += ahead[min(i, len(ahead) - 1)][:2]
         obs = np.asarray(values, dtype=np.float32)
-        return np.clip(obs, self.state_space.low, self.state_space.high)
+        # np.clip's result, without its overhead for small arrays
+        low, high = self._bounds
+        return np.minimum(np.maximum(obs, low, out=obs), high, out=obs)
 
     def _info(self):
         r = self._raw

@@ -11,7 +11,10 @@ variant_config(config, camera=(H, W)) also gives every camera sensor of the worl
 models in its models/ folder an H x W image and an update_rate of one frame per step of the
 config's smallest EngineTimestep (the models carrying one are copied: their other files
 linked, model.sdf rewritten), and runs the status function `<name>_camera.py` beside the
-config's `<name>.py` (rl_parkring: observe_camera.py, which returns the frame)."""
+config's `<name>.py` (rl_parkring: observe_camera.py, which returns the frame). The world
+engine's sun shadow map is then sized to the camera (shadow_map_size(): 256 texels a side for
+84 x 84 instead of 1024, the engine's ShadowMapSize unless the config sets one), and
+shadows=False turns the cameras' shadows off (the engine's Shadows)."""
 import json
 import os
 import re
@@ -77,6 +80,17 @@ def _models_with_camera(models, dest, camera, rate):
     return count
 
 
+def shadow_map_size(camera):
+    """The sun's shadow map for an H x W camera: the power of two of at least 3 texels per
+    pixel of the image's larger side, in [64, 1024] (1024: the world engine's default). The
+    map covers ShadowDistance (60 m) ahead of the camera: at 256 texels, 0.28 m a texel, about
+    what a pixel of an 84-pixel-wide, 90-degree image spans 10 m away."""
+    size = 64
+    while size < 3 * max(camera) and size < 1024:
+        size *= 2
+    return size
+
+
 def check_camera(camera):
     try:
         height, width = (int(v) for v in camera)
@@ -124,9 +138,10 @@ def _world_copy(world, sub, physics_step, camera, rate):
     return copy
 
 
-def variant_config(config, physics_step=None, camera=None):
+def variant_config(config, physics_step=None, camera=None, shadows=True):
     """Returns (path of the new config, its temporary folder: remove it after the run).
-    physics_step: the worlds' physics step in s (None: unchanged); camera: (H, W) or None."""
+    physics_step: the worlds' physics step in s (None: unchanged); camera: (H, W) or None;
+    shadows: False turns the cameras' sun shadows off."""
     if physics_step is not None:
         physics_step = float(physics_step)
         if not 0.0 < physics_step <= 0.05:
@@ -144,6 +159,10 @@ def variant_config(config, physics_step=None, camera=None):
     rate = 1.0 / min(steps) if steps else 20.0  # one frame per step of the loop
     if camera is not None:
         _camera_status(cfg, config)
+        for engine in worlds:
+            engine.setdefault("ShadowMapSize", shadow_map_size(camera))
+            if not shadows:
+                engine["Shadows"] = False
     tmp = tempfile.mkdtemp(prefix="convoy_gym_")
     try:
         for i, engine in enumerate(worlds):

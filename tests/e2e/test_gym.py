@@ -1,7 +1,8 @@
 """End-to-end tests of convoy_gym's DrivingEnv on experiments/rl_parkring: the gymnasium
 contract (reset / step shapes and dtypes, observations in the observation space), seeding
 (same seed -> the same episode bit for bit, another seed -> another), actions outside the
-space, termination and truncation, a custom reward, another physics step, and that close(),
+space, termination and truncation, a custom reward, another physics step, the lap completed
+at the default 5 ms physics step, a config with the python_json agent engine, and that close(),
 a `with` block and garbage collection leave no process behind. `Vector`: VectorDrivingEnv(2)
 (batch shapes, each sub-environment equal to a DrivingEnv with its seed, autoreset, a bad
 action naming the env, an error in one env closing all, no process left after close()).
@@ -11,7 +12,9 @@ for the same seed, bad camera arguments).
 
 Run: cd tests/e2e && CONVOY_BIN_DIR=../../build/bin /usr/bin/python3 -m unittest -v test_gym"""
 import gc
+import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -127,14 +130,18 @@ class DrivingEnvTest(unittest.TestCase):
         self.env.step([0.0, 1.0])  # still usable
 
     def test_leaving_the_track_terminates(self):
-        obs, _ = self.env.reset(seed=0)
+        obs, info = self.env.reset(seed=0)
         for i in range(200):
+            before = info
             obs, reward, terminated, truncated, info = self.env.step([0.55, 8.0])
             if terminated or truncated:
                 break
         self.assertTrue(terminated, "a full-lock circle should leave the track")
         self.assertFalse(truncated)
-        self.assertLessEqual(reward, -10.0)
+        # default_reward: waypoints gained, minus 0.1 per metre off the path, minus 10
+        self.assertAlmostEqual(reward, info["waypoint"] - before["waypoint"]
+                               - 0.1 * info["off_path"] - 10.0, places=9)
+        self.assertFalse(info["lap_done"])
         self.assertGreater(info["off_path"], 3.0)
 
 
@@ -177,6 +184,33 @@ class LifecycleTest(unittest.TestCase):
                 ends.append(obs)
             np.testing.assert_array_equal(ends[0], ends[1])
         self.assertFalse(os.path.exists(folder))
+
+    def test_lap_at_the_default_physics_step(self):
+        # DrivingEnv's default 5 ms physics step (PHYSICS_STEP) keeps the world's lap: the
+        # heading-error policy at 8 m/s completes it (about 2,640 steps, 132 s simulated)
+        with DrivingEnv(max_steps=4000) as env:
+            obs, info = env.reset(options={"start_steps": 1, "start_speed": 0.0,
+                                           "start_steer": 0.0})
+            for _ in range(4000):
+                action = [float(np.clip(0.8 * obs[4], -0.55, 0.55)), 8.0]
+                obs, reward, terminated, truncated, info = env.step(action)
+                if terminated or truncated:
+                    break
+            self.assertTrue(info["lap_done"], info)
+            self.assertLess(info["off_path"], 1.0)
+
+    def test_agent_engine_config(self):
+        # A config with rl_parkring's python_json "agent" engine gets the action as its
+        # datapack (drive_tf turns it into the joint targets), at the world's own step
+        config = os.path.join(REPO, "experiments", "rl_parkring", "simulation_config.json")
+        with DrivingEnv(config=config, physics_step=None, max_steps=40) as env:
+            self.assertIsNone(env._tmp)
+            obs, info = env.reset(seed=5)
+            start = obs
+            for _ in range(40):
+                obs, reward, terminated, truncated, info = env.step(policy(obs))
+            self.assertTrue(truncated)
+            self.assertGreater(float(np.hypot(*(obs[:2] - start[:2]))), 5.0)
 
     def test_close_and_garbage_collection(self):
         env = DrivingEnv()
@@ -370,6 +404,22 @@ class Camera(unittest.TestCase):
         self.assertIn("<width>80</width>", sdf)
         self.assertIn("<height>60</height>", sdf)
         self.assertIn("<update_rate>20.0</update_rate>", sdf)
+
+    def test_shadow_map_sized_to_the_camera(self):
+        from convoy_gym.world_variant import shadow_map_size, variant_config
+        self.assertEqual([shadow_map_size(c) for c in [(60, 80), (84, 84), (8, 8), (480, 736)]],
+                         [256, 256, 64, 1024])
+        # the running variant's world engine has it; shadows=False turns them off
+        with open(self.env._nrp_config) as f:
+            world = json.load(f)["EngineConfigs"][0]
+        self.assertEqual((world["ShadowMapSize"], world.get("Shadows")), (256, None))
+        path, tmp = variant_config(self.env.config, camera=(84, 84), shadows=False)
+        try:
+            with open(path) as f:
+                world = json.load(f)["EngineConfigs"][0]
+            self.assertEqual((world["ShadowMapSize"], world["Shadows"]), (256, False))
+        finally:
+            shutil.rmtree(tmp)
 
     def test_same_seed_same_frames(self):
         frames_a, states_a = self.episode(seed=5)

@@ -62,6 +62,13 @@ class ScenarioEnv(unittest.TestCase):
     def tearDownClass(cls):
         cls.env.close()
 
+    def test_driving_env_with_a_scenario_is_a_scenario_env(self):
+        from convoy_gym import DrivingEnv
+        with DrivingEnv(scenario=os.path.join(SUITE, "cut_in.xosc")) as env:
+            self.assertIsInstance(env, ScenarioDrivingEnv)
+            obs, _ = env.reset(seed=1)
+            self.assertTrue(env.observation_space.contains(obs))
+
     def test_spaces_and_tuples(self):
         env = self.env
         obs, info = env.reset(seed=3)

@@ -9,6 +9,7 @@ namespace convoy::world {
 void CameraDatapacks::configure(const WorldContext& ctx, const nlohmann::json& config) {
   ctx_ = &ctx;
   shadows_.distance = config.value("ShadowDistance", 60.0);
+  shadows_.map_size = config.value("ShadowMapSize", 1024);
   // As the world's <scene><shadows> says (SDF: on by default), unless the config says.
   shadows_.enabled = config.contains("Shadows") && config["Shadows"].is_boolean()
                          ? config["Shadows"].get<bool>()

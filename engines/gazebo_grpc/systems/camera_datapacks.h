@@ -1,7 +1,8 @@
 // Camera datapacks: the world's <sensor type="camera">s (camera_sensors.h renders them),
 // and the cameras' sun shadows.
 //
-// Config keys: Shadows (default: the world's <scene><shadows>), ShadowDistance (m, 60).
+// Config keys: Shadows (default: the world's <scene><shadows>), ShadowDistance (m, 60),
+// ShadowMapSize (texels a side, 1024).
 // Datapacks (each camera under NRP's plugin name and NRP-Core 1.4's scoped name):
 //   <camera plugin>::<sensor>, <model>::<link>::<sensor>  GazeboCameraDataPack, read
 //   ...::depth      JSON {"width", "height", "depth": float32 ndarray (metres)}
