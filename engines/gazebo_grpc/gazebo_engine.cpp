@@ -5,7 +5,8 @@
 // each, and forwards to them. Each system's header lists its config keys and datapacks.
 //
 // Config keys of the adapter: GazeboWorldFile, GazeboSDFModels [{Name, File, InitPose,
-// InitSpeed}] (model_inserts.h), GazeboRNGSeed (the camera noise), WorldLoadTime (accepted;
+// InitSpeed}] (model_inserts.h), Sensors (LiDARs, IMUs, GNSS mounted by config:
+// sensor_config.h), GazeboRNGSeed (the camera noise), WorldLoadTime (accepted;
 // loading is synchronous), EngineTimestep. The systems, in registration order (the order of their
 // calls):
 //   weather              systems/weather_input.h        <WeatherDataPack> (JSON, written)
@@ -26,6 +27,7 @@
 
 #include "engine/engine.h"
 #include "model_inserts.h"
+#include "sensor_config.h"
 #include "systems/brakes.h"
 #include "systems/camera_datapacks.h"
 #include "systems/contacts.h"
@@ -68,6 +70,7 @@ class GazeboEngine final : public Engine {
                                              int64_t timestep_ns) override {
     std::string loaded;
     world::WorldDesc desc = load(config, &loaded);
+    world::mount_config_sensors(config, timestep_ns * 1e-9, &desc);  // "Sensors"
     world_ = std::make_unique<world::WorldSystems>(std::move(desc),
                                                    config.value("GazeboRNGSeed", 0u), name);
     std::fprintf(stderr, "convoy: engine '%s': %s; physics %.3f s, cameras %.3f s\n", name.c_str(),

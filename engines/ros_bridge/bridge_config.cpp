@@ -80,6 +80,14 @@ BridgeConfig parse_config(const json& config) {
   if (!(c.camera_hfov > 0 && c.camera_hfov < 3.14159))
     throw key_error("CameraHorizontalFov",
                     "must be in (0, pi) rad, got " + config.at("CameraHorizontalFov").dump());
+  if (config.contains("SensorFrames")) {
+    for (const auto& [frame, id] : config.at("SensorFrames").items()) {
+      if (!id.is_string() || id.get<std::string>().empty() || id.get<std::string>()[0] == '/')
+        throw key_error("SensorFrames/" + frame,
+                        "must be a frame id (no leading '/'), got " + id.dump());
+      c.sensor_frames[frame] = id.get<std::string>();
+    }
+  }
   const json& subscribe = config.at("Subscribe");
   for (size_t i = 0; i < subscribe.size(); ++i) {
     const std::string key = "Subscribe/" + std::to_string(i);

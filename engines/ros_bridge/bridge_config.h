@@ -3,6 +3,7 @@
 // message header (those do not compile as C++20: they use std::allocator<void>::rebind).
 #pragma once
 
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -16,6 +17,10 @@ struct Frames {
 
 // The message types the bridge subscribes to.
 enum class InType { kControl, kTwist, kTwistStamped };
+
+// Frame ids of sensor messages by the sensor's datapack frame (<model>::<link>::<sensor>);
+// a sensor not listed keeps that name.
+using SensorFrames = std::map<std::string, std::string>;
 
 struct Subscription {
   std::string topic;
@@ -33,6 +38,7 @@ struct BridgeConfig {
   bool publish_clock = true;
   Frames frames;
   double camera_hfov = 1.57;
+  SensorFrames sensor_frames;  // SensorFrames
 };
 
 // "convoy_msgs/Control", "geometry_msgs/Twist", "geometry_msgs/TwistStamped".

@@ -11,6 +11,9 @@
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Imu.h>
+#include <sensor_msgs/NavSatFix.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/ColorRGBA.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -20,6 +23,8 @@
 
 #include "bridge_config.h"
 #include "convoy/datapacks.pb.h"
+#include "convoy/nav_sensors.pb.h"
+#include "convoy/point_cloud.pb.h"
 #include "convoy/road_users.pb.h"
 
 namespace convoy::ros_bridge {
@@ -64,6 +69,20 @@ std::vector<convoy_msgs::Event> events(const nlohmann::json& value, ros::Time st
 // {"path": [[x, y, z?, yaw?], ...]} as a nav_msgs/Path in frames.map. Throws
 // std::invalid_argument saying which point is malformed.
 nav_msgs::Path path(const nlohmann::json& value, const Frames& frames, ros::Time stamp);
+
+// --- LiDAR, IMU, GNSS (nav_conversions.cpp) -------------------------------------------------
+// Each is stamped with its reading's simulated time (time_ns) and framed by its `frame`
+// (<model>::<link>::<sensor>) or what SensorFrames maps it to.
+std::string sensor_frame(const std::string& frame, const SensorFrames& frames);
+// An unorganised cloud (height 1, one point a return, ring-major) with the datapack's fields
+// (x y z intensity instance label ring column flags), point_step 32, little-endian. Throws
+// std::invalid_argument for a dtype without a PointField type or bytes not whole points.
+sensor_msgs::PointCloud2 point_cloud2(const data::PointCloud& cloud, const SensorFrames& frames);
+// No orientation (SDF's enable_orientation false): orientation_covariance[0] = -1 (REP 145).
+// Covariances are 0 (unknown). Throws std::invalid_argument without 3 rates and 3 accelerations.
+sensor_msgs::Imu imu(const data::Imu& reading, const SensorFrames& frames);
+// STATUS_FIX by GPS, covariance unknown.
+sensor_msgs::NavSatFix navsat_fix(const data::NavSat& fix, const SensorFrames& frames);
 
 // --- Messages from ROS as JSON datapacks --------------------------------------------------
 nlohmann::json control_json(const convoy_msgs::Control& control);  // throttle brake steer ...

@@ -61,13 +61,20 @@ void RosBridgeEngine::queue(const datapack::View& dp) {
     node_->queue_link(topic, datapack::read_proto<data::Link>(dp), time_ns_);
   } else if (type == datapack::type_name<data::RoadUsers>()) {
     node_->queue_road_users(topic, datapack::read_proto<data::RoadUsers>(dp), time_ns_);
+  } else if (type == datapack::type_name<data::PointCloud>()) {
+    node_->queue_point_cloud(topic, datapack::read_proto<data::PointCloud>(dp));
+  } else if (type == datapack::type_name<data::Imu>()) {
+    node_->queue_imu(topic, datapack::read_proto<data::Imu>(dp));
+  } else if (type == datapack::type_name<data::NavSat>()) {
+    node_->queue_navsat(topic, datapack::read_proto<data::NavSat>(dp));
   } else if (dp.is_json()) {
     node_->queue_json(topic, datapack::read_json(dp), time_ns_);
   } else {
     throw std::invalid_argument("type " + (type.empty() ? std::string("?") : type) +
                                 ": the ros_bridge engine '" + name_ +
                                 "' publishes convoy.data.Camera, convoy.data.Link, "
-                                "convoy.data.RoadUsers and JSON {\"events\"} or {\"path\"} "
+                                "convoy.data.RoadUsers, convoy.data.PointCloud, convoy.data.Imu, "
+                                "convoy.data.NavSat and JSON {\"events\"} or {\"path\"} "
                                 "datapacks");
   }
 }

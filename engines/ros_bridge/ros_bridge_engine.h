@@ -19,6 +19,8 @@
 //   PublishClock        true                /clock each step, and /use_sim_time = true
 //   MapFrame, BaseFrame, CameraFrame        "map", "base_link", "camera"
 //   CameraHorizontalFov 1.57                rad, for camera_info
+//   SensorFrames        {}                  {"<model>::<link>::<sensor>": "frame id"} for the
+//                                           LiDAR, IMU and GNSS messages
 //
 // Datapacks read (published on the topic named like the datapack, stamped with the engine's
 // time at the start of the step, in the order received; all publishers are latched, so a
@@ -29,6 +31,11 @@
 //                          BaseFrame) and the transform on /tf
 //   convoy.data.RoadUsers  convoy_msgs/RoadUsers on NAME, visualization_msgs/MarkerArray on
 //                          NAME/markers
+//   convoy.data.PointCloud sensor_msgs/PointCloud2 on NAME (x y z intensity instance label ring
+//                          column flags, height 1), stamped with the scan's time
+//   convoy.data.Imu        sensor_msgs/Imu on NAME, stamped with the reading's time
+//   convoy.data.NavSat     sensor_msgs/NavSatFix on NAME, stamped with the reading's time
+//                          (the three framed <model>::<link>::<sensor>, or as SensorFrames maps it)
 //   JSON {"events": [...]}  a convoy_msgs/Event per item on NAME
 //   JSON {"path": [[x, y, z?, yaw?], ...]}  nav_msgs/Path on NAME
 //   anything else: an error naming the datapack and its type.

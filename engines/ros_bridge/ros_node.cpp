@@ -292,6 +292,26 @@ void RosNode::queue_road_users(const std::string& topic, const data::RoadUsers& 
   });
 }
 
+void RosNode::queue_point_cloud(const std::string& topic, const data::PointCloud& cloud) {
+  auto msg = boost::make_shared<sensor_msgs::PointCloud2>(
+      point_cloud2(cloud, impl_->config.sensor_frames));
+  ros::Publisher p = impl_->publisher<sensor_msgs::PointCloud2>(topic);
+  impl_->pending.push_back([p, msg] { p.publish(msg); });
+}
+
+void RosNode::queue_imu(const std::string& topic, const data::Imu& reading) {
+  auto msg = boost::make_shared<sensor_msgs::Imu>(imu(reading, impl_->config.sensor_frames));
+  ros::Publisher p = impl_->publisher<sensor_msgs::Imu>(topic);
+  impl_->pending.push_back([p, msg] { p.publish(msg); });
+}
+
+void RosNode::queue_navsat(const std::string& topic, const data::NavSat& fix) {
+  auto msg =
+      boost::make_shared<sensor_msgs::NavSatFix>(navsat_fix(fix, impl_->config.sensor_frames));
+  ros::Publisher p = impl_->publisher<sensor_msgs::NavSatFix>(topic);
+  impl_->pending.push_back([p, msg] { p.publish(msg); });
+}
+
 void RosNode::queue_json(const std::string& topic, const json& value, int64_t stamp_ns) {
   const bool has_events = value.is_object() && value.contains("events");
   const bool has_path = value.is_object() && value.contains("path");

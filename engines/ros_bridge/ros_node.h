@@ -12,6 +12,8 @@
 
 #include "bridge_config.h"
 #include "convoy/datapacks.pb.h"
+#include "convoy/nav_sensors.pb.h"
+#include "convoy/point_cloud.pb.h"
 #include "convoy/road_users.pb.h"
 
 namespace convoy::ros_bridge {
@@ -35,6 +37,10 @@ class RosNode {
                     std::string_view pixels, int64_t stamp_ns);
   void queue_link(const std::string& topic, const data::Link& link, int64_t stamp_ns);
   void queue_road_users(const std::string& topic, const data::RoadUsers& users, int64_t stamp_ns);
+  // Sensors: stamped with their reading's time, not `stamp_ns`'s step (conversions.h).
+  void queue_point_cloud(const std::string& topic, const data::PointCloud& cloud);
+  void queue_imu(const std::string& topic, const data::Imu& reading);
+  void queue_navsat(const std::string& topic, const data::NavSat& fix);
   // {"events": [...]} or {"path": [...]}.
   void queue_json(const std::string& topic, const nlohmann::json& value, int64_t stamp_ns);
 

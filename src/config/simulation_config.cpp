@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "config/json_schema.h"
+#include "config/sensor_keys.h"
 
 namespace convoy::config {
 namespace {
@@ -469,6 +470,7 @@ SimulationConfig load_simulation_config(const fs::path& file,
   }
   std::vector<std::pair<std::string, std::string>> errors, warnings;
   read_graph_keys(doc, config, &errors, &warnings);
+  read_engine_sensor_keys(config.engines, &errors);  // gazebo_grpc's Sensors (sensor_keys.h)
   for (const auto& [pointer, message] : errors) report.add(pointer, message);
   for (const auto& [pointer, message] : warnings) report.add(pointer, message, true);
   report.throw_if_errors();
