@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "core/error.h"
 #include "engine/engine.h"
 #include "model_inserts.h"
 #include "sensor_config.h"
@@ -69,8 +70,13 @@ class GazeboEngine final : public Engine {
   std::vector<engine::DataPackId> initialize(const std::string& name, const nlohmann::json& config,
                                              int64_t timestep_ns) override {
     std::string loaded;
-    world::WorldDesc desc = load(config, &loaded);
-    world::mount_config_sensors(config, timestep_ns * 1e-9, &desc);  // "Sensors"
+    world::WorldDesc desc;
+    try {  // the world file, its models and the config's sensors: the user's input (exit 2)
+      desc = load(config, &loaded);
+      world::mount_config_sensors(config, timestep_ns * 1e-9, &desc);  // "Sensors"
+    } catch (const std::runtime_error& e) {
+      throw UserError(e.what());
+    }
     world_ = std::make_unique<world::WorldSystems>(std::move(desc),
                                                    config.value("GazeboRNGSeed", 0u), name);
     std::fprintf(stderr, "convoy: engine '%s': %s; physics %.3f s, cameras %.3f s\n", name.c_str(),
@@ -87,8 +93,14 @@ class GazeboEngine final : public Engine {
     world_->add<world::NavSensors>();
     world_->add<world::EgoState>();
     world_->add<world::Contacts>();
+    std::vector<world::ProvidedDataPack> provided;
+    try {  // the systems' config keys and the sensors' parameters: the user's input
+      provided = world_->configure(config);
+    } catch (const std::runtime_error& e) {
+      throw UserError(e.what());
+    }
     std::vector<engine::DataPackId> ids;
-    for (const auto& p : world_->configure(config)) {
+    for (const auto& p : provided) {
       engine::DataPackId& id = ids.emplace_back();
       id.set_name(p.name);
       id.set_engine_name(name);

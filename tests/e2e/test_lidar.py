@@ -16,7 +16,7 @@ import unittest
 
 from e2e_util import REPO, E2ETestCase
 
-EXIT_ENGINE = 3  # the world engine refuses its world in initialize (see BadInput)
+EXIT_USER = 2  # the world engine refuses its world in initialize: the user's input (see BadInput)
 
 LIDAR = """
         <sensor name="lidar" type="gpu_lidar">
@@ -156,7 +156,7 @@ class BadInput(LidarCase):
     def check(self, *needles, **kw):
         self.experiment(**kw)
         r = self.run_convoy(timeout=60)
-        self.assertExit(r, EXIT_ENGINE)
+        self.assertExit(r, EXIT_USER)
         self.assertStderrHas(r, "model 'sensor_car' link 'lidar_link' sensor 'lidar'", *needles)
         self.assertOneError(r)
         self.assertNoEngineLeft()

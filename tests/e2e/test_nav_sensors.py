@@ -22,7 +22,7 @@ import unittest
 
 from e2e_util import REPO, E2ETestCase
 
-EXIT_ENGINE = 3  # the world engine refuses its world in initialize (as test_lidar's)
+EXIT_USER = 2  # the world engine refuses its world in initialize: the user's input
 LAT0, LON0, ELEV0 = 48.2082, 16.3738, 171.0
 
 NOISE = ("<noise type=\"gaussian\"><mean>0</mean><stddev>{stddev}</stddev>"
@@ -189,7 +189,7 @@ class Readings(NavCase):
 
 class BadInput(NavCase):
     def assertRefused(self, r, *parts):
-        self.assertExit(r, EXIT_ENGINE)
+        self.assertExit(r, EXIT_USER)
         for p in parts:
             self.assertIn(p, r.stderr, r)
         self.assertNoEngineLeft()
