@@ -55,6 +55,9 @@ def _parser():
     p.add_argument("--record", action="store_true",
                    help="record each run (RUN_DIR/recording.mcap); report.html links each to the "
                         "dashboard: open it with `convoy view OUT_DIR`")
+    p.add_argument("--perception", choices=("ground_truth", "sensors"),
+                   help="the default ego's perception in OpenSCENARIO runs (convoy run --scenario "
+                        "--perception; default: ground_truth); leaderboard.csv's perception column")
     p.add_argument("--build", help="Convoy's build folder, for bin/convoy (default "
                                    "<repo>/build, or $CONVOY_BIN_DIR/convoy when set)")
     p.add_argument("--poll", type=float, default=1.0, help="seconds between Slurm polls")
@@ -132,7 +135,8 @@ def _campaign(args):
         entries = load_suite(args.suite)
         out = os.path.abspath(args.out or os.path.join(
             "campaigns", os.path.basename(os.path.normpath(os.path.abspath(args.suite)))))
-        plan = make_plan(entries, args.seeds, weathers, out, convoy, args.seconds, args.record)
+        plan = make_plan(entries, args.seeds, weathers, out, convoy, args.seconds, args.record,
+                         args.perception)
         os.makedirs(out, exist_ok=True)
         _lock_out(out)
         state = CampaignState.open(out, plan, args.backend)

@@ -14,7 +14,9 @@ Per task (collect):
 
 leaderboard.csv: one row per task, sorted by (scenario, seed, weather); columns COLUMNS:
 scenario, seed, weather, parameters (a parameter distribution variant's values,
-`name=value;...` in the distribution's order; empty for other entries), driving_score,
+`name=value;...` in the distribution's order; empty for other entries), perception (the
+reference agent's: "ground_truth" or "sensors", from the run's summary.json, else the
+campaign's --perception; empty when neither says), driving_score,
 route_completion, infraction_penalty (empty without a score), one count per infraction kind of INFRACTION_KINDS (the score's infractions with
 "counted" not false; empty without a score), exit_code (empty when unknown), wall_s (3
 decimals; empty when unknown). Numbers are written as Python's repr of the float, so the file
@@ -34,7 +36,7 @@ INFRACTION_KINDS = ("collision_pedestrian", "collision_vehicle", "collision_stat
                     "stop_sign", "scenario_timeout", "yield_emergency", "min_speed", "off_route",
                     "off_road", "wrong_way", "agent_blocked")
 SCORE_COLUMNS = ("driving_score", "route_completion", "infraction_penalty")
-COLUMNS = ("scenario", "seed", "weather", "parameters") + SCORE_COLUMNS + INFRACTION_KINDS + ("exit_code", "wall_s")
+COLUMNS = ("scenario", "seed", "weather", "parameters", "perception") + SCORE_COLUMNS + INFRACTION_KINDS + ("exit_code", "wall_s")
 
 
 def load_scorer():
@@ -71,12 +73,15 @@ def collect(plan, state, scorer=None, scorer_missing=None):
     records = []
     for task, st in zip(plan["tasks"], state.tasks):
         rec = {"name": task["name"], "scenario": task["scenario"], "seed": task["seed"],
-               "weather": task["weather"], "parameters": task.get("parameters") or {}, "config": task["config"], "run_dir": task["run_dir"],
+               "weather": task["weather"], "parameters": task.get("parameters") or {},
+               "perception": task.get("perception"), "config": task["config"], "run_dir": task["run_dir"],
                "state": st["state"], "exit_code": st["exit_code"], "wall_s": st["wall_s"],
                "attempts": st["attempts"], "log": st["log"], "reason": st["reason"],
                "summary": _read_json(os.path.join(task["run_dir"], "summary.json")),
                "score": None, "score_error": None}
         live = rec["summary"]
+        if isinstance(live.get("perception"), str):
+            rec["perception"] = live["perception"]   # what the run says it used
         if st["exit_code"] != 0:
             rec["score_error"] = "the run did not succeed"
         elif isinstance(live.get("score"), dict) and "driving_score" in live:
@@ -114,7 +119,7 @@ def leaderboard_rows(records):
     rows = []
     for r in records:
         row = {"scenario": r["scenario"], "seed": r["seed"], "weather": r["weather"],
-               "parameters": parameters_label(r.get("parameters"))}
+               "parameters": parameters_label(r.get("parameters")), "perception": r.get("perception")}
         score = r["score"]
         for k in SCORE_COLUMNS:
             v = score.get(k) if score else None

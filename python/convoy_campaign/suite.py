@@ -260,12 +260,20 @@ def task_name(scenario, seed, weather):
     return "%s__s%d__%s" % (scenario, seed, weather)
 
 
-def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=False):
+def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=False, perception=None):
     """The campaign's plan: {"version", "out", "convoy", "seconds", "seeds", "weathers",
     "record", "tasks": [{"index", "name", "scenario", "seed", "weather", "config", "run_dir",
     "argv", ["parameters"]}]} ("parameters": a distribution variant's, when it has any). With `record` each run also writes RUN_DIR/recording.mcap (`convoy run
-    --record`), which report.html links to the dashboard."""
+    --record`), which report.html links to the dashboard. With `perception` ("ground_truth" or
+    "sensors": the default ego's, `convoy run --scenario --perception`) each OpenSCENARIO task
+    runs with it, and the plan and its tasks say so ("perception"); a simulation-config entry
+    is then bad input (its ego is the config's)."""
     out_dir = os.path.abspath(out_dir)
+    if perception is not None:
+        for e in entries:
+            if e["type"] == ".json":
+                raise SuiteError("--perception %s: applies to OpenSCENARIO entries; %s is a simulation "
+                                 "config (its ego is the config's)" % (perception, e["source"]))
     tasks = []
     for e in entries:
         for seed in range(seeds):
@@ -273,7 +281,7 @@ def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=Fa
                 name = task_name(e["name"], seed, weather)
                 run_dir = os.path.join(out_dir, "runs", name)
                 argv = ENTRY_TYPES[e["type"]](e, seed, weather, {
-                    "convoy": convoy, "run_dir": run_dir, "seconds": seconds})
+                    "convoy": convoy, "run_dir": run_dir, "seconds": seconds, "perception": perception})
                 if record:
                     argv.insert(argv.index("run") + 1, "--record")  # after `convoy run`
                 task = {"index": len(tasks), "name": name, "scenario": e["name"],
@@ -281,6 +289,11 @@ def make_plan(entries, seeds, weathers, out_dir, convoy, seconds=None, record=Fa
                         "run_dir": run_dir, "argv": argv}
                 if e.get("parameters"):
                     task["parameters"] = dict(e["parameters"])
+                if perception is not None:
+                    task["perception"] = perception
                 tasks.append(task)
-    return {"version": 1, "out": out_dir, "convoy": convoy, "seconds": seconds, "seeds": seeds,
+    plan = {"version": 1, "out": out_dir, "convoy": convoy, "seconds": seconds, "seeds": seeds,
             "weathers": list(weathers), "record": bool(record), "tasks": tasks}
+    if perception is not None:
+        plan["perception"] = perception
+    return plan

@@ -1,7 +1,7 @@
 """The campaign runner's `.xosc` entry type (docs/campaigns.md, "Adding an entry type";
 docs/scenarios.md, "Campaigns"): a task runs
 
-    convoy run -q --scenario FILE.xosc --run-dir RUN_DIR [-o SimulationTimeout=S]
+    convoy run -q --scenario FILE.xosc --run-dir RUN_DIR [--perception P] [-o SimulationTimeout=S]
         -o EngineConfigs/0/GazeboRNGSeed=<seed> -o EngineConfigs/1/Seed=<seed>
         [-o EngineConfigs/1/<Key>=<value> ...]   the campaign's weather, unless it is "clear"
         -o <the entry's overrides>
@@ -19,6 +19,8 @@ WEATHER_INDEX = 1
 
 def xosc_command(entry, seed, weather, options):
     argv = [options["convoy"], "run", "-q", "--scenario", entry["config"], "--run-dir", options["run_dir"]]
+    if options.get("perception"):   # the campaign's --perception
+        argv += ["--perception", options["perception"]]
     o = []
     if options.get("seconds") is not None:
         o.append("SimulationTimeout=%s" % _override_value(float(options["seconds"])))

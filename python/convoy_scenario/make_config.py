@@ -16,7 +16,10 @@ runs; docs/scenarios.md, "Running a scenario"):
   has traffic lights;
 - the scenario engine (engines/scenario) driving the entities, and the ego: the report's PID
   waypoint follower (experiments/city_traffic/ego_driver.py) with the ego planner
-  (ground-truth input), the camera and Convoy's detector, on the ego's route;
+  (ground-truth input), the camera and Convoy's detector, on the ego's route; with
+  --perception sensors the smart car with a roof LiDAR (models/smart_car_lidar) whose planner
+  drives on the detector's boxes ranged by the LiDAR (perception_tf.py; docs/scenarios.md,
+  "Perception: ground truth or sensors");
 - the transceiver functions (scenario_tf, traffic_tf, the ego's), the live driving score
   (python/convoy_bench/metrics_tf.py) and the status function that ends the run when the
   scenario is done.
@@ -32,7 +35,7 @@ for a parked car, `convoy.MidBlockProbability`).
 
 Usage: /usr/bin/python3 -m convoy_scenario.make_config SCENARIO.xosc --out CONFIG.json
            [--world WORLD.sdf] [--ego FRAGMENT.json] [--param NAME=VALUE]... [--bin-dir DIR]
-           [--snapshots T1,T2]
+           [--snapshots T1,T2] [--perception ground_truth|sensors]
 The route CSV is written next to CONFIG.json (ego_route.csv). Every path in the config is
 absolute. Exit 2 with one message on bad input."""
 
@@ -73,6 +76,8 @@ MAPS = {
     os.path.join(AD, "parkring.xodr"): os.path.join(AD, "parkring_road_no_ego.sdf"),
 }
 EGO_MODEL = os.path.join(CITY, "models", "smart_car", "model.sdf")
+EGO_MODEL_LIDAR = os.path.join(CITY, "models", "smart_car_lidar", "model.sdf")
+PERCEPTIONS = ("ground_truth", "sensors")
 AGENT_DT = 0.05
 WORLD_DT = 0.02
 DETECTOR_DT = 0.1
@@ -165,11 +170,30 @@ def route_length(scenario):
     return max(40.0, min(300.0, 0.5 * CRUISE * duration))
 
 
-def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0.0, speed=0.0):
+def planner_config(perception, out_dir):
+    """The ego planner's parameter file: the city's; for sensors a copy with Input "sensors"
+    written into out_dir."""
+    path = os.path.join(CITY, "ego_planner.json")
+    if perception == "ground_truth":
+        return path
+    with open(path) as f:
+        cfg = json.load(f)
+    cfg["Input"] = perception
+    out = os.path.join(os.path.abspath(out_dir), "ego_planner_%s.json" % perception)
+    with open(out, "w") as f:
+        json.dump(cfg, f, indent=2)
+        f.write("\n")
+    return out
+
+
+def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0.0, speed=0.0,
+                perception="ground_truth", out_dir="."):
     """The report's smart car as the ego, at `pose` (x, y, yaw), rolling at the ego's Init
-    `speed` (m/s; forward only: a negative one starts it at rest)."""
+    `speed` (m/s; forward only: a negative one starts it at rest). With perception "sensors"
+    the smart car carries a roof LiDAR and its planner takes perception_tf's objects."""
     x, y, yaw = pose
-    out_engines[0]["GazeboSDFModels"] = [{"Name": "smart_car", "File": EGO_MODEL,
+    model = EGO_MODEL_LIDAR if perception == "sensors" else EGO_MODEL
+    out_engines[0]["GazeboSDFModels"] = [{"Name": "smart_car", "File": model,
                                           "InitPose": [x, y, z, 0.0, pitch, yaw],
                                           "InitSpeed": max(0.0, float(speed))}]
     # the smart car's meshes (model://smart_car/...) are found next to its model
@@ -181,8 +205,8 @@ def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0
         {"EngineType": "python_json", "EngineName": "planner",
          "PythonFileName": os.path.join(REPO, "experiments", "ego_planner", "ego_planner_engine.py"),
          "EngineTimestep": WORLD_DT,
-         "EngineEnvParams": ["CONVOY_EGO_PLANNER_CONFIG=" + os.path.join(CITY, "ego_planner.json"),
-                             "CONVOY_EGO_ROUTE=" + route_csv]},
+         "EngineEnvParams": ["CONVOY_EGO_PLANNER_CONFIG=" + planner_config(perception, out_dir),
+                             "CONVOY_EGO_ROUTE=" + route_csv, "CONVOY_PERCEPTION=" + perception]},
         {"EngineType": "detector", "EngineName": "yolo_detector", "Backend": "convoy",
          "EngineTimestep": DETECTOR_DT},
     ]
@@ -191,15 +215,21 @@ def default_ego(world_sdf, pose, route_csv, out_engines, out_tfs, z=0.0, pitch=0
         {"Name": "motor_tf", "FileName": os.path.join(REPO, "experiments", "ego_planner", "motor_tf.py")},
         {"Name": "camera_tf", "FileName": os.path.join(AD, "camera_tf.py")},
         {"Name": "detection_tf", "FileName": os.path.join(REPO, "python", "convoy_bench", "detection_tf.py")},
+        {"Name": "perception_tf", "FileName": os.path.join(HERE, "perception_tf.py")},
     ]
     return "gazebo/smart_car::road_user"
 
 
 def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin_dir=None, snapshots=None,
-          scenery="auto"):
+          scenery="auto", perception="ground_truth"):
     """(config dict, ego route points [[x, y, heading]], scored route length)."""
     scenario = load(xosc, parameters=parameters or None)
     base = os.path.basename(xosc)
+    if perception not in PERCEPTIONS:
+        raise ScenarioError("--perception %r: expected one of %s" % (perception, ", ".join(PERCEPTIONS)))
+    if perception != "ground_truth" and ego_fragment:
+        raise ScenarioError("--perception %s is the default ego's (the smart car's); it does not go "
+                            "with --ego %s" % (perception, ego_fragment))
     if ego_fragment == "scenario":
         return build_exact(scenario, xosc, parameters, stop_time)
     if not scenario.logic_file:
@@ -283,7 +313,7 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
             engines[0]["GazeboSDFModels"] = frag["GazeboSDFModels"]
     else:
         ego_state = default_ego(world_sdf, ego_pose, route_csv, engines, tfs, *ego_surface,
-                                speed=player.states[ego].speed)
+                                speed=player.states[ego].speed, perception=perception, out_dir=out_dir)
     if has_lights:
         engines.append({"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": AGENT_DT,
                         "Map": xodr, "Leader": "self", "Green": 15.0, "Yellow": 3.0, "AllRed": 2.0})
@@ -318,10 +348,11 @@ def build(xosc, world=None, ego_fragment=None, parameters=None, out_dir=".", bin
     return config, drive, scored_len
 
 
-def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapshots=None, scenery="auto"):
+def write(xosc, out, world=None, ego=None, parameters=None, bin_dir=None, snapshots=None, scenery="auto",
+          perception="ground_truth"):
     out_dir = os.path.dirname(os.path.abspath(out))
     os.makedirs(out_dir, exist_ok=True)
-    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots, scenery)
+    config, drive, _ = build(xosc, world, ego, parameters, out_dir, bin_dir, snapshots, scenery, perception)
     # the scenario as read here, handed to the scenario engine (read once: parsed.py)
     parsed = os.path.join(out_dir, "scenario.parsed")
     save_parsed(load(xosc, parameters=parameters or None), xosc, parameters, parsed)
@@ -362,10 +393,13 @@ def main(argv=None):
     ap.add_argument("--bin-dir", help="where convoy-odr is")
     ap.add_argument("--snapshots", help="T1,T2,...: save the ego camera's frame at these simulated "
                     "seconds as camera_<t>s.png in the run folder (the default ego only)")
+    ap.add_argument("--perception", default="ground_truth", choices=list(PERCEPTIONS),
+                    help="the default ego's perception: ground_truth (the world's road users, the "
+                    "default) or sensors (the detector's boxes ranged by a roof LiDAR, tracked)")
     a = ap.parse_args(argv)
     try:
         snaps = [float(t) for t in a.snapshots.split(",")] if a.snapshots else None
-        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir, snaps, a.scenery)
+        write(a.scenario, a.out, a.world, a.ego, dict(a.param), a.bin_dir, snaps, a.scenery, a.perception)
     except ScenarioError as e:
         print("error: %s" % e, file=sys.stderr)
         return 2

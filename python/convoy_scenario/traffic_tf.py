@@ -43,7 +43,9 @@ AGENTS = [e["EngineName"] for e in ENGINES if e.get("EngineType") in ("vehicle_a
 LIGHTS = next((e for e in ENGINES if e.get("EngineType") == "traffic_lights"), None)
 WORLD = next((e["EngineName"] for e in ENGINES if e.get("EngineType") == "gazebo_grpc"), None)
 SCENARIO = next((e for e in ENGINES if e.get("EngineType") == "scenario"), None)
-PLANNER = "planner" if any(e["EngineName"] == "planner" for e in ENGINES) else None
+# the planner's input is built here unless perception_tf.py builds it (--perception sensors)
+PLANNER = "planner" if any(e["EngineName"] == "planner" and "CONVOY_PERCEPTION=sensors" not in
+                           e.get("EngineEnvParams", []) for e in ENGINES) else None
 EGO_DP = None
 if SCENARIO is not None:
     spec = (SCENARIO.get("Entities") or {}).get(SCENARIO.get("EgoName", "Ego"), "")

@@ -21,9 +21,11 @@ import json
 import math
 import tempfile
 
-SOURCES = ("ground_truth", "detections")
+SOURCES = ("ground_truth", "detections", "sensors")
 SOURCE_LABELS = {"ground_truth": "ground-truth objects (the world's RoadUsers, not perception)",
-                 "detections": "detector boxes ranged in the camera's depth image"}
+                 "detections": "detector boxes ranged in the camera's depth image",
+                 "sensors": "sensor perception: detector boxes ranged by LiDAR points (depth "
+                            "image when too few), tracked (convoy_traffic.fusion)"}
 
 # key: (default, minimum, maximum)
 PARAMETERS = {

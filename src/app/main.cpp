@@ -27,7 +27,8 @@ void usage(const char* prog) {
       "                  [--record] [--record-blobs] [--live [HOST:]PORT [--insecure]]\n"
       "       %s run --scenario FILE.xosc [--world WORLD.sdf] [--scenery KIND] [--ego "
       "FRAGMENT.json|scenario]\n"
-      "                [--scenario-param NAME=VALUE]... [-o Key=Value]... [--run-dir DIR]\n"
+      "                [--scenario-param NAME=VALUE]... [--perception KIND] [-o Key=Value]...\n"
+      "                [--run-dir DIR]\n"
       "                [--quiet] [--record]\n"
       "       %s replay RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
       "       %s score RUN_DIR [--out DIR] [-c CONFIG] [-o Key=Value]... [--quiet]\n"
@@ -67,6 +68,8 @@ void usage(const char* prog) {
       "  --ego FILE          with --scenario: a config fragment with the user's ego engines\n"
       "  --scenario-param NAME=VALUE  with --scenario: a value of one of the scenario's\n"
       "                      global parameters (repeatable)\n"
+      "  --perception KIND   with --scenario: the default ego's perception: ground_truth\n"
+      "                      (default) or sensors (detector boxes ranged by a roof LiDAR)\n"
       "  --ego scenario      with --scenario: the scenario moves the ego too, exactly as its\n"
       "                      actions say (as esmini does; no camera, no stack under test)\n"
       "  -o, --param K=V     override a config key; K may be a path like "
@@ -242,7 +245,7 @@ int main(int argc, char** argv) {
   }
   convoy::app::RunOptions options;
   std::string mode = "standalone", dir, log_output, log_filename = ".console_output.log";
-  std::string scenario, world, ego, scenery;
+  std::string scenario, world, ego, scenery, perception;
   std::vector<std::string> scenario_params;
   std::optional<convoy::python::Interpreter> scenario_python;
   for (; i < argc; ++i) {
@@ -275,6 +278,8 @@ int main(int argc, char** argv) {
       scenery = value();
     else if (a == "--scenario-param")
       scenario_params.push_back(value());
+    else if (a == "--perception")
+      perception = value();
     else if (a == "-q" || a == "--quiet")
       options.quiet = true;
     else if (a == "--record")
@@ -374,11 +379,14 @@ int main(int argc, char** argv) {
     }
     // the interpreter stays up for the run: its functions find the scenario already read
     scenario_python.emplace();
-    if (!convoy::app::prepare_scenario({scenario, world, ego, scenery, scenario_params}, options))
+    if (!convoy::app::prepare_scenario({scenario, world, ego, scenery, scenario_params, perception},
+                                       options))
       return 2;
-  } else if (!world.empty() || !ego.empty() || !scenery.empty() || !scenario_params.empty()) {
+  } else if (!world.empty() || !ego.empty() || !scenery.empty() || !scenario_params.empty() ||
+             !perception.empty()) {
     std::fprintf(stderr,
-                 "error: --world, --scenery, --ego and --scenario-param go with --scenario\n");
+                 "error: --world, --scenery, --ego, --scenario-param and --perception go with "
+                 "--scenario\n");
     return 2;
   }
   if (options.config_file.empty()) {

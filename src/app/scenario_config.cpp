@@ -76,6 +76,7 @@ bool prepare_scenario(const ScenarioRequest& r, RunOptions& options) {
     args.insert(args.end(), {"--ego", r.ego == "scenario" ? r.ego : fs::absolute(r.ego).string()});
   if (!r.scenery.empty()) args.insert(args.end(), {"--scenery", r.scenery});
   for (const auto& p : r.params) args.insert(args.end(), {"--param", p});
+  if (!r.perception.empty()) args.insert(args.end(), {"--perception", r.perception});
   if (run_make_config(args) != 0) {
     std::fprintf(stderr, "error: --scenario %s: no config could be made (run folder %s)\n",
                  r.scenario.c_str(), options.run_dir.c_str());

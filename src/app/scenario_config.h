@@ -17,6 +17,7 @@ struct ScenarioRequest {
   std::string ego;                  // --ego: a fragment, or "scenario"
   std::string scenery;              // --scenery
   std::vector<std::string> params;  // --scenario-param NAME=VALUE
+  std::string perception;           // --perception: ground_truth (default) or sensors
 };
 
 // Writes RUN_DIR/scenario_config.json (creating the run folder, default

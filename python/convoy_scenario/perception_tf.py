@@ -1,0 +1,165 @@
+"""The reference agent's perception in a scenario run (make_config.py --perception;
+docs/scenarios.md, "Perception: ground truth or sensors"), at the planner's rate.
+
+The mode is the planner engine's CONVOY_PERCEPTION (EngineEnvParams), "ground_truth" when it
+has none. It is written once into summary.json as `perception` (with `perception_label`), so
+the run and the campaign's leaderboard say which perception drove the ego.
+
+- ground_truth: nothing else here; traffic_tf.py gives the planner the world's road users.
+- sensors: this function builds the planner's `planner_input` (source "sensors"; traffic_tf
+  then leaves it out): the detector's boxes (its `detections`, from the camera's frames) ranged
+  by the roof LiDAR's cloud (`<ego model>::base_link::roof_lidar`, the smart_car_lidar model),
+  the camera's depth image when a box has too few returns (convoy_traffic.fusion), tracked
+  over the detector's frames for velocities (ego_planner.Tracker). Traffic lights are not
+  detected: a red (or too late yellow) light of the ego's approach comes from the lights
+  engine's state as a standing object at its stop line, as traffic_tf does (labelled
+  source "traffic_lights").
+
+The counts (perception_boxes, perception_ranged_by_lidar / _depth, perception_rejected_by_lidar:
+near boxes without LiDAR returns, dropped as phantoms; perception_lidar_only: obstacles in the
+ego's way the LiDAR saw and no box explained, fusion.lidar_obstacles) are written every simulated
+second of detections. CONVOY_PERCEPTION_DUMP=N (debugging) saves the first N frames from
+CONVOY_PERCEPTION_DUMP_FROM s on (default 0; the boxes, the cloud's x, y, z, label, instance and
+flags, the fused objects) as RUN_DIR/perception_<frame>.npz."""
+
+import math
+import os
+import sys
+
+from nrp_core import *  # noqa: F401,F403
+from nrp_core.data.nrp_json import JsonDataPack
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+from convoy_bench.run_files import load_config, update_summary  # noqa: E402
+from convoy_traffic.ego_planner import SOURCE_LABELS, Tracker, ego_state, objects_from_road_users  # noqa: E402
+
+CONFIG = load_config()
+ENGINES = CONFIG.get("EngineConfigs", [])
+PLANNER = next(e for e in ENGINES if e.get("EngineName") == "planner")
+MODE = next((p.split("=", 1)[1] for p in PLANNER.get("EngineEnvParams", [])
+             if p.startswith("CONVOY_PERCEPTION=")), "ground_truth")
+WORLD = next(e["EngineName"] for e in ENGINES if e.get("EngineType") == "gazebo_grpc")
+DETECTOR = next((e["EngineName"] for e in ENGINES if e.get("EngineType") == "detector"), None)
+LIGHTS = next((e for e in ENGINES if e.get("EngineType") == "traffic_lights"), None)
+SCENARIO = next((e for e in ENGINES if e.get("EngineType") == "scenario"), None)
+EGO_SPEC = ((SCENARIO or {}).get("Entities") or {}).get((SCENARIO or {}).get("EgoName", "Ego"), "")
+EGO_WORLD, EGO_DP = EGO_SPEC.split("/", 1) if "/" in EGO_SPEC else (WORLD, "smart_car::road_user")
+EGO_MODEL = EGO_DP.split("::", 1)[0]
+LIDAR_DP = EGO_MODEL + "::base_link::roof_lidar"
+CAMERA_DEPTH = "smart_camera::camera::depth"
+STOP_LOOKAHEAD = 60.0    # m, as traffic_tf.py
+YELLOW_STOP_DECEL = 3.0  # m/s^2, as traffic_tf.py
+
+LABELS = {"ground_truth": SOURCE_LABELS["ground_truth"], "sensors": SOURCE_LABELS["sensors"]}
+_state = {"written": False, "tracker": Tracker(), "frame": None, "objects": [],
+          "ranged": {"lidar": 0, "depth": 0, "rejected": 0, "lidar_only": 0}, "boxes": 0, "last_write": 0.0,
+          "dump": int(os.environ.get("CONVOY_PERCEPTION_DUMP", "0") or 0),
+          "dump_from": float(os.environ.get("CONVOY_PERCEPTION_DUMP_FROM", "0") or 0)}
+
+if MODE == "sensors":
+    import numpy as np  # noqa: E402
+    from convoy_sensors.point_cloud import points  # noqa: E402
+    from convoy_traffic.fusion import Rig, accepted, fuse, lidar_obstacles  # noqa: E402
+    RIG = Rig.smart_car_lidar()
+    STOP_LINES = []
+    if LIGHTS is not None:
+        from convoy_scenario.stop_lines import stop_lines  # noqa: E402
+        STOP_LINES = stop_lines(LIGHTS["Map"])
+
+
+def stop_line_object(e, signals):
+    """The ego's red light as a RoadUser dict standing at its stop line, or None."""
+    reach = e["length_offset"] + 0.5 * e["length"]
+    fx, fy = e["x"] + reach * math.cos(e["yaw"]), e["y"] + reach * math.sin(e["yaw"])
+    for line in STOP_LINES:
+        d = line.ahead(fx, fy, e["yaw"])
+        if d is None or d < -0.5 or d > STOP_LOOKAHEAD:
+            continue
+        state = signals.get(line.id, "off")
+        stop = state in ("red", "red_yellow") or (
+            state == "yellow" and e["speed"] ** 2 <= 2.0 * YELLOW_STOP_DECEL * max(d, 0.0))
+        if not stop:
+            return None
+        cx, cy = line.centre()
+        return {"id": "stop_line:" + line.id, "category": "car",
+                "x": cx + 0.1 * math.cos(line.heading), "y": cy + 0.1 * math.sin(line.heading),
+                "yaw": line.heading, "length": 0.2, "width": 3.0, "length_offset": 0.0}
+    return None
+
+
+def _summary():
+    fields = {"perception": MODE, "perception_label": LABELS.get(MODE, MODE)}
+    if MODE == "sensors":
+        fields["perception_boxes"] = _state["boxes"]
+        fields["perception_ranged_by_lidar"] = _state["ranged"]["lidar"]
+        fields["perception_ranged_by_depth"] = _state["ranged"]["depth"]
+        fields["perception_rejected_by_lidar"] = _state["ranged"]["rejected"]
+        fields["perception_lidar_only"] = _state["ranged"]["lidar_only"]
+    update_summary(fields)
+
+
+def _sensors(ego, detections, scan, depth, lights):
+    e = ego_state(ego.data)
+    det = None if detections is None or detections.isEmpty() else detections.data
+    if det is not None and "detections" in det and det.get("frame") != _state["frame"]:
+        _state["frame"] = det.get("frame")
+        xyz = flags = None
+        if scan is not None and not scan.isEmpty():
+            p = points(scan)
+            xyz = np.stack([p["x"], p["y"], p["z"]], axis=1)
+            flags = p["flags"]
+        dimg = None if depth is None or depth.isEmpty() else depth.data["depth"]
+        boxes = list(det["detections"])
+        objs = fuse(RIG, boxes, xyz, flags=flags, depth=dimg)
+        objs += lidar_obstacles(RIG, xyz, flags, objects=accepted(objs))
+        _state["boxes"] += len(boxes)
+        for o in objs:
+            _state["ranged"][o["ranged_by"]] += 1
+        _state["objects"] = _state["tracker"].update(accepted(objs), det.get("time_ns", 0) * 1e-9,
+                                                     e["speed"])
+        t = det.get("time_ns", 0) * 1e-9
+        if t - _state["last_write"] >= 1.0:
+            _state["last_write"] = t
+            _summary()
+        if _state["dump"] > 0 and t >= _state["dump_from"]:
+            _state["dump"] -= 1
+            _dump(boxes, scan, objs)
+    objects = list(_state["objects"])
+    signals = dict(lights.data["signals"]) if lights is not None and not lights.isEmpty() else {}
+    line = stop_line_object(e, signals) if STOP_LINES else None
+    if line is not None:
+        objects += [dict(o, source="traffic_lights") for o in objects_from_road_users(e, [line])]
+    return [JsonDataPack("planner_input", "planner", {"source": "sensors", "ego": e, "objects": objects})]
+
+
+def _dump(boxes, scan, objs):
+    import json
+    p = points(scan) if scan is not None and not scan.isEmpty() else None
+    path = os.path.join(os.environ.get("CONVOY_RUN_DIR", "."), "perception_%s.npz" % _state["frame"])
+    np.savez(path, boxes=json.dumps(boxes), objects=json.dumps(objs),
+             **({k: np.array(p[k]) for k in ("x", "y", "z", "label", "instance", "flags")} if p is not None else {}))
+
+
+def _perception(ego, detections=None, scan=None, depth=None, lights=None):
+    if not _state["written"]:
+        _state["written"] = True
+        _summary()
+    if MODE != "sensors" or ego.isEmpty():
+        return []
+    return _sensors(ego, detections, scan, depth, lights)
+
+
+perception = _perception
+if MODE == "sensors":
+    if DETECTOR is None:
+        raise RuntimeError("perception_tf: --perception sensors needs the detector engine (EngineType "
+                           "detector) in the config")
+    if LIGHTS is not None:
+        perception = EngineDataPack(keyword="lights", id=DataPackIdentifier(
+            "traffic_lights", LIGHTS["EngineName"]))(perception)
+    perception = EngineDataPack(keyword="depth", id=DataPackIdentifier(CAMERA_DEPTH, WORLD))(perception)
+    perception = EngineDataPack(keyword="scan", id=DataPackIdentifier(LIDAR_DP, WORLD))(perception)
+    perception = EngineDataPack(keyword="detections", id=DataPackIdentifier("detections", DETECTOR))(perception)
+perception = EngineDataPack(keyword="ego", id=DataPackIdentifier(EGO_DP, EGO_WORLD))(perception)
+perception = TransceiverFunction("planner")(perception)
