@@ -308,9 +308,9 @@ class GrpcService final : public engine::Engine::Service {
     std::lock_guard<std::mutex> lock(mutex_);  // one call at a time, in arrival order
     engine::Reply reply = queue_.submit(request);
     if (!reply.error().empty())  // a user's input fault travels as INVALID_ARGUMENT
-      return grpc::Status(reply.user_error() ? grpc::StatusCode::INVALID_ARGUMENT
-                                             : grpc::StatusCode::INTERNAL,
-                          reply.error());
+      return grpc::Status(
+          reply.user_error() ? grpc::StatusCode::INVALID_ARGUMENT : grpc::StatusCode::INTERNAL,
+          reply.error());
     take(reply);
     return grpc::Status::OK;
   }

@@ -35,8 +35,8 @@ std::unique_ptr<WorldSystems> nav_world(const std::string& rate = "100") {
 TEST(WorldNavSensors, DatapacksUnderBothNames) {
   auto world = nav_world();
   const auto provided = world->configure({{"EngineTimestep", 0.01}});
-  EXPECT_EQ(names(provided), (std::vector<std::string>{"ball::body::imu", "imu_plugin::imu",
-                                                       "ball::body::gnss"}));
+  EXPECT_EQ(names(provided),
+            (std::vector<std::string>{"ball::body::imu", "imu_plugin::imu", "ball::body::gnss"}));
   EXPECT_EQ(provided[0].type, "convoy.data.Imu");
   EXPECT_EQ(provided[2].type, "convoy.data.NavSat");
 }
