@@ -115,7 +115,7 @@ void ExternalProcesses::start(RunLog& log) {
     spec.log_file = log_dir_ / external_log_name(words[0], i);
     spec.search_dirs = {bin_dir()};
     try {
-      started_.push_back({proc.cmd, launch::launch(spec)});
+      started_.push_back({proc.cmd, launch::launch(spec), spec.log_file});
     } catch (const std::exception& e) {
       stop(&log);
       throw UserError(config_file_.string() + ": " + proc.pointer + "/ProcCmd \"" + proc.cmd +
@@ -142,6 +142,15 @@ size_t ExternalProcesses::running() const {
   size_t n = 0;
   for (const auto& p : started_) n += p.child.running() ? 1 : 0;
   return n;
+}
+
+std::optional<ExternalProcesses::Failure> ExternalProcesses::first_failure() {
+  for (auto& p : started_) {
+    if (!p.child.running() || !p.child.poll()) continue;
+    const std::string how = p.child.describe();
+    if (how != "exited with status 0") return Failure{"\"" + p.cmd + "\" " + how, p.log};
+  }
+  return std::nullopt;
 }
 
 }  // namespace convoy::app

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,11 +47,19 @@ class ExternalProcesses {
   // that had already ended on its own.
   void stop(RunLog* log);
   size_t running() const;
+  // The first one that has ended with a failure (a non-zero status or a signal): what it was
+  // and how it ended ("\"cmd\" exited with status 2"), and its log; nullopt if none.
+  struct Failure {
+    std::string what;
+    std::filesystem::path log;
+  };
+  std::optional<Failure> first_failure();
 
  private:
   struct Started {
     std::string cmd;
     launch::ChildProcess child;
+    std::filesystem::path log;
   };
   const std::vector<config::ExternalProcessConfig>& procs_;
   std::filesystem::path config_file_, config_dir_, log_dir_;

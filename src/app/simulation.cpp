@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "app/engine_set.h"
+#include "app/event_loop_run.h"
 #include "app/external_processes.h"
 #include "app/live_run.h"
 #include "app/nrp_server.h"
@@ -256,15 +257,21 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
     log.error(e);
     return kExitUserError;
   }
-  if (cfg->loop != "FTILoop")
-    log.info("warning: SimulationLoop " + cfg->loop + " is not available yet; running FTILoop");
+  const bool event_loop = cfg->loop == "EventLoop";
+  if (event_loop && !cfg->engines.empty())
+    log.info(
+        "warning: SimulationLoop EventLoop with EngineConfigs is not available yet; running "
+        "the FTILoop (the graph in it, as DataPackProcessor cg)");
   if (cfg->process_launcher_type != "Basic")
     log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
              " is not available; using Basic");
   // ComputationalGraph, EventLoop and ExternalProcesses are the config's (its warnings say
-  // when they are ignored); MQTTNode and ROSNode are read, but the graph has no client yet.
+  // when they are ignored); MQTTNode and ROSNode are used by the EventLoop without engines.
+  const bool graph_clients = event_loop && cfg->engines.empty();
   for (const char* key : {"ConnectROS", "ConnectMQTT", "EventLoopTimeout", "EventLoopTimestep",
                           "ROSNode", "MQTTNode"}) {
+    if (graph_clients && (std::string(key) == "ROSNode" || std::string(key) == "MQTTNode"))
+      continue;
     // An object counts when present ("ROSNode": {} starts a node with the defaults in NRP-Core);
     // an empty list asks for nothing.
     if (cfg->json.contains(key) && (!cfg->json[key].empty() || cfg->json[key].is_object())) {
@@ -390,8 +397,15 @@ int run_simulation(const RunOptions& options) {
       return report(cfg, run_dir, log, figures, 0, refused);
     }
   }
-  Outcome outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup,
-                                live ? live->tap() : nullptr, live ? live->gate() : nullptr);
+  Outcome outcome;
+  if (cfg.loop == "EventLoop" && cfg.engines.empty()) {
+    export_run_environment(run_dir);
+    python::Interpreter interpreter;
+    outcome = run_event_loop(cfg, run_dir, log, &figures);
+  } else {
+    outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup,
+                          live ? live->tap() : nullptr, live ? live->gate() : nullptr);
+  }
   const double wall_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
   nlohmann::json live_fields;
   if (live) live_fields = {{"live", live->finish()}};

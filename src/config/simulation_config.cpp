@@ -336,6 +336,11 @@ SimulationConfig load_simulation_config(const fs::path& file,
     }
   }
 
+  // NRP-Core's EventLoop may run without engines (its mqtt_simple example has no EngineConfigs).
+  if (doc.is_object() && !doc.contains("EngineConfigs") && doc.contains("SimulationLoop") &&
+      doc["SimulationLoop"] == "EventLoop")
+    doc["EngineConfigs"] = json::array();
+
   // Refused before anything else: validating (and later starting) them all would take long.
   if (doc.is_object() && doc.contains("EngineConfigs") && doc["EngineConfigs"].is_array() &&
       doc["EngineConfigs"].size() > kMaxEngines) {

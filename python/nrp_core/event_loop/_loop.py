@@ -4,6 +4,7 @@ that NRP-Core's Python module exports for asynchronous engines.
 """
 import abc
 import logging
+import os
 import threading
 import time
 
@@ -46,11 +47,12 @@ class EventLoop:
         self.graph.compute()
         self.iterations += 1
 
-    def run(self, timeout=0.0):
-        """Runs cycles until `timeout` seconds have passed (0: until stop())."""
+    def run(self, timeout=0.0, should_stop=None):
+        """Runs cycles until `timeout` seconds have passed (0: until stop(), or until
+        should_stop() is true: checked before each cycle)."""
         self._stop.clear()
         start = last = self._clock()
-        while not self._stop.is_set():
+        while not self._stop.is_set() and not (should_stop and should_stop()):
             now = self._clock()
             elapsed_ms = int((now - start) * 1000)
             if timeout and now - start >= timeout:
@@ -166,3 +168,71 @@ class EventLoopInterface(abc.ABC):
     @abc.abstractmethod
     def _shutdown_cb(self):
         raise NotImplementedError
+
+
+class EventLoopRun:
+    """The coordinator's SimulationLoop "EventLoop" without engines (NRP-Core 1.4's
+    EventLoopSimManager): connect() makes the config's MQTTNode client (starting mosquitto
+    on a local MQTTBroker no broker answers on) and ROSNode node; load() the
+    ComputationalGraph; run() cycles every EventLoop.Timestep until EventLoop.Timeout wall
+    seconds; close() disconnects and stops what connect() started.
+
+    `config` is the simulation config (a dict with defaults filled or not); `log_dir` holds
+    mosquitto's log. Errors are ComputationalGraphError naming the key."""
+
+    def __init__(self, config, log_dir):
+        self.config = config
+        self.log_dir = log_dir
+        loop = config.get("EventLoop") or {}
+        self.timeout = float(loop.get("Timeout", 0.0))
+        self.timestep = float(loop.get("Timestep", 0.01))
+        self.warn_threshold = float(loop.get("TimestepWarnThreshold", 0.001))
+        self.exec_mode = loop.get("ExecutionMode", "AllNodes")
+        self.mqtt = self.ros = self.broker = self.graph = self.loop = None
+
+    def connect(self):
+        from ._mqtt import DEFAULT_BROKER, LocalBroker, MqttConnection, MqttError
+        from ._policies import ComputationalGraphError
+        node = self.config.get("MQTTNode")
+        if node is not None:
+            address = node.get("MQTTBroker", DEFAULT_BROKER)
+            try:
+                self.broker = LocalBroker.ensure(address, os.path.join(self.log_dir,
+                                                                       "mosquitto.log"))
+                if self.broker is not None:
+                    _log.info("started mosquitto on %s for the run", address)
+                self.mqtt = MqttConnection(address, node.get("ClientName", "NRP-core-client"))
+            except (MqttError, ValueError) as e:
+                self.close()
+                raise ComputationalGraphError("MQTTNode.MQTTBroker: %s" % e) from None
+        if self.config.get("ROSNode") is not None:
+            from ._rospy_transport import RospyInterface
+            self.ros = RospyInterface(self.config["ROSNode"].get("NodeName", "nrp_core"))
+
+    def load(self, files, base_dir):
+        from ._loader import load_computational_graph
+        from ._policies import ExecutionMode
+        from ._transport import Transports
+        mode = ExecutionMode.OUTPUT_DRIVEN if self.exec_mode == "OutputDriven" else \
+            ExecutionMode.ALL_NODES
+        self.graph = load_computational_graph(files, mode, Transports(self.mqtt, self.ros),
+                                              base_dir=base_dir)
+        self.loop = EventLoop(self.graph, self.timestep, self.warn_threshold, ros=self.ros)
+
+    def run(self, should_stop=None):
+        """Runs the loop; returns the number of cycles."""
+        _log.info("Creating Event Loop with configuration: timestep=%d(ms), timeout=%d(ms)",
+                  int(1000 * self.timestep), int(1000 * self.timeout))
+        self.loop.run(self.timeout, should_stop)
+        return self.loop.iterations
+
+    def close(self):
+        if self.mqtt is not None:
+            self.mqtt.close()
+            self.mqtt = None
+        if self.ros is not None:
+            self.ros.shutdown()
+            self.ros = None
+        if self.broker is not None:
+            self.broker.stop()
+            self.broker = None

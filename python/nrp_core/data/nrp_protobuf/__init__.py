@@ -217,6 +217,18 @@ def _raw_data_class(type_name, name):
     return cls
 
 
+def _nrp_message_class(name):
+    """NRP-Core's <Package><Message> class (GazeboJoint is nrp_protobuf.gazebo_pb2.Joint)."""
+    for package in ("Gazebo", "Dump", "EngineTest", "NrpGenericProto", "Wrappers"):
+        if name.startswith(package) and len(name) > len(package):
+            try:
+                module = importlib.import_module("nrp_protobuf.%s_pb2" % package.lower())
+            except ImportError:
+                return None
+            return getattr(module, name[len(package):], None)
+    return None
+
+
 def __getattr__(name):
     # `from nrp_core.data.nrp_protobuf import RoadUserDataPack`: any registered type's class;
     # `...RawData`: its RawData class.
@@ -230,6 +242,10 @@ def __getattr__(name):
             type_name = registry.types().get(name)
             if type_name is not None:
                 return _datapack_class(type_name)
+    # NRP-Core's message classes: GazeboJoint, DumpString... (<Package><Message>).
+    cls = None if name.endswith(("DataPack", "RawData")) else _nrp_message_class(name)
+    if cls is not None:
+        return cls
     raise AttributeError("module %r has no attribute %r" % (__name__, name))
 
 
