@@ -1,4 +1,4 @@
-"""NRP-Core 1.4's event-loop examples' node files (tests/data/nrp_event_loop, NRP-Core's own,
+"""NRP-Core 1.4's event-loop examples' node files (experiments/nrp_event_loop, NRP-Core's own,
 unchanged) loaded by nrp_core.event_loop and run a few cycles against a fake MQTT broker."""
 import json
 import os
@@ -12,7 +12,8 @@ import nrp_core.event_loop as el
 from nrp_core.event_loop import Transports, load_computational_graph
 from test_event_loop import FakeBroker, GraphTest, _proto_class
 
-EXAMPLES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "nrp_event_loop")
+EXAMPLES = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "experiments",
+                        "nrp_event_loop")
 UPSTREAM = "/tmp/nrpsrc/examples/event_loop_examples"
 
 
