@@ -3,9 +3,11 @@
 #include "sensor_config.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 namespace convoy::world {
 namespace {
@@ -13,7 +15,11 @@ namespace {
 using nlohmann::json;
 
 WorldDesc world() {
-  const auto file = std::filesystem::temp_directory_path() / "convoy_sensor_config_test.sdf";
+  // One file per test and process: ctest runs this binary's tests side by side.
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("convoy_sensor_config_" + std::string(test->name()) + "_" +
+                     std::to_string(::getpid()) + ".sdf");
   std::ofstream(file) << R"(<?xml version="1.0"?><sdf version="1.7"><world name="w">
     <model name="car"><pose>1 2 0 0 0 0</pose><link name="body"><inertial><mass>1</mass>
     </inertial></link></model></world></sdf>)";
