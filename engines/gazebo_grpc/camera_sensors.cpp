@@ -77,8 +77,10 @@ VehicleExtent vehicle_extent(const ModelDesc& model) {
 
 }  // namespace
 
-CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed)
+CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed,
+                             render::MeshFileCache* files, KeptCameras kept)
     : physics_(physics), rng_(seed) {
+  if (files) files_ = files;
   for (const auto& model : desc.models)
     for (const auto& link : model.links)
       for (const auto& cam : link.cameras) {
@@ -93,32 +95,32 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
     for (const auto& link : model.links) lidars = lidars || !link.lidars.empty();
   if (cameras_.empty() && !lidars) return;
   has_scene_ = true;
+  for (auto& cam : cameras_)
+    if (cam.desc->format == "L8" || cam.desc->format == "L_INT8") cam.depth_channels = 1;
   // Gaussian noise comes from a fixed table read at a random offset per frame: as random as
   // a camera needs, deterministic for a seed, and far cheaper than a draw per pixel. The tables
   // take about as long as the renderer and the scene, which touch neither rng_ nor the
   // cameras' noise, so they are drawn meanwhile in a thread of their own (the same draws in
-  // the same order: the same tables).
+  // the same order: the same tables). A world made again takes them, and the renderer, from
+  // the last one (`kept`: the same description and seed, so the same tables).
+  const bool reuse = kept.has_noise && kept.noise.size() == cameras_.size();
   double noise_s = 0;
-  std::thread noise([this, &noise_s] {
+  std::thread noise([this, &noise_s, reuse, &kept] {
     const auto start = std::chrono::steady_clock::now();
-    std::normal_distribution<double> normal(0.0, 1.0);
-    for (auto& cam : cameras_) {
-      if (cam.desc->format == "L8" || cam.desc->format == "L_INT8") cam.depth_channels = 1;
-      if (!cam.desc->noise || cam.desc->noise_stddev <= 0) continue;
-      // 2^20 starting points, each followed by a whole frame's worth of samples
-      cam.noise.resize((size_t{1} << 20) +
-                       static_cast<size_t>(cam.desc->width) * cam.desc->height * 3);
-      for (auto& v : cam.noise) {
-        v = static_cast<int16_t>(
-            std::lround(255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
-      }
+    if (reuse) {
+      for (size_t i = 0; i < cameras_.size(); ++i) cameras_[i].noise = std::move(kept.noise[i]);
+      rng_ = kept.rng;
+    } else {
+      draw_noise_tables();
     }
+    rng_after_tables_ = rng_;
     noise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
   const auto t0 = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point t1, t2;
   try {
-    if (!cameras_.empty()) renderer_ = std::make_unique<render::Renderer>();
+    if (!cameras_.empty())
+      renderer_ = kept.renderer ? std::move(kept.renderer) : std::make_unique<render::Renderer>();
     t1 = std::chrono::steady_clock::now();
     build_scene(desc);
     t2 = std::chrono::steady_clock::now();
@@ -130,6 +132,29 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
   auto s = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   std::fprintf(stderr, "convoy: cameras: renderer %.3f s, scene %.3f s, noise %.3f s (alongside)\n",
                s(t0, t1), s(t1, t2), noise_s);
+}
+
+void CameraSensors::draw_noise_tables() {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (auto& cam : cameras_) {
+    if (!cam.desc->noise || cam.desc->noise_stddev <= 0) continue;
+    // 2^20 starting points, each followed by a whole frame's worth of samples
+    cam.noise.resize((size_t{1} << 20) +
+                     static_cast<size_t>(cam.desc->width) * cam.desc->height * 3);
+    for (auto& v : cam.noise) {
+      v = static_cast<int16_t>(
+          std::lround(255.0 * (cam.desc->noise_mean + cam.desc->noise_stddev * normal(rng_))));
+    }
+  }
+}
+
+KeptCameras CameraSensors::release_kept() {
+  KeptCameras k;
+  k.renderer = std::move(renderer_);
+  for (auto& cam : cameras_) k.noise.push_back(std::move(cam.noise));
+  k.rng = rng_after_tables_;
+  k.has_noise = has_scene_;
+  return k;
 }
 
 CameraSensors::~CameraSensors() = default;
@@ -197,13 +222,12 @@ const std::vector<CameraSensors::FilePart>& CameraSensors::file_mesh(const std::
   auto [it, fresh] = file_meshes_.try_emplace(path + key_scale);
   if (!fresh) return it->second;
   try {
-    for (auto& part :
-         render::load_mesh(path, {static_cast<float>(scale.x()), static_cast<float>(scale.y()),
-                                  static_cast<float>(scale.z())})) {
+    for (const auto& part :
+         files_->load(path, {static_cast<float>(scale.x()), static_cast<float>(scale.y()),
+                             static_cast<float>(scale.z())})) {
       int texture = part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
       render::Material material = part.material(texture);
-      it->second.push_back(
-          {scene_.add_mesh_levels(render::simplified_levels(std::move(part.mesh))), material});
+      it->second.push_back({scene_.add_mesh_levels(part.levels()), material});
     }
   } catch (...) {
     file_meshes_.erase(it);

@@ -13,6 +13,7 @@
 #include "core/two_way.h"
 #include "datapack/datapack.h"
 #include "physics_world.h"
+#include "render/mesh_loader.h"
 #include "render/renderer.h"
 #include "weather_effects.h"
 #include "world_description.h"
@@ -25,11 +26,27 @@ struct VehicleExtent {
   double front = 2.0, height = 0.0;
 };
 
+// What a world made again (the same description and seed) takes over from the last one's
+// cameras: the renderer (its EGL context) and the cameras' noise tables, with the generator
+// as it was after drawing them.
+struct KeptCameras {
+  std::unique_ptr<render::Renderer> renderer;
+  std::vector<std::vector<int16_t>> noise;  // by camera
+  std::mt19937_64 rng;
+  bool has_noise = false;
+};
+
 class CameraSensors {
  public:
-  // Builds the scene. The renderer (EGL) starts only if the world has a camera.
-  CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed);
+  // Builds the scene. The renderer (EGL) starts only if the world has a camera. Mesh files
+  // come through `files` when given (kept by the caller across worlds made again), else
+  // through a cache of its own; `kept`: from release_kept() of the same world's last cameras.
+  CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics, uint64_t seed,
+                render::MeshFileCache* files = nullptr, KeptCameras kept = {});
   ~CameraSensors();
+  // Hands the renderer and the noise tables over (for the next CameraSensors of this world);
+  // this one renders no more.
+  KeptCameras release_kept();
 
   size_t count() const { return cameras_.size(); }
   // How many times camera i has rendered: its datapacks change only when this does.
@@ -162,6 +179,7 @@ class CameraSensors {
   };
   const std::vector<FilePart>& file_mesh(const std::string& path, const Eigen::Vector3d& scale);
   void build_scene(const WorldDesc& desc);
+  void draw_noise_tables();
   // The scene's lights, sky and atmosphere for camera `cam` under weather_.
   void apply_weather(const Camera& cam, const Eigen::Isometry3d& camera_pose);
   // Adds the scene instances of a link's visuals, the link placed at `placement`, labelled
@@ -183,11 +201,14 @@ class CameraSensors {
   std::vector<Tracked> tracked_;
   std::vector<Actor> actors_;
   std::map<std::string, std::vector<FilePart>> file_meshes_;  // by path and scale
+  render::MeshFileCache own_files_;
+  render::MeshFileCache* files_ = &own_files_;
   std::map<std::pair<std::string, std::string>, std::vector<int>>
       visual_instances_;                                  // (link, visual) -> scene instances
   std::vector<std::string> model_names_, model_classes_;  // by model_id - 1
   std::mt19937_64 rng_;
-  mutable TwoWay split_;  // the frame conversion's second thread
+  std::mt19937_64 rng_after_tables_;  // rng_ once the noise tables were drawn
+  mutable TwoWay split_;              // the frame conversion's second thread
   double now_ = 0;
   std::vector<render::Light> base_lights_;
   std::vector<bool> street_light_;  // by base light

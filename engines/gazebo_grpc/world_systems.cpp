@@ -16,11 +16,13 @@ WorldSystems::WorldSystems(WorldDesc desc, uint64_t seed, const std::string& eng
 }
 
 void WorldSystems::make_world() {
+  KeptCameras kept = cameras_ ? cameras_->release_kept() : KeptCameras{};
   cameras_.reset();
   const auto t0 = std::chrono::steady_clock::now();
   physics_ = std::make_unique<PhysicsWorld>(desc_);
   const auto t1 = std::chrono::steady_clock::now();
-  cameras_ = std::make_unique<CameraSensors>(desc_, *physics_, seed_);
+  cameras_ =
+      std::make_unique<CameraSensors>(desc_, *physics_, seed_, &mesh_files_, std::move(kept));
   physics_s_ = std::chrono::duration<double>(t1 - t0).count();
   cameras_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   ctx_.physics = physics_.get();

@@ -50,8 +50,9 @@ class WorldSystems {
   // The datapack `name` from the first system that provides it (left empty if none does).
   void get_datapack(const std::string& name, datapack::Builder& out);
   bool unchanged(const std::string& name);
-  // The world as loaded: the physics and cameras made again, the clock at 0, every system
-  // reset.
+  // The world as loaded: the physics and cameras made again (mesh files, the renderer and
+  // the cameras' noise tables kept from before: the same, and costly to make), the clock at
+  // 0, every system reset.
   void reset();
 
   const WorldContext& context() const { return ctx_; }
@@ -68,6 +69,7 @@ class WorldSystems {
   uint64_t seed_;
   std::unique_ptr<PhysicsWorld> physics_;
   std::unique_ptr<CameraSensors> cameras_;
+  render::MeshFileCache mesh_files_;  // read once for every world made again
   WorldContext ctx_;
   std::vector<std::unique_ptr<WorldSystem>> systems_;
   std::unordered_map<std::string, WorldSystem*> provider_;  // datapack name -> system

@@ -156,4 +156,18 @@ std::vector<LoadedMesh> load_mesh(const std::string& path, const std::array<floa
   return parts;
 }
 
+const MeshLevels& LoadedMesh::levels() const {
+  if (!levels_) levels_ = std::make_shared<const MeshLevels>(simplified_levels(mesh));
+  return *levels_;
+}
+
+const std::vector<LoadedMesh>& MeshFileCache::load(const std::string& path,
+                                                   const std::array<float, 3>& scale) {
+  const auto key = std::make_pair(path, scale);
+  if (auto it = meshes_.find(key); it != meshes_.end()) return it->second;
+  std::vector<LoadedMesh> parts = load_mesh(path, scale);
+  ++files_read_;
+  return meshes_.emplace(key, std::move(parts)).first->second;
+}
+
 }  // namespace convoy::render

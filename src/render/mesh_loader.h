@@ -7,6 +7,8 @@
 #pragma once
 
 #include <array>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,10 +31,29 @@ struct LoadedMesh {
 
   // The part's material, drawn with the given Scene texture (-1: none).
   Material material(int texture = -1) const;
+  // simplified_levels(mesh), made on the first call and kept.
+  const MeshLevels& levels() const;
+
+ private:
+  mutable std::shared_ptr<const MeshLevels> levels_;
 };
 
 // Throws std::runtime_error naming the file if it cannot be read or holds no triangles.
 std::vector<LoadedMesh> load_mesh(const std::string& path,
                                   const std::array<float, 3>& scale = {1, 1, 1});
+
+// load_mesh's results kept for the life of the cache (as Gazebo's MeshManager keeps a
+// process's meshes): a world made again (a reset) reads each file once, not once a reset.
+// A file that fails is not kept (the next call reads it again and throws again).
+class MeshFileCache {
+ public:
+  const std::vector<LoadedMesh>& load(const std::string& path,
+                                      const std::array<float, 3>& scale = {1, 1, 1});
+  size_t files_read() const { return files_read_; }
+
+ private:
+  std::map<std::pair<std::string, std::array<float, 3>>, std::vector<LoadedMesh>> meshes_;
+  size_t files_read_ = 0;
+};
 
 }  // namespace convoy::render

@@ -120,6 +120,21 @@ TEST(PoseTest, RollPitchYawAndQuaternionAgree) {
   EXPECT_EQ(c[12], 1);
 }
 
+TEST_F(MeshFiles, TheCacheReadsAFileOnceForEachScaleAndKeepsNoFailure) {
+  const std::string obj = write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  MeshFileCache cache;
+  const auto& first = cache.load(obj);
+  EXPECT_EQ(&cache.load(obj), &first);  // the same parts, not read again
+  EXPECT_EQ(cache.files_read(), 1u);
+  EXPECT_EQ(max_corner(cache.load(obj, {2, 2, 2})[0].mesh), (std::array<float, 3>{2, 2, 0}));
+  EXPECT_EQ(cache.files_read(), 2u);
+  EXPECT_EQ(&first[0].levels(), &first[0].levels());  // simplified once
+  EXPECT_EQ(first[0].levels().meshes.at(0).triangle_count(), 1u);
+  EXPECT_THROW(cache.load((dir_ / "missing.obj").string()), std::runtime_error);
+  EXPECT_THROW(cache.load((dir_ / "missing.obj").string()), std::runtime_error);  // tried again
+  EXPECT_EQ(cache.files_read(), 2u);
+}
+
 TEST_F(MeshFiles, LoadsObjWithMaterialAndScale) {
   write("part.mtl", "newmtl paint\nKd 0.2 0.4 0.6\nKs 0.5 0.5 0.5\nNs 50\n");
   const std::string obj = write("part.obj",
