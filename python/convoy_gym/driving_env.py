@@ -171,7 +171,8 @@ class DrivingEnv(ClosesOnExit):
         try:
             self._nrp = NrpCore(address or _free_address(),
                                 experiment_folder=os.path.dirname(config),
-                                config_file=run_config, args=args, log_output=log_output)
+                                config_file=run_config, args=args, log_output=log_output,
+                                local_channel=True)
             self._nrp.initialize()
             self._joint = None if self._agent else self._nrp._message_class(JOINT_TYPE)
         except BaseException:

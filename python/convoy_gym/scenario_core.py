@@ -308,7 +308,7 @@ class ScenarioSim:
         try:
             self.config, self.info = build_episode_config(scenario, self.tmp, learning, parameters, timeout)
             self.nrp = NrpCore(free_address(), experiment_folder=self.tmp, config_file=self.config,
-                               args=args, log_output=log_output)
+                               args=args, log_output=log_output, local_channel=True)
             self.nrp.initialize()
         except BaseException:
             self.close()

@@ -83,6 +83,8 @@ void usage(const char* prog) {
       "                      Python client (python/nrp_client) at --server_address\n"
       "  --server_address HOST:PORT   where the server listens (loopback addresses only,\n"
       "                      unless --insecure)\n"
+      "  --local_socket PATH with -m server: the same calls at a Unix socket too, for a\n"
+      "                      client on this machine (framed protobuf; src/transport/local_rpc.h)\n"
       "  --slave             started by a client: ignore Ctrl-C, end when the client ends\n"
       "  --logoutput all|engines|silent   all: this program's output into --logfilename;\n"
       "                      silent: none; engines: (engines log into the run folder anyway)\n"
@@ -296,6 +298,8 @@ int main(int argc, char** argv) {
       options.slave = true;
     else if (a == "--insecure")
       options.insecure = true;
+    else if (a == "--local_socket")
+      options.local_socket = value();
     else if (a == "--live")
       options.live = value();
     else if (a == "--live-camera-hz") {
@@ -353,6 +357,10 @@ int main(int argc, char** argv) {
     }
   } else if (mode != "standalone") {
     std::fprintf(stderr, "error: -m must be standalone or server, got '%s'\n", mode.c_str());
+    return 2;
+  }
+  if (!options.local_socket.empty() && !options.server) {
+    std::fprintf(stderr, "error: --local_socket needs -m server\n");
     return 2;
   }
   if (!options.live.empty()) {

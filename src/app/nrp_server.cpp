@@ -149,6 +149,49 @@ void NrpServer::listen(const std::string& address, bool insecure) {
   log_.info("serving NRP-Core clients at " + address);
 }
 
+void NrpServer::listen_local(const std::string& path) {
+  try {
+    local_ = std::make_unique<transport::LocalRpcServer>(
+        path,
+        [this](uint8_t method, const std::string& request) { return local_call(method, request); });
+  } catch (const std::runtime_error& e) {
+    throw UserError(std::string("--local_socket: ") + e.what());
+  }
+  log_.info("serving NRP-Core clients at the local socket " + path + " too");
+}
+
+template <typename In, typename Out, typename Call>
+transport::LocalReply NrpServer::local(const std::string& request, Call call) {
+  In in;
+  if (!in.ParseFromString(request))
+    return {grpc::StatusCode::INVALID_ARGUMENT, "the local call's request does not parse"};
+  Out out;
+  const grpc::Status status = (this->*call)(nullptr, &in, &out);
+  if (!status.ok()) return {status.error_code(), status.error_message()};
+  return {0, out.SerializeAsString()};
+}
+
+transport::LocalReply NrpServer::local_call(uint8_t method, const std::string& request) {
+  using namespace ::NrpCore;
+  switch (method) {
+    case 0:
+      return local<EmptyMessage, InitializeResponse>(request, &NrpServer::initialize);
+    case 1:
+      return local<RunLoopMessage, RunLoopResponse>(request, &NrpServer::runLoop);
+    case 2:
+      return local<EmptyMessage, RunLoopResponse>(request, &NrpServer::runUntilTimeout);
+    case 3:
+      return local<EmptyMessage, Response>(request, &NrpServer::stopLoop);
+    case 4:
+      return local<ResetMessage, ResetResponse>(request, &NrpServer::reset);
+    case 5:
+      return local<EmptyMessage, Response>(request, &NrpServer::shutdown);
+    case 6:
+      return local<TypeRequest, TypeDescription>(request, &NrpServer::describeType);
+  }
+  return {grpc::StatusCode::UNIMPLEMENTED, "no method " + std::to_string(method)};
+}
+
 void NrpServer::wait(pid_t parent) {
   std::unique_lock<std::mutex> lock(done_mutex_);
   while (!shut_down_) {
@@ -195,6 +238,7 @@ void NrpServer::run_in_main_thread(const std::function<void()>& job) {
 
 void NrpServer::stop_serving() {
   stop_ = true;
+  local_.reset();
   if (server_) server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
 }
 

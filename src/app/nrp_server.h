@@ -21,6 +21,7 @@
 #include "app/session.h"
 #include "config/simulation_config.h"
 #include "convoy/nrp_server.grpc.pb.h"
+#include "transport/local_rpc.h"
 
 namespace convoy::app {
 
@@ -32,6 +33,10 @@ class NrpServer final : public NrpCore::NrpCore::Service {
   // Listens at `address` (HOST:PORT): the loopback only, unless `insecure`. Throws UserError
   // when it cannot.
   void listen(const std::string& address, bool insecure);
+  // Also serves the same calls at the Unix socket `path` (transport/local_rpc.h), method byte
+  // = the call's index in the service: 0 initialize, 1 runLoop, 2 runUntilTimeout, 3 stopLoop,
+  // 4 reset, 5 shutdown, 6 describeType. Throws UserError naming --local_socket.
+  void listen_local(const std::string& path);
   // Blocks until a client's shutdown, an interrupt, or (with `parent` > 0) the exit of the
   // process `parent` (the client that started the server with --slave). Meanwhile runs the
   // jobs that must run in this thread. Call from the main thread, without the GIL.
@@ -71,6 +76,9 @@ class NrpServer final : public NrpCore::NrpCore::Service {
   grpc::Status request(const char* what, std::initializer_list<State> from,
                        ::NrpCore::SimStateMessage* state, F&& action);
   void fail(const std::string& message, int code);
+  transport::LocalReply local_call(uint8_t method, const std::string& request);
+  template <typename In, typename Out, typename Call>
+  transport::LocalReply local(const std::string& request, Call call);
   void set_state(::NrpCore::SimStateMessage* out) const;
   void take_trajectory(::NrpCore::Trajectory* out);
   // Runs `job` in the thread that called wait(), and returns when it is done. Engines are
@@ -85,6 +93,7 @@ class NrpServer final : public NrpCore::NrpCore::Service {
   RunLog& log_;
   std::unique_ptr<Session> session_;
   std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<transport::LocalRpcServer> local_;
   std::mutex mutex_;  // one call at a time; taken before the GIL
   std::atomic<State> state_{State::kCreated};
   std::string error_message_;  // why the state is Failed

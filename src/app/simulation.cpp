@@ -435,6 +435,7 @@ int serve_simulation(const RunOptions& options) {
     try {
       external.start(log);
       server.listen(options.server_address, options.insecure);
+      if (!options.local_socket.empty()) server.listen_local(options.local_socket);
       {
         pybind11::gil_scoped_release release;  // each call takes the GIL in its gRPC thread
         server.wait(parent);

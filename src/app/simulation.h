@@ -21,6 +21,7 @@ struct RunOptions {
   std::string server_address;  // --server_address HOST:PORT
   bool slave = false;          // --slave: started by a client; ignore Ctrl-C, end with it
   bool insecure = false;       // --insecure: listen beyond the loopback too
+  std::string local_socket;    // --local_socket PATH: the same calls at a Unix socket too
   // --live [HOST:]PORT: serve the run to Foxglove WebSocket clients (app/live_run.h).
   std::string live;
   double live_camera_hz = 10;  // --live-camera-hz: JPEG frames per simulated second

@@ -17,7 +17,7 @@ from e2e_util import BIN_DIR, REPO, E2ETestCase, basic_config, engine_script, pi
 
 os.environ.setdefault("CONVOY_BIN_DIR", BIN_DIR)
 sys.path.insert(0, os.path.join(REPO, "python"))
-from nrp_client import NrpCore, NrpCoreError  # noqa: E402
+from nrp_client import NrpCore, NrpCoreError, find_nrpcoresim  # noqa: E402
 from google.protobuf import wrappers_pb2  # noqa: E402
 
 # Adds the "dx" of its "action" datapack to x every step; reset() sets x back to 0.
@@ -309,6 +309,35 @@ class Client(E2ETestCase):
                 server = int(r.stdout.split()[0])
                 self.assertGone([server] + list(self.engine_pids().values()))
                 self.assertEqual(self.scan_engine_processes(), [])
+
+
+class LocalChannelClient(Client):
+    """Every Client test again, with run_loop() and reset() through NRPCoreSim's local socket
+    (NrpCore(local_channel=True), src/transport/local_rpc.h): the same answers and errors."""
+
+    def client(self, **kwargs):
+        nrp = NrpCore(free_address(), experiment_folder=self.dir, local_channel=True, **kwargs)
+        self.addCleanup(nrp.shutdown)
+        return nrp
+
+    def test_the_socket_is_private_and_gone_after_shutdown(self):
+        self.experiment()
+        nrp = self.client()
+        folder = nrp._local_dir
+        self.assertEqual(os.stat(folder).st_mode & 0o777, 0o700)
+        self.assertEqual(os.listdir(folder), ["nrp.sock"])
+        nrp.initialize()
+        self.assertEqual(len(nrp.run_loop(3)[1]), 3)
+        nrp.shutdown()
+        self.assertFalse(os.path.exists(folder))
+
+    def test_local_socket_needs_server_mode(self):
+        self.experiment()
+        r = subprocess.run([find_nrpcoresim(), "-c", "simulation_config.json",
+                            "--local_socket", os.path.join(self.dir, "x.sock")],
+                           cwd=self.dir, capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("--local_socket needs -m server", r.stderr)
 
 
 class GeneratedCode(E2ETestCase):

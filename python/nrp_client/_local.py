@@ -1,0 +1,97 @@
+"""The client side of NRPCoreSim's local channel (`--local_socket PATH`,
+src/transport/local_rpc.h): the gRPC service's calls as frames on a Unix socket.
+
+A frame is a 4-byte little-endian length, then that many bytes. A request is one byte naming
+the method (its index in METHODS), then the request message; the reply is one byte of gRPC
+status code (0: OK), then the reply message or the error text. Errors are raised as
+grpc.RpcError with code() and details(), as a gRPC call's are, so that callers handle both
+alike."""
+import os
+import socket
+import struct
+import threading
+import time
+
+import grpc
+
+METHODS = ("initialize", "runLoop", "runUntilTimeout", "stopLoop", "reset", "shutdown",
+           "describeType")
+_CODES = {c.value[0]: c for c in grpc.StatusCode}
+_LEN = struct.Struct("<I")
+
+
+class LocalRpcError(grpc.RpcError):
+    def __init__(self, code, details):
+        super().__init__(details)
+        self._code, self._details = code, details
+
+    def code(self):
+        return self._code
+
+    def details(self):
+        return self._details
+
+
+class LocalChannel:
+    """One connection to the server's local socket; calls from several threads take turns."""
+
+    def __init__(self, path, timeout_s, alive):
+        """Connects to `path`, retrying for `timeout_s` while alive() (the server starts its
+        local socket right after its gRPC port)."""
+        deadline = time.monotonic() + timeout_s
+        while True:
+            sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+            try:
+                sock.connect(path)
+                break
+            except OSError as e:
+                sock.close()
+                if not alive() or time.monotonic() > deadline:
+                    raise ConnectionError("NRPCoreSim's local socket %s: %s" % (path, e)) from None
+                time.sleep(0.005)
+        self._sock = sock
+        self._lock = threading.Lock()
+
+    def callable(self, method, response_class):
+        index = bytes([METHODS.index(method)])
+
+        def call(request, timeout=None):
+            payload = self._call(index + request.SerializeToString())
+            return response_class.FromString(payload)
+        return call
+
+    def close(self):
+        sock, self._sock = self._sock, None
+        if sock is not None:
+            sock.close()
+
+    def _call(self, frame):
+        with self._lock:
+            if self._sock is None:
+                raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "the local channel is closed")
+            try:
+                self._sock.sendall(_LEN.pack(len(frame)) + frame)
+                (n,) = _LEN.unpack(self._recv(4))
+                reply = self._recv(n)
+            except OSError as e:
+                raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "local socket: %s" % e) from None
+        if not reply:
+            raise LocalRpcError(grpc.StatusCode.INTERNAL, "an empty reply from the server")
+        if reply[0] != 0:
+            code = _CODES.get(reply[0], grpc.StatusCode.UNKNOWN)
+            raise LocalRpcError(code, reply[1:].decode("utf-8", "replace"))
+        return reply[1:]
+
+    def _recv(self, n):
+        view = memoryview(bytearray(n))
+        got = 0
+        while got < n:
+            k = self._sock.recv_into(view[got:], n - got)
+            if k == 0:
+                raise OSError("the server closed the connection")
+            got += k
+        return bytes(view) if n else b""
+
+
+def socket_path(folder):
+    return os.path.join(folder, "nrp.sock")
