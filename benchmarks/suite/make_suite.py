@@ -35,13 +35,21 @@ AGENT = ('      <ObjectController><Controller name="convoy.agent"><Properties/><
          '</ObjectController>\n')
 
 
-def vehicle(name, entry, assign=None, agent=True):
+def vehicle(name, entry, assign=None, agent=True, props=None):
+    """props: the agent controller's Properties ({"convoy.v0": "0"}: its AI's desired speed)."""
     a = ""
     if assign:
         a = "\n        <ParameterAssignments>%s</ParameterAssignments>\n      " % "".join(
             '<ParameterAssignment parameterRef="%s" value="%s"/>' % kv for kv in assign.items())
     return ('    <ScenarioObject name="%s">\n      <CatalogReference catalogName="SuiteVehicles" entryName="%s">%s'
-            '</CatalogReference>\n%s    </ScenarioObject>' % (name, entry, a, AGENT if agent else ""))
+            '</CatalogReference>\n%s    </ScenarioObject>' % (name, entry, a, _agent(props) if agent else ""))
+
+
+def _agent(props):
+    if not props:
+        return AGENT
+    return AGENT.replace("<Properties/>", "<Properties>%s</Properties>" % "".join(
+        '<Property name="%s" value="%s"/>' % kv for kv in sorted(props.items())))
 
 
 def pedestrian(name, entry):
@@ -335,16 +343,21 @@ def pedestrian_behind_parked(weather=None, desc=""):
 
 
 def stopped_vehicle(desc=""):
-    # 60 s: the ego, past the car, reaches junction 100 on its approach's red at ~27 s and
-    # waits for the green at 40 s (as red_light)
-    p = {"EgoS": ("double", "30"), "StoppedS": ("double", "110"), "RouteLength": ("double", "180"),
-         "Duration": ("double", "60")}
-    init = {"Ego": ego_init() + [route("PassOnTheLeft", [lane_pos("1", "-2", "${$StoppedS - 30}"),
-                                                         lane_pos("2", "-1", "20")])],
-            "Stopped": [teleport(lane_pos("1", "-1", "$StoppedS")), hold("${$StoppedS - 250}", "-1.75", "0")]}
-    return scenario("Stopped vehicle ahead%s: a broken-down car stands in the ego's lane; the ego's route "
-                    "passes it in the left lane" % desc, p, [EGO, vehicle("Stopped", "sedan", {"Model": "sedan_red"})],
-                    init, [])
+    # The ego's route is its own lane (1:-1 onward, straight on through junction 100): the
+    # reference agent passes the broken-down car by a lane change of its own (its planner's MOBIL
+    # check, python/convoy_traffic/lane_change.py), into the right lane once the car coming from
+    # behind there has gone by. The broken-down car's AI wants no speed (convoy.v0 0): it stands
+    # all run (a hold trajectory alone holds it only while the storyboard runs). 60 s: past the
+    # car, the ego reaches junction 100 on its approach's red and waits for the green at 40 s.
+    p = {"EgoS": ("double", "30"), "StoppedS": ("double", "110"), "PasserSpeed": ("double", "8.5"),
+         "RouteLength": ("double", "180"), "Duration": ("double", "60")}
+    init = {"Ego": ego_init(),
+            "Stopped": [teleport(lane_pos("1", "-1", "$StoppedS")), hold("${$StoppedS - 250}", "-1.75", "0")],
+            "Passer": [teleport(lane_pos("1", "-2", "0")), speed("$PasserSpeed")]}
+    return scenario("Stopped vehicle ahead%s: a broken-down car stands in the ego's lane; a car in the right "
+                    "lane comes from behind at $PasserSpeed m/s; the ego's route stays in its lane" % desc, p,
+                    [EGO, vehicle("Stopped", "sedan", {"Model": "sedan_red"}, props={"convoy.v0": "0"}),
+                     vehicle("Passer", "sedan", {"Model": "sedan_white"})], init, [])
 
 
 def red_light(desc=""):

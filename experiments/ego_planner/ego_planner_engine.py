@@ -7,7 +7,10 @@ the report's PID waypoint follower. The parameters come from a JSON file: the en
 CONVOY_EGO_PLANNER_CONFIG (set it with EngineEnvParams), default ego_planner.json, relative to
 this script's folder. With CONVOY_EGO_ROUTE (a route CSV with columns x, y: the one the
 follower drives) the planner's path is that route ahead (convoy_traffic.route_path), else the
-ego's current curvature. At shutdown it writes its result (ego_stops_for_pedestrians, distances,
+ego's current curvature; with the route's map too ($CONVOY_EGO_MAP, else the scenario's in
+the run folder's scenario_config.json: convoy_traffic.lanes) it passes stopped vehicles by a
+lane change, and `target` also carries "steer" (rad) while the ego is off its route's lane.
+At shutdown it writes its result (ego_stops_for_pedestrians, distances,
 speed trace) to $CONVOY_RUN_DIR/<Output>.
 """
 import json
@@ -17,6 +20,9 @@ from nrp_core.engines.python_json import EngineScript
 
 from convoy_traffic.ego_planner import Planner, parse_config, SOURCE_LABELS
 from convoy_traffic.route_path import RoutePath
+from convoy_traffic.lanes import RouteLanes, map_path
+from convoy_scenario.roads import RoadMap
+from convoy_scenario.xmltree import ScenarioError
 
 
 class Script(EngineScript):
@@ -39,7 +45,15 @@ class Script(EngineScript):
                 route = RoutePath.from_csv(route_csv)
             except (OSError, KeyError, ValueError) as e:
                 raise RuntimeError("%s: CONVOY_EGO_ROUTE %s: %s" % (engine, route_csv, e))
-        self.planner = Planner(self.params, route)
+        lanes, map_file = None, None
+        if route is not None and self.params["LaneChange"]:
+            map_file = map_path()
+            if map_file:
+                try:
+                    lanes = RouteLanes.from_map(route, RoadMap.open(map_file), map_file)
+                except (OSError, ValueError, ScenarioError) as e:
+                    raise RuntimeError("%s: the map %s: %s" % (engine, map_file, e))
+        self.planner = Planner(self.params, route, lanes)
         self.engine = engine
         self.run_dir = os.environ.get("CONVOY_RUN_DIR", ".")
         self._registerDataPack("planner_input")
@@ -50,6 +64,8 @@ class Script(EngineScript):
                                                 SOURCE_LABELS[self.params["Input"]],
                                                 "route " + route_csv if route else "curvature"),
               flush=True)
+        print("%s: lane changes %s%s" % (engine, self.planner.lane_change,
+                                          " (map %s)" % map_file if map_file else ""), flush=True)
 
     def runLoop(self, timestep_ns):
         d = self._getDataPack("planner_input")

@@ -6,7 +6,8 @@ The smart car's wheel joints are velocity-controlled with P = 10 only, so alone 
 speed follows the wheels' with a 1.6 s lag (0.6 m/s^2 per m/s of difference). A proportional
 speed loop on the ego's measured speed (SPEED_GAIN) shortens it to about 0.55 s; the wheel
 target stays within [target - MAX_UNDER, target + MAX_OVER], and is 0 once the car is (nearly)
-stopped with a target of 0, so it never drives backwards."""
+stopped with a target of 0, so it never drives backwards. While the planner changes lanes its
+target carries "steer" (rad), which replaces the follower's steering (convoy_traffic.lane_change)."""
 from nrp_core import *
 from nrp_core.data.nrp_json import *
 from nrp_core.data.nrp_protobuf import GazeboJointDataPack
@@ -35,8 +36,13 @@ def car_control(actors, target, ego):
         dp = GazeboJointDataPack("smart_car_joint_plugin::" + j, "gazebo")
         dp.data.velocity = wheel / WHEEL_RADIUS
         out.append(dp)
+    # the planner steers while it changes lanes (off the route the follower follows)
+    steer = None if target.isEmpty() else target.data.get('steer')
     for j, k in (("front_left_steering_joint", 'angular_L'), ("front_right_steering_joint", 'angular_R')):
         dp = GazeboJointDataPack("smart_car_joint_plugin::" + j, "gazebo")
-        dp.data.position = actors.data[k] if not actors.isEmpty() else 0.0
+        if steer is not None and not actors.isEmpty() and actors.data['linear_L'] > 0:
+            dp.data.position = float(steer)
+        else:
+            dp.data.position = actors.data[k] if not actors.isEmpty() else 0.0
         out.append(dp)
     return out

@@ -6,6 +6,8 @@ follower's rear wheels (the follower keeps steering):
 - AEB: when the time to collision with an object in the path falls below `TtcAeb`, or the
   IDM command would not stop in time, the target speed is capped by a braking profile that
   stops `StopMargin` m before the object at up to `AebDeceleration` m/s^2.
+- with a route and its lanes (ground truth only): lane changes around stopped vehicles (MOBIL)
+  and a cruise speed that follows faster traffic up to the limit: convoy_traffic.lane_change.
 
 Objects come in the ego's frame (x forward from its reference point, y left) as dicts
 {id, class, lon, lat, length, width, v_lon, v_lat, source}. Two sources build them:
@@ -20,6 +22,8 @@ docs/architecture.md, "Ego planner".
 import json
 import math
 import tempfile
+
+from convoy_traffic.lane_change import LANE_PARAMETERS, LaneChanger
 
 SOURCES = ("ground_truth", "detections", "sensors")
 SOURCE_LABELS = {"ground_truth": "ground-truth objects (the world's RoadUsers, not perception)",
@@ -45,6 +49,7 @@ PARAMETERS = {
     "CommandSlack": (3.0, 0.1, 20.0),          # m/s: the command stays at most this above the speed
     "TraceRate": (10.0, 0.1, 1000.0),          # Hz of the speed trace in the output JSON
 }
+PARAMETERS.update(LANE_PARAMETERS)   # lane changes (convoy_traffic.lane_change)
 KEYS = set(PARAMETERS) | {"Input", "Output"}
 # The road-user classes (docs/road_users.md) the planner reacts to; scenery (buildings, trees,
 # parked models' other classes) is not in the path's concern. COCO names a detector may give
@@ -219,11 +224,24 @@ NEAR_FIELD_M = 5.0  # gap within which the ego's own heading decides, route or n
 
 
 class Planner:
-    def __init__(self, params, route=None):
+    def __init__(self, params, route=None, lanes=None):
         """`route`: a route_path.RoutePath in the world frame, or None: the path is then the
-        ego's current curvature (its yaw rate over its speed)."""
+        ego's current curvature (its yaw rate over its speed). `lanes`: a lanes.RouteLanes of
+        the route: with it (and LaneChange 1, ground-truth input) the ego passes stopped
+        vehicles by a lane change (convoy_traffic.lane_change)."""
         self.p = params
         self.route = route
+        self.lc = None
+        if route is None or lanes is None:
+            self.lane_change = "off (no route or no map)"
+        elif not params["LaneChange"]:
+            self.lane_change = "off (LaneChange 0)"
+        elif params["Input"] != "ground_truth":
+            # a lane change needs the lane behind the ego: the camera's perception looks ahead only
+            self.lane_change = "off (input %s sees nothing behind the ego)" % params["Input"]
+        else:
+            self.lane_change = "on"
+            self.lc = LaneChanger(params, route, lanes)
         self._route_s = None  # the ego's last arc length on the route
         self.v_cmd = None
         self.stop_events = []       # ego stopped / AEB-braked because of a pedestrian
@@ -286,6 +304,8 @@ class Planner:
             return None, None, None
         h = self.route.heading(s_obj) - ego["yaw"]
         v_left = -math.sin(h) * o["v_lon"] + math.cos(h) * o["v_lat"]
+        if self.lc is not None:
+            d -= self.lc.offset_at(s_obj)   # the path is the route offset by a lane change
         return s_obj - s_ego - o["length"] / 2 - front, d, v_left
 
     def step(self, t, ego, objects):
@@ -293,6 +313,12 @@ class Planner:
         v = max(ego["speed"], 0.0)
         if self.v_cmd is None:
             self.v_cmd = v
+        steer = None
+        v0 = max(p["CruiseSpeed"], 0.01)
+        if self.lc is not None:
+            users = [o for o in objects if o["class"] in ROAD_USER_CLASSES]
+            steer = self.lc.update(t, ego, self.route_position(ego), users, p["CruiseSpeed"])
+            v0 = max(self.lc.v0, 0.01)   # the traffic's flow (lane_change.flow_speed)
         lead, lead_gap = None, None
         for o in objects:
             if o["class"] not in ROAD_USER_CLASSES:
@@ -304,14 +330,16 @@ class Planner:
                 if self.min_ped_distance is None or gap < self.min_ped_distance:
                     self.min_ped_distance = gap
         # IDM
-        v0 = max(p["CruiseSpeed"], 0.01)
         acc = p["MaxAcceleration"] * (1 - (v / v0) ** p["Delta"])
         ttc = None
         mode = "cruise"
         if lead is not None:
             dv = v - lead["v_lon"]
             s = max(lead_gap, 0.01)
-            s_star = p["StandstillDistance"] + max(
+            s0 = p["StandstillDistance"]
+            if self.lc is not None and lead["id"] == self.lc.standoff_id:
+                s0 += p["LaneChangeStandoff"]   # room to pull out once the next lane is free
+            s_star = s0 + max(
                 0.0, v * p["TimeGap"] + v * dv / (2 * math.sqrt(p["MaxAcceleration"] *
                                                                p["ComfortDeceleration"])))
             acc -= p["MaxAcceleration"] * (s_star / s) ** 2
@@ -369,9 +397,10 @@ class Planner:
                  "lead": lead["id"] if lead else None,
                  "lead_class": lead["class"] if lead else None,
                  "gap_m": round(lead_gap, 3) if lead else None,
-                 "lead_speed_mps": round(lead["v_lon"], 3) if lead else None}) + "\n")
+                 "lead_speed_mps": round(lead["v_lon"], 3) if lead else None,
+                 "steer": round(steer, 4) if steer is not None else None}) + "\n")
         return {"speed": self.v_cmd, "mode": mode, "lead": lead["id"] if lead else None,
-                "gap_m": lead_gap, "ttc_s": ttc}
+                "gap_m": lead_gap, "ttc_s": ttc, "steer": steer}
 
     def result(self):
         src = self.p["Input"]
@@ -385,6 +414,9 @@ class Planner:
                 "min_gap_to_lead_m": self.min_gap,
                 "aeb_active_s": round(self.aeb_active_s, 3),
                 "max_deceleration_mps2": round(self.max_decel, 3),
+                "lane_change": self.lane_change,
+                "lane_changes": self.lc.events if self.lc is not None else [],
+                "max_cruise_speed_mps": round(self.lc.max_v0 if self.lc else self.p["CruiseSpeed"], 3),
                 "parameters": {k: self.p[k] for k in sorted(PARAMETERS)},
                 "speed_trace": self.trace}
 

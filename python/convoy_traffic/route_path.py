@@ -62,3 +62,11 @@ class RoutePath:
         i = min(max(bisect.bisect_right(self.s, s) - 1, 0), len(self.points) - 2)
         (x0, y0), (x1, y1) = self.points[i], self.points[i + 1]
         return math.atan2(y1 - y0, x1 - x0)
+
+    def point(self, s):
+        """The route's (x, y) at arc length s (clamped to the route)."""
+        s = min(max(s, 0.0), self.length)
+        i = min(max(bisect.bisect_right(self.s, s) - 1, 0), len(self.points) - 2)
+        (x0, y0), (x1, y1) = self.points[i], self.points[i + 1]
+        u = (s - self.s[i]) / (self.s[i + 1] - self.s[i])
+        return x0 + u * (x1 - x0), y0 + u * (y1 - y0)
