@@ -227,7 +227,8 @@ const std::vector<CameraSensors::FilePart>& CameraSensors::file_mesh(const std::
                              static_cast<float>(scale.z())})) {
       int texture = part.texture_path.empty() ? -1 : scene_.add_texture_file(part.texture_path);
       render::Material material = part.material(texture);
-      it->second.push_back({scene_.add_mesh_levels(part.levels()), material});
+      for (const auto& levels : part.drawables())
+        it->second.push_back({scene_.add_mesh_levels(levels), material});
     }
   } catch (...) {
     file_meshes_.erase(it);

@@ -12,8 +12,9 @@ models in its models/ folder an H x W image and an update_rate of one frame per 
 config's smallest EngineTimestep (the models carrying one are copied: their other files
 linked, model.sdf rewritten), and runs the status function `<name>_camera.py` beside the
 config's `<name>.py` (rl_parkring: observe_camera.py, which returns the frame). The world
-engine's sun shadow map is then sized to the camera (shadow_map_size(): 256 texels a side for
-84 x 84 instead of 1024, the engine's ShadowMapSize unless the config sets one), and
+engine's sun shadow map is then sized to the camera (shadow_distance(): 30 m ahead for 84 x 84 instead of
+60, the engine's ShadowDistance; shadow_map_size(): 128 texels a side over it instead of 1024,
+the engine's ShadowMapSize; each unless the config sets one), and
 shadows=False turns the cameras' shadows off (the engine's Shadows)."""
 import json
 import os
@@ -80,13 +81,26 @@ def _models_with_camera(models, dest, camera, rate):
     return count
 
 
+FULL_SHADOW_DISTANCE = 60.0  # m: the world engine's default ShadowDistance
+FULL_SHADOW_WIDTH = 168      # pixels: a camera this wide or wider gets all of it
+
+
+def shadow_distance(camera):
+    """How far ahead of an H x W camera the sun's shadows are drawn: the world engine's 60 m
+    for an image at least 168 pixels wide, less for a smaller one, in proportion (30 m at 84),
+    at least 20 m. A shadow there spans as many pixels as one 60 m away in a 168-pixel
+    image: about one, less than the blur of the image itself."""
+    return max(20.0, FULL_SHADOW_DISTANCE * min(1.0, max(camera) / FULL_SHADOW_WIDTH))
+
+
 def shadow_map_size(camera):
     """The sun's shadow map for an H x W camera: the power of two of at least 3 texels per
-    pixel of the image's larger side, in [64, 1024] (1024: the world engine's default). The
-    map covers ShadowDistance (60 m) ahead of the camera: at 256 texels, 0.28 m a texel, about
-    what a pixel of an 84-pixel-wide, 90-degree image spans 10 m away."""
+    pixel of the image's larger side over the full 60 m, scaled to shadow_distance(camera),
+    in [64, 1024] (1024: the world engine's default). For 84 x 84: 128 texels over 30 m, 0.23 m
+    a texel, about what a pixel of an 84-pixel-wide, 90-degree image spans 10 m away."""
+    need = 3 * max(camera) * shadow_distance(camera) / FULL_SHADOW_DISTANCE
     size = 64
-    while size < 3 * max(camera) and size < 1024:
+    while size < need and size < 1024:
         size *= 2
     return size
 
@@ -161,6 +175,7 @@ def variant_config(config, physics_step=None, camera=None, shadows=True):
         _camera_status(cfg, config)
         for engine in worlds:
             engine.setdefault("ShadowMapSize", shadow_map_size(camera))
+            engine.setdefault("ShadowDistance", shadow_distance(camera))
             if not shadows:
                 engine["Shadows"] = False
     tmp = tempfile.mkdtemp(prefix="convoy_gym_")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -222,6 +223,50 @@ MeshData cluster(const MeshData& mesh, double cell, float* error) {
 }
 
 }  // namespace
+
+float horizontal_extent(const MeshData& mesh) {
+  if (mesh.positions.empty()) return 0;
+  float lo[2] = {mesh.positions[0], mesh.positions[1]}, hi[2] = {lo[0], lo[1]};
+  for (size_t i = 0; i < mesh.vertex_count(); ++i)
+    for (int k = 0; k < 2; ++k) {
+      lo[k] = std::min(lo[k], mesh.positions[3 * i + k]);
+      hi[k] = std::max(hi[k], mesh.positions[3 * i + k]);
+    }
+  return std::max(hi[0] - lo[0], hi[1] - lo[1]);
+}
+
+std::vector<MeshData> split_into_tiles(const MeshData& mesh, float tile) {
+  if (!(tile > 0)) throw std::invalid_argument("split_into_tiles: tile must be > 0");
+  const float* p = mesh.positions.data();
+  auto cell = [&](uint32_t a, uint32_t b, uint32_t c, int k) {
+    const float centroid = (p[3 * a + k] + p[3 * b + k] + p[3 * c + k]) / 3;
+    return static_cast<int64_t>(std::floor(centroid / tile));
+  };
+  std::map<std::pair<int64_t, int64_t>, MeshData> tiles;  // (row y, column x)
+  std::map<std::pair<int64_t, int64_t>, std::unordered_map<uint32_t, uint32_t>> remap;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const uint32_t* v = &mesh.indices[3 * t];
+    const std::pair<int64_t, int64_t> key{cell(v[0], v[1], v[2], 1), cell(v[0], v[1], v[2], 0)};
+    MeshData& out = tiles[key];
+    auto& index_of = remap[key];
+    for (int j = 0; j < 3; ++j) {
+      auto [it, fresh] = index_of.try_emplace(v[j], static_cast<uint32_t>(out.vertex_count()));
+      if (fresh) {
+        const size_t i = v[j];
+        out.positions.insert(out.positions.end(), p + 3 * i, p + 3 * i + 3);
+        if (!mesh.normals.empty())
+          out.normals.insert(out.normals.end(), &mesh.normals[3 * i], &mesh.normals[3 * i] + 3);
+        if (!mesh.uvs.empty())
+          out.uvs.insert(out.uvs.end(), &mesh.uvs[2 * i], &mesh.uvs[2 * i] + 2);
+      }
+      out.indices.push_back(it->second);
+    }
+  }
+  std::vector<MeshData> out;
+  out.reserve(tiles.size());
+  for (auto& [key, m] : tiles) out.push_back(std::move(m));
+  return out;
+}
 
 MeshLevels simplified_levels(MeshData mesh) {
   MeshLevels out;

@@ -30,6 +30,14 @@ MeshData make_sphere(float radius, int stacks = 16, int slices = 32);
 // SDF <plane>: a rectangle of sx by sy in the xy plane, centred, facing +z.
 MeshData make_plane(float sx, float sy);
 
+// The mesh cut into square tiles of `tile` metres in x and y (each triangle goes to the tile
+// of its centroid; its vertices are copied into that tile), the non-empty ones in row order.
+// A large static mesh (a road network) drawn as tiles lets the renderer leave out what is
+// behind or beside the camera. Throws std::invalid_argument for a tile size <= 0.
+std::vector<MeshData> split_into_tiles(const MeshData& mesh, float tile);
+// Its extent in x and y (the larger one), metres.
+float horizontal_extent(const MeshData& mesh);
+
 // A mesh and coarser versions of it, each with its geometric error: the largest distance
 // between its surface and the true shape's, in metres. The renderer's levels of detail (see
 // Scene::add_mesh_levels).

@@ -156,9 +156,19 @@ std::vector<LoadedMesh> load_mesh(const std::string& path, const std::array<floa
   return parts;
 }
 
-const MeshLevels& LoadedMesh::levels() const {
-  if (!levels_) levels_ = std::make_shared<const MeshLevels>(simplified_levels(mesh));
-  return *levels_;
+const std::vector<MeshLevels>& LoadedMesh::drawables() const {
+  if (drawables_) return *drawables_;
+  std::vector<MeshLevels> out;
+  if (horizontal_extent(mesh) > kTileAbove) {
+    MeshData whole = mesh;
+    if (whole.normals.empty()) compute_normals(&whole);
+    for (auto& tile : split_into_tiles(whole, kTile))
+      out.push_back(MeshLevels{{std::move(tile)}, {0.0f}});
+  } else {
+    out.push_back(simplified_levels(mesh));
+  }
+  drawables_ = std::make_shared<const std::vector<MeshLevels>>(std::move(out));
+  return *drawables_;
 }
 
 const std::vector<LoadedMesh>& MeshFileCache::load(const std::string& path,

@@ -31,11 +31,16 @@ struct LoadedMesh {
 
   // The part's material, drawn with the given Scene texture (-1: none).
   Material material(int texture = -1) const;
-  // simplified_levels(mesh), made on the first call and kept.
-  const MeshLevels& levels() const;
+  // What the renderer draws for it, made on the first call and kept: simplified_levels(mesh);
+  // or, for a mesh wider than kTileAbove metres (a road network), its tiles of kTile metres
+  // (split_into_tiles), each at full detail (simplified alone, neighbouring tiles would not
+  // meet), so that what is out of a camera's view is left out.
+  static constexpr float kTileAbove = 120.0f;
+  static constexpr float kTile = 40.0f;
+  const std::vector<MeshLevels>& drawables() const;
 
  private:
-  mutable std::shared_ptr<const MeshLevels> levels_;
+  mutable std::shared_ptr<const std::vector<MeshLevels>> drawables_;
 };
 
 // Throws std::runtime_error naming the file if it cannot be read or holds no triangles.

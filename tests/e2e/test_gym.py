@@ -406,18 +406,21 @@ class Camera(unittest.TestCase):
         self.assertIn("<update_rate>20.0</update_rate>", sdf)
 
     def test_shadow_map_sized_to_the_camera(self):
-        from convoy_gym.world_variant import shadow_map_size, variant_config
-        self.assertEqual([shadow_map_size(c) for c in [(60, 80), (84, 84), (8, 8), (480, 736)]],
-                         [256, 256, 64, 1024])
+        from convoy_gym.world_variant import shadow_distance, shadow_map_size, variant_config
+        sizes = [(60, 80), (84, 84), (8, 8), (480, 736), (120, 160)]
+        self.assertEqual([shadow_map_size(c) for c in sizes], [128, 128, 64, 1024, 512])
+        self.assertEqual([round(shadow_distance(c), 2) for c in sizes],
+                         [28.57, 30.0, 20.0, 60.0, 57.14])
         # the running variant's world engine has it; shadows=False turns them off
         with open(self.env._nrp_config) as f:
             world = json.load(f)["EngineConfigs"][0]
-        self.assertEqual((world["ShadowMapSize"], world.get("Shadows")), (256, None))
+        self.assertEqual((world["ShadowMapSize"], world["ShadowDistance"], world.get("Shadows")),
+                         (128, shadow_distance(self.env.camera), None))
         path, tmp = variant_config(self.env.config, camera=(84, 84), shadows=False)
         try:
             with open(path) as f:
                 world = json.load(f)["EngineConfigs"][0]
-            self.assertEqual((world["ShadowMapSize"], world["Shadows"]), (256, False))
+            self.assertEqual((world["ShadowMapSize"], world["Shadows"]), (128, False))
         finally:
             shutil.rmtree(tmp)
 

@@ -60,6 +60,57 @@ void expect_outward_winding(const MeshData& m) {
   }
 }
 
+// A flat grid of n x n squares of `size` metres from (x0, y0), two triangles each, with uvs.
+MeshData grid(int n, float size, float x0, float y0) {
+  MeshData m;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      m.positions.insert(m.positions.end(), {x0 + i * size, y0 + j * size, 0.0f});
+      m.uvs.insert(m.uvs.end(), {i * 1.0f, j * 1.0f});
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 1, d = c + 1;
+      m.indices.insert(m.indices.end(), {a, b, d, a, d, c});
+    }
+  return m;
+}
+
+TEST(MeshTiles, EveryTriangleGoesToTheTileOfItsCentroid) {
+  const MeshData road = grid(50, 2.0f, -50, -50);  // 100 m x 100 m, 5,000 triangles
+  EXPECT_FLOAT_EQ(horizontal_extent(road), 100.0f);
+  const auto tiles = split_into_tiles(road, 40.0f);
+  ASSERT_EQ(tiles.size(), 16u);  // cells -2..1 in x and y
+  size_t triangles = 0;
+  for (const MeshData& t : tiles) {
+    triangles += t.triangle_count();
+    EXPECT_EQ(t.uvs.size() / 2, t.vertex_count());
+    float lo = 1e9f, hi = -1e9f;
+    for (size_t i = 0; i < t.vertex_count(); ++i) {
+      lo = std::min(lo, t.positions[3 * i]);
+      hi = std::max(hi, t.positions[3 * i]);
+    }
+    EXPECT_LE(hi - lo, 40.0f + 2.0f);  // a tile, and the triangles that stick out of it
+    for (uint32_t v : t.indices) ASSERT_LT(v, t.vertex_count());
+  }
+  EXPECT_EQ(triangles, road.triangle_count());
+  EXPECT_THROW(split_into_tiles(road, 0.0f), std::invalid_argument);
+}
+
+TEST(MeshTiles, AWideMeshIsDrawnAsTilesAndASmallOneWithItsLevels) {
+  LoadedMesh wide;
+  wide.mesh = grid(100, 2.0f, 0, 0);  // 200 m
+  const auto& tiles = wide.drawables();
+  EXPECT_EQ(tiles.size(), 25u);  // 5 x 5 tiles of 40 m
+  for (const MeshLevels& t : tiles) {
+    EXPECT_EQ(t.meshes.size(), 1u);  // full detail only: tiles meet without cracks
+    EXPECT_EQ(t.meshes[0].normals.size(), t.meshes[0].positions.size());
+  }
+  LoadedMesh small;
+  small.mesh = grid(10, 2.0f, 0, 0);
+  EXPECT_EQ(small.drawables().size(), 1u);
+}
+
 TEST(PrimitivesTest, ShapesHaveTheirSizesAndFaceOutwards) {
   const MeshData box = make_box(1, 2, 3);
   EXPECT_EQ(box.triangle_count(), 12u);
@@ -128,8 +179,8 @@ TEST_F(MeshFiles, TheCacheReadsAFileOnceForEachScaleAndKeepsNoFailure) {
   EXPECT_EQ(cache.files_read(), 1u);
   EXPECT_EQ(max_corner(cache.load(obj, {2, 2, 2})[0].mesh), (std::array<float, 3>{2, 2, 0}));
   EXPECT_EQ(cache.files_read(), 2u);
-  EXPECT_EQ(&first[0].levels(), &first[0].levels());  // simplified once
-  EXPECT_EQ(first[0].levels().meshes.at(0).triangle_count(), 1u);
+  EXPECT_EQ(&first[0].drawables(), &first[0].drawables());  // simplified once
+  EXPECT_EQ(first[0].drawables().at(0).meshes.at(0).triangle_count(), 1u);
   EXPECT_THROW(cache.load((dir_ / "missing.obj").string()), std::runtime_error);
   EXPECT_THROW(cache.load((dir_ / "missing.obj").string()), std::runtime_error);  // tried again
   EXPECT_EQ(cache.files_read(), 2u);
