@@ -11,6 +11,13 @@ the ego's loop. Prints the median of the runs:
   lidar 64x2048 real-time factor: R   (target >= 2)
   lidar range error p99 m: E          (noise off, against a brute-force double-precision
                                        intersection; target <= 0.01)
+
+and, when build/benchmarks/radar_bench is there (benchmarks/radar/radar_bench.cpp: the same
+city and traffic, a front radar at 20 Hz on the vehicle driving the loop), the median of as
+many runs of `--scans` x 2 scans:
+
+  radar real-time factor: R           (the radar's own work per scan: object tracking, the
+                                       Embree scene's update, occlusion rays, detection)
 """
 import argparse
 import os
@@ -26,6 +33,17 @@ import machine  # noqa: E402
 FIGURES = ("lidar 32x1024 real-time factor", "lidar 64x2048 real-time factor",
            "lidar range error p99 m")
 TARGETS = {FIGURES[0]: "target >= 10", FIGURES[1]: "target >= 2", FIGURES[2]: "target <= 0.01"}
+
+
+RADAR = "radar real-time factor"
+
+
+def run_radar(program, scans):
+    r = subprocess.run([program, "--scans", str(scans)], capture_output=True, text=True)
+    m = re.search(re.escape(RADAR) + r": ([0-9.eE+-]+)", r.stdout)
+    if r.returncode != 0 or not m:
+        sys.exit("radar_bench failed (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr))
+    return float(m.group(1))
 
 
 def run_once(program, scans):
@@ -58,6 +76,13 @@ def main():
         fmt = "%.5f" if name == FIGURES[2] else "%.1f"
         print(("%s: " + fmt + "   (%s; runs: %s)") % (
             name, median, TARGETS[name], ", ".join(fmt % v for v in values)))
+    radar = os.path.join(args.build, "benchmarks", "radar_bench")
+    if os.path.exists(radar):
+        values = [run_radar(radar, 2 * args.scans) for _ in range(max(1, args.runs))]
+        print("%s: %.1f   (runs: %s)" % (RADAR, statistics.median(values),
+                                         ", ".join("%.1f" % v for v in values)))
+    else:
+        print("%s: not measured (cmake --build %s --target radar_bench)" % (RADAR, args.build))
     print("CPU: %s, %d cores" % (machine.cpu_model(), os.cpu_count() or 0))
 
 

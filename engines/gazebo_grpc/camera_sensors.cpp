@@ -92,7 +92,8 @@ CameraSensors::CameraSensors(const WorldDesc& desc, const PhysicsWorld& physics,
       }
   bool lidars = false;  // a LiDAR scans the same scene (systems/lidar_sensors.h)
   for (const auto& model : desc.models)
-    for (const auto& link : model.links) lidars = lidars || !link.lidars.empty();
+    for (const auto& link : model.links)
+      lidars = lidars || !link.lidars.empty() || !link.radars.empty();  // radars cast rays too
   if (cameras_.empty() && !lidars) return;
   has_scene_ = true;
   for (auto& cam : cameras_)

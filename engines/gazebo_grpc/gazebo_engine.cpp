@@ -38,9 +38,11 @@
 #include "systems/lidar_sensors.h"
 #include "systems/link_states.h"
 #include "systems/nav_sensors.h"
+#include "systems/radar_sensors.h"
 #include "systems/road_user_actors.h"
 #include "systems/traffic_light_state.h"
 #include "systems/weather_input.h"
+#include "systems/wheel_odometry.h"
 #include "world_cache.h"
 #include "world_systems.h"
 
@@ -91,6 +93,8 @@ class GazeboEngine final : public Engine {
     world_->add<world::CameraDatapacks>();
     world_->add<world::LidarSensors>();
     world_->add<world::NavSensors>();
+    world_->add<world::RadarSensors>();
+    world_->add<world::WheelOdometry>();
     world_->add<world::EgoState>();
     world_->add<world::Contacts>();
     std::vector<world::ProvidedDataPack> provided;

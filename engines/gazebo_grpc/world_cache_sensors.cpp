@@ -48,6 +48,44 @@ void get(Reader& r, NavSensorDesc& d) {
   d.navsat.update_rate = r.pod<double>();
 }
 
+void put(Writer& w, const RadarDesc& d) {
+  for (const auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name}) w.str(*s);
+  w.iso(d.pose);
+  const radar::RadarParams& p = d.radar;
+  for (double v : {p.horizontal_fov, p.vertical_fov, p.min_range, p.max_range, p.range_stddev,
+                   p.azimuth_stddev, p.elevation_stddev, p.range_rate_stddev, p.rcs_stddev,
+                   p.detection_range, p.clutter, p.update_rate})
+    w.pod(v);
+}
+void get(Reader& r, RadarDesc& d) {
+  for (auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name}) *s = r.str();
+  d.pose = r.iso();
+  radar::RadarParams& p = d.radar;
+  for (double* v : {&p.horizontal_fov, &p.vertical_fov, &p.min_range, &p.max_range, &p.range_stddev,
+                    &p.azimuth_stddev, &p.elevation_stddev, &p.range_rate_stddev, &p.rcs_stddev,
+                    &p.detection_range, &p.clutter, &p.update_rate})
+    *v = r.pod<double>();
+}
+
+void put(Writer& w, const OdometryDesc& d) {
+  for (const auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name, &d.left_joint,
+                        &d.right_joint, &d.steering_joint})
+    w.str(*s);
+  const auto& o = d.odometry;
+  for (double v :
+       {o.wheel_radius, o.track, o.wheelbase, o.scale_stddev, o.slip_stddev, o.update_rate})
+    w.pod(v);
+}
+void get(Reader& r, OdometryDesc& d) {
+  for (auto* s : {&d.name, &d.model, &d.link, &d.plugin_name, &d.scoped_name, &d.left_joint,
+                  &d.right_joint, &d.steering_joint})
+    *s = r.str();
+  auto& o = d.odometry;
+  for (double* v :
+       {&o.wheel_radius, &o.track, &o.wheelbase, &o.scale_stddev, &o.slip_stddev, &o.update_rate})
+    *v = r.pod<double>();
+}
+
 }  // namespace
 
 void put_sensors(Writer& w, const LinkDesc& l) {
@@ -67,6 +105,10 @@ void put_sensors(Writer& w, const LinkDesc& l) {
   }
   w.size(l.nav_sensors.size());
   for (const auto& d : l.nav_sensors) put(w, d);
+  w.size(l.radars.size());
+  for (const auto& d : l.radars) put(w, d);
+  w.size(l.odometers.size());
+  for (const auto& d : l.odometers) put(w, d);
 }
 
 void get_sensors(Reader& r, LinkDesc& l) {
@@ -86,6 +128,10 @@ void get_sensors(Reader& r, LinkDesc& l) {
   }
   l.nav_sensors.resize(r.size());
   for (auto& d : l.nav_sensors) get(r, d);
+  l.radars.resize(r.size());
+  for (auto& d : l.radars) get(r, d);
+  l.odometers.resize(r.size());
+  for (auto& d : l.odometers) get(r, d);
 }
 
 }  // namespace convoy::world::cache_io

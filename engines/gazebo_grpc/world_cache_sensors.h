@@ -1,5 +1,5 @@
-// The parsed-world cache's records of a link's LiDARs, IMUs and GNSS receivers
-// (world_cache.cpp writes a link's other parts). Internal to the cache.
+// The parsed-world cache's records of a link's LiDARs, IMUs, GNSS receivers, radars and wheel
+// odometers (world_cache.cpp writes a link's other parts). Internal to the cache.
 #pragma once
 
 #include "world_cache_io.h"

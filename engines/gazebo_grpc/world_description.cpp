@@ -11,6 +11,7 @@
 #include "camera_desc.h"
 #include "lidar_desc.h"
 #include "nav_desc.h"
+#include "radar_desc.h"
 #include "sdf_eigen.h"
 #include "world_plugins.h"
 
@@ -228,6 +229,10 @@ class Loader {
         ld.lidars.push_back(lidar_desc(sensor, model_name, l->Name(), file_));
       if (is_nav_sensor(sensor))
         ld.nav_sensors.push_back(nav_desc(sensor, model_name, l->Name(), file_));
+      if (is_radar_sensor(sensor))
+        ld.radars.push_back(radar_desc(sensor, model_name, l->Name(), file_));
+      if (is_odometry_sensor(sensor))
+        ld.odometers.push_back(odometry_desc(sensor, model_name, l->Name(), file_));
       if (!is_camera_sensor(sensor)) continue;
       ld.cameras.push_back(camera_desc(sensor, model_name, l->Name(), file_));
     }

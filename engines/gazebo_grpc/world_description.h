@@ -13,6 +13,8 @@
 #include "nav_sensors/geodetic.h"
 #include "nav_sensors/imu_model.h"
 #include "nav_sensors/navsat_model.h"
+#include "radar/radar_model.h"
+#include "wheel_odometry/odometry_model.h"
 
 namespace convoy::world {
 
@@ -87,6 +89,21 @@ struct NavSensorDesc {
   nav_sensors::NavSatParams navsat;                         // kNavSat
 };
 
+// A radar: <sensor type="custom"> with a convoy_radar <plugin> (radar_desc.h reads it).
+struct RadarDesc {
+  std::string name, model, link, plugin_name, scoped_name;  // as LidarDesc's
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();   // in the link frame
+  radar::RadarParams radar;
+};
+
+// Wheel odometry: <sensor type="custom"> with a convoy_wheel_odometry <plugin> naming the
+// model's rear wheel joints (and a steering joint) (radar_desc.h reads it).
+struct OdometryDesc {
+  std::string name, model, link, plugin_name, scoped_name;  // as LidarDesc's
+  std::string left_joint, right_joint, steering_joint;      // unscoped; steering: "" if none
+  wheel_odometry::OdometryParams odometry;
+};
+
 struct LinkDesc {
   std::string name;                                        // model::link
   std::string short_name;                                  // link
@@ -100,6 +117,8 @@ struct LinkDesc {
   std::vector<CameraDesc> cameras;
   std::vector<LidarDesc> lidars;
   std::vector<NavSensorDesc> nav_sensors;
+  std::vector<RadarDesc> radars;
+  std::vector<OdometryDesc> odometers;
 };
 
 struct AxisDesc {

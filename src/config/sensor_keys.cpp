@@ -37,7 +37,8 @@ const std::map<std::string, Preset>& presets() {
 }
 
 const std::set<std::string> kLidarTypes{"lidar", "gpu_lidar", "ray", "gpu_ray"};
-const std::set<std::string> kTypes{"lidar", "gpu_lidar", "ray", "gpu_ray", "imu", "navsat", "gps"};
+const std::set<std::string> kTypes{"lidar",  "gpu_lidar", "ray",   "gpu_ray",       "imu",
+                                   "navsat", "gps",       "radar", "wheel_odometry"};
 
 // Reads one entry; problems go to `add` with the entry's key.
 class EntryReader {
@@ -128,6 +129,48 @@ void read_lidar(EntryReader& r, SensorEntry& e) {
   if (e.range_resolution < 0) r.fail("RangeResolution", "must be >= 0 m");
 }
 
+// A number >= 0 (or > 0 with `positive`) at most `max`.
+double bounded(EntryReader& r, const char* key, double fallback, bool positive, double max,
+               const char* unit) {
+  const double v = r.num(key, fallback);
+  if (positive ? !(v > 0) : !(v >= 0))
+    r.fail(key, std::string("must be ") + (positive ? "> 0" : ">= 0") + " " + unit + ", got " +
+                    num_text(v));
+  else if (v > max)
+    r.fail(key, "must be at most " + num_text(max) + " " + unit + ", got " + num_text(v));
+  return v;
+}
+
+void read_radar(EntryReader& r, SensorEntry& e) {
+  e.update_rate = r.num("UpdateRate", 20);
+  e.h_fov = bounded(r, "HorizontalFov", 1.2, true, 2 * M_PI, "rad");
+  e.v_fov = bounded(r, "VerticalFov", 0.2, true, M_PI, "rad");
+  e.range_min = bounded(r, "RangeMin", 0.5, false, 1e6, "m");
+  e.range_max = r.num("RangeMax", 150);
+  if (!(e.range_max > e.range_min))
+    r.fail("RangeMax", "must be above RangeMin (" + num_text(e.range_min) + " m), got " +
+                           num_text(e.range_max));
+  e.range_stddev = bounded(r, "RangeStddev", 0.1, false, 1e3, "m");
+  e.azimuth_stddev = bounded(r, "AzimuthStddev", 0.005, false, 1, "rad");
+  e.elevation_stddev = bounded(r, "ElevationStddev", 0.01, false, 1, "rad");
+  e.range_rate_stddev = bounded(r, "RangeRateStddev", 0.1, false, 1e3, "m/s");
+  e.rcs_stddev = bounded(r, "RcsStddev", 1, false, 100, "dB");
+  e.detection_range = bounded(r, "DetectionRange", 0, false, 1e6, "m");
+  e.clutter = bounded(r, "Clutter", 2, false, 1000, "returns per scan");
+}
+
+void read_odometry(EntryReader& r, SensorEntry& e) {
+  e.update_rate = r.num("UpdateRate", 50);
+  if (r.j().contains("LeftJoint")) e.left_joint = r.str("LeftJoint", false);
+  if (r.j().contains("RightJoint")) e.right_joint = r.str("RightJoint", false);
+  if (r.j().contains("SteeringJoint")) e.steering_joint = r.str("SteeringJoint", false);
+  e.wheel_radius = bounded(r, "WheelRadius", 0.3, true, 10, "m");
+  e.track = bounded(r, "Track", 1.6, true, 20, "m");
+  e.wheelbase = bounded(r, "Wheelbase", 0, false, 50, "m");
+  e.scale_stddev = bounded(r, "ScaleStddev", 0, false, 0.49, "(relative)");
+  e.slip_stddev = bounded(r, "SlipStddev", 0, false, 100, "m/s");
+}
+
 }  // namespace
 
 bool SensorEntry::is_lidar() const { return kLidarTypes.count(type) > 0; }
@@ -159,12 +202,17 @@ std::vector<SensorEntry> read_sensor_entries(const json& engine, double step_s,
     r.str("Model", true);
     r.str("Link", true);
     if (!e.type.empty() && !kTypes.count(e.type))
-      r.fail("Type", "unknown type '" + e.type + "' (lidar, gpu_lidar, ray, gpu_ray, imu, navsat)");
+      r.fail("Type", "unknown type '" + e.type +
+                         "' (lidar, gpu_lidar, ray, gpu_ray, imu, navsat, radar, wheel_odometry)");
     if (!seen.insert(e.model + "::" + e.link + "::" + e.name).second)
       r.fail("Name", "a second sensor of that name on that link");
     read_pose(r, e);
     if (e.is_lidar()) {
       read_lidar(r, e);
+    } else if (e.type == "radar") {
+      read_radar(r, e);
+    } else if (e.type == "wheel_odometry") {
+      read_odometry(r, e);
     } else {
       e.update_rate = r.num("UpdateRate", 0);
     }
@@ -268,17 +316,25 @@ std::vector<std::pair<size_t, size_t>> blocks(const std::string& text, const std
   return out;
 }
 
-// model name -> its links ("" file: links unknown).
-using Models = std::map<std::string, std::pair<bool, std::set<std::string>>>;
+// A model's links and joints (known: false when its file was not found).
+struct ModelNames {
+  bool known = false;
+  std::set<std::string> links, joints;
+};
+using Models = std::map<std::string, ModelNames>;
+
+ModelNames model_names(const std::string& text) {
+  const auto links = names_of(text, "link"), joints = names_of(text, "joint");
+  return {true, {links.begin(), links.end()}, {joints.begin(), joints.end()}};
+}
 
 void add_file_model(Models& models, const std::string& name, const fs::path& file) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) {
-    models[name] = {false, {}};
+    models[name] = {};
     return;
   }
-  const auto links = names_of(read_text(file), "link");
-  models[name] = {true, std::set<std::string>(links.begin(), links.end())};
+  models[name] = model_names(read_text(file));
 }
 
 Models world_models(const json& engine) {
@@ -296,8 +352,7 @@ Models world_models(const json& engine) {
       at = e;
     }
     own.append(inner, at, std::string::npos);
-    const auto links = names_of(own, "link");
-    models[name_attribute(text, begin)] = {true, std::set<std::string>(links.begin(), links.end())};
+    models[name_attribute(text, begin)] = model_names(own);
   }
   for (const auto& [begin, end] : blocks(text, "include")) {
     const std::string block = text.substr(begin, end - begin);
@@ -324,6 +379,21 @@ Models world_models(const json& engine) {
   return models;
 }
 
+// A wheel odometer's joints in its model.
+void check_joints(const SensorEntry& e, const ModelNames& m, const std::string& at,
+                  const std::string& who, Problems* problems) {
+  for (const auto& [key, joint] :
+       {std::pair<const char*, const std::string*>{"LeftJoint", &e.left_joint},
+        {"RightJoint", &e.right_joint},
+        {"SteeringJoint", &e.steering_joint}}) {
+    if (joint->empty() || m.joints.count(*joint)) continue;
+    std::string known;
+    for (const auto& j : m.joints) known += (known.empty() ? "" : ", ") + j;
+    problems->emplace_back(at + "/" + key, who + "model '" + e.model + "' has no joint '" + *joint +
+                                               "' (joints: " + known + ")");
+  }
+}
+
 }  // namespace
 
 void read_sensor_keys(const json& engine, double step_s, const std::string& pointer,
@@ -335,9 +405,10 @@ void read_sensor_keys(const json& engine, double step_s, const std::string& poin
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string model = list[i].value("Model", ""), link = list[i].value("Link", "");
     const std::string name = list[i].value("Name", "");
-    bool listed = false;
-    for (const auto& e : entries) listed |= e.model == model && e.link == link && e.name == name;
-    if (!listed) continue;
+    const SensorEntry* entry = nullptr;
+    for (const auto& e : entries)
+      if (e.model == model && e.link == link && e.name == name) entry = &e;
+    if (!entry) continue;
     const std::string at = pointer + "/Sensors/" + std::to_string(i);
     const std::string who = "model '" + model + "' link '" + link + "' sensor '" + name + "': ";
     auto it = models.find(model);
@@ -353,11 +424,13 @@ void read_sensor_keys(const json& engine, double step_s, const std::string& poin
       problems->emplace_back(at + "/Model",
                              who + "no model '" + model +
                                  "' in the world file or GazeboSDFModels (models: " + known + ")");
-    } else if (it->second.first && !it->second.second.count(link)) {
+    } else if (it->second.known && !it->second.links.count(link)) {
       std::string known;
-      for (const auto& l : it->second.second) known += (known.empty() ? "" : ", ") + l;
+      for (const auto& l : it->second.links) known += (known.empty() ? "" : ", ") + l;
       problems->emplace_back(at + "/Link", who + "model '" + model + "' has no link '" + link +
                                                "' (links: " + known + ")");
+    } else if (it->second.known && entry->type == "wheel_odometry") {
+      check_joints(*entry, it->second, at, who, problems);
     }
   }
 }

@@ -2,6 +2,7 @@
 #include "convoy/datapacks.pb.h"
 #include "convoy/nav_sensors.pb.h"
 #include "convoy/point_cloud.pb.h"
+#include "convoy/radar.pb.h"
 #include "convoy/road_users.pb.h"
 #include "datapack/nrp.h"
 #include "datapack/registry.h"
@@ -19,6 +20,8 @@ void register_standard_types(Registry& r) {
   r.add<data::PointCloud>("PointCloudDataPack");  // LiDAR (proto/convoy/point_cloud.proto)
   r.add<data::Imu>("ImuDataPack");                // proto/convoy/nav_sensors.proto
   r.add<data::NavSat>("NavSatDataPack");
+  r.add<data::Radar>("RadarDataPack");  // proto/convoy/radar.proto
+  r.add<data::Odometry>("OdometryDataPack");
   // NRP-Core's message set (datapack/nrp.h): Dump, EngineTest, Gazebo, NrpGenericProto,
   // Wrappers. Gazebo.Camera / Joint / Link travel as the three above, whose Python classes
   // keep the names GazeboCameraDataPack... (Registry::add: a named class wins).

@@ -61,7 +61,8 @@ TEST(SensorKeys, BadValuesNameTheFieldAndTheSensor) {
                 "100 Hz is above the engine's step rate (1 / EngineTimestep = 50 Hz)");
   EXPECT_EQ(only_problem(lidar_engine({{"Type", "sonar"}})),
             "/EngineConfigs/0/Sensors/0/Type | " + who +
-                "unknown type 'sonar' (lidar, gpu_lidar, ray, gpu_ray, imu, navsat)");
+                "unknown type 'sonar' (lidar, gpu_lidar, ray, gpu_ray, imu, navsat, radar, "
+                "wheel_odometry)");
   EXPECT_EQ(only_problem(lidar_engine({{"Preset", "vlp99"}})),
             "/EngineConfigs/0/Sensors/0/Preset | " + who +
                 "unknown preset 'vlp99' (vlp16, hdl32, hdl64)");
