@@ -14,6 +14,7 @@
 #include <ctime>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -258,16 +259,14 @@ int load(const RunOptions& options, RunLog& log, config::SimulationConfig* cfg, 
     return kExitUserError;
   }
   const bool event_loop = cfg->loop == "EventLoop";
-  if (event_loop && !cfg->engines.empty())
-    log.info(
-        "warning: SimulationLoop EventLoop with EngineConfigs is not available yet; running "
-        "the FTILoop (the graph in it, as DataPackProcessor cg)");
+  if (event_loop && cfg->record)
+    log.info("warning: Record is not available with SimulationLoop EventLoop; nothing is recorded");
   if (cfg->process_launcher_type != "Basic")
     log.info("warning: ProcessLauncherType " + cfg->process_launcher_type +
              " is not available; using Basic");
   // ComputationalGraph, EventLoop and ExternalProcesses are the config's (its warnings say
-  // when they are ignored); MQTTNode and ROSNode are used by the EventLoop without engines.
-  const bool graph_clients = event_loop && cfg->engines.empty();
+  // when they are ignored); MQTTNode and ROSNode are the graph's (EventLoop or cg).
+  const bool graph_clients = event_loop || cfg->datapack_processor == "cg";
   for (const char* key : {"ConnectROS", "ConnectMQTT", "EventLoopTimeout", "EventLoopTimestep",
                           "ROSNode", "MQTTNode"}) {
     if (graph_clients && (std::string(key) == "ROSNode" || std::string(key) == "MQTTNode"))
@@ -297,6 +296,7 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
                     loop::DataPackTap* live_tap, loop::PauseGate* gate) {
   export_run_environment(run_dir);
   python::Interpreter interpreter;
+  std::optional<GraphClients> graph_clients;  // closed after the session's graph is gone
   ExternalProcesses external(cfg, run_dir / "logs");
   Session session(cfg, run_dir, log, quiet);
   Outcome outcome;
@@ -314,6 +314,8 @@ Outcome run_engines(const config::SimulationConfig& cfg, const fs::path& run_dir
         throw UserError(std::string("Record: ") + e.what());
       }
     }
+    if (cfg.datapack_processor == "cg" && (cfg.mqtt_node || cfg.ros_node))
+      graph_clients.emplace(cfg, run_dir / "logs", log);  // the graph's MQTT and ROS nodes
     external.start(log);
     session.initialize(/*keep_observations=*/false);
     session.run_to_end();
@@ -398,10 +400,10 @@ int run_simulation(const RunOptions& options) {
     }
   }
   Outcome outcome;
-  if (cfg.loop == "EventLoop" && cfg.engines.empty()) {
+  if (cfg.loop == "EventLoop") {
     export_run_environment(run_dir);
     python::Interpreter interpreter;
-    outcome = run_event_loop(cfg, run_dir, log, &figures);
+    outcome = run_event_loop(cfg, run_dir, log, &figures, options.quiet);
   } else {
     outcome = run_engines(cfg, run_dir, options.quiet, log, &figures, &startup,
                           live ? live->tap() : nullptr, live ? live->gate() : nullptr);

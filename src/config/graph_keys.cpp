@@ -74,13 +74,17 @@ void read_graph_keys(const nlohmann::json& doc, SimulationConfig& config, Issues
       warnings->emplace_back("/ComputationalGraph",
                              "DataPackProcessor is cg but no graph file is given: nothing relays "
                              "datapacks between the engines");
+  }
+  if (cg || event_loop) {
+    // With the EventLoop the engines' FTILoop always runs the graph (NRP-Core's slave mode).
+    const std::string why = cg ? "DataPackProcessor is cg" : "SimulationLoop is EventLoop";
     if (doc.contains("DataPackProcessingFunctions") && !doc["DataPackProcessingFunctions"].empty())
-      warnings->emplace_back("/DataPackProcessingFunctions",
-                             "ignored: DataPackProcessor is cg (as in NRP-Core, the graph "
-                             "replaces the transceiver functions)");
+      warnings->emplace_back(
+          "/DataPackProcessingFunctions",
+          "ignored: " + why + " (as in NRP-Core, the graph replaces the transceiver functions)");
     if (doc.contains("StatusFunction"))
       warnings->emplace_back("/StatusFunction",
-                             "ignored: DataPackProcessor is cg (NRP-Core runs it with tf only)");
+                             "ignored: " + why + " (NRP-Core runs it with tf only)");
   } else if (!event_loop && !config.computational_graph.empty()) {
     warnings->emplace_back("/ComputationalGraph",
                            "ignored: used with DataPackProcessor cg or SimulationLoop EventLoop");

@@ -1,5 +1,6 @@
 #include "python/graph_runtime.h"
 
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -45,12 +46,19 @@ void GraphRuntime::load(const std::vector<fs::path>& files, const fs::path& base
   try {
     py::module_ el = py::module_::import("nrp_core.event_loop");
     empty_class_ = py::module_::import("nrp_core._datapacks").attr("EmptyDataPack");
-    py::object transports = el.attr("Transports")(py::none(), py::none());
-    graph_ = el.attr("load_computational_graph")(py_files, py::arg("transports") = transports,
-                                                 py::arg("base_dir") = base_dir.string(),
-                                                 py::arg("fti_loop") = true);
-    link_ = el.attr("EngineLink")(graph_);
-    step_ = el.attr("FTIStep")(graph_, link_, py::none());
+    graph_ = py::module_::import("nrp_core.event_loop._loop").attr("event_loop_graph")();
+    slave_ = !graph_.is_none();
+    if (slave_) {
+      link_ = el.attr("EngineLink")(graph_);
+    } else {
+      py::object transports =
+          py::module_::import("nrp_core.event_loop._clients").attr("active_transports")();
+      graph_ = el.attr("load_computational_graph")(py_files, py::arg("transports") = transports,
+                                                   py::arg("base_dir") = base_dir.string(),
+                                                   py::arg("fti_loop") = true);
+      link_ = el.attr("EngineLink")(graph_);
+      step_ = el.attr("FTIStep")(graph_, link_, transports.attr("ros"));
+    }
     py::object ns = py::module_::import("types").attr("SimpleNamespace");
     source_ = ns(py::arg("get_datapacks") =
                      py::cpp_function([this](const std::string& engine, const py::list& names) {
@@ -105,8 +113,10 @@ py::list GraphRuntime::get_datapacks(const std::string& engine, const py::list& 
       continue;
     }
     const datapack::BlobReader* reader = src_->reader_for ? src_->reader_for(engine) : nullptr;
+    // Slave mode: the EventLoop reads the datapack in a later cycle, so images are copied.
     py::object obj =
-        to_python(datapack::View(*dp, reader ? *reader : datapack::inline_blob_reader()));
+        to_python(datapack::View(*dp, reader ? *reader : datapack::inline_blob_reader()),
+                  slave_ ? ImageAccess::kCopy : ImageAccess::kView);
     if (src_->updated && !src_->updated(engine, name)) obj.attr("_updated") = false;
     out.append(obj);
   }
@@ -131,13 +141,20 @@ void GraphRuntime::send_datapacks(const std::string& engine, const py::list& dat
 
 void GraphRuntime::run_graph(const std::vector<std::string>& due_engines,
                              const loop::InputSource& src, std::vector<engine::DataPack>* outputs) {
+  std::optional<py::gil_scoped_acquire> gil;
+  if (slave_) gil.emplace();   // on the FTILoop's thread, beside the EventLoop's
   set_live_time(src.time_ns);  // what convoy_live.publish stamps its messages with
   src_ = &src;
   outputs_ = outputs;
   try {
     py::list due;
     for (const auto& e : due_engines) due.append(e);
-    step_.attr("step")(source_, sink_, due, src.time_ns / 1'000'000, src.iteration);
+    if (slave_) {
+      link_.attr("update_from_engines")(source_, due);
+      link_.attr("send_to_engines")(sink_, due);
+    } else {
+      step_.attr("step")(source_, sink_, due, src.time_ns / 1'000'000, src.iteration);
+    }
   } catch (py::error_already_set& e) {
     src_ = nullptr;
     throw FunctionError(label_ + ": " + message_of(e));

@@ -6,7 +6,14 @@
 // computed only when their engine has finished a step). Each loop cycle, run_graph() pushes
 // the due engines' datapacks into their FromEngine nodes ("<engine>_input"), sets the Clock
 // node to the simulated time in ms and the Iteration node to the cycle, computes the graph and
-// returns what the due engines' ToEngine nodes ("<engine>_output") hold.
+// returns what the due engines' ToEngine nodes ("<engine>_output") hold. The graph's MQTT and
+// ROS nodes use the process's active GraphClients (nrp_core.event_loop._clients), if any.
+//
+// Slave mode (SimulationLoop "EventLoop" with EngineConfigs, NRP-Core's ComputationalGraphHandle
+// with slaveMode): when an EventLoop runs in the process (nrp_core.event_loop._loop
+// .event_loop_graph()), load() takes its graph instead of loading the files, and run_graph(),
+// called on the FTILoop's own thread, takes the GIL, hands the due engines' datapacks to the
+// FromEngine nodes and sends what their ToEngine nodes hold; the EventLoop computes the graph.
 #pragma once
 
 #include <filesystem>
@@ -33,6 +40,8 @@ class GraphRuntime final : public loop::FunctionRunner {
   std::vector<std::pair<std::string, std::string>> requested() const { return requested_; }
   // "computational graph (a.py, b.py)", for messages.
   const std::string& label() const { return label_; }
+  // The graph is an EventLoop's (see above).
+  bool slave() const { return slave_; }
 
   void begin_cycle() override {}
   // A graph has no transceiver or preprocessing functions: these throw std::logic_error.
@@ -49,6 +58,7 @@ class GraphRuntime final : public loop::FunctionRunner {
   void send_datapacks(const std::string& engine, const py::list& datapacks);
 
   std::string label_;
+  bool slave_ = false;
   py::object graph_, link_, step_;
   py::object source_, sink_;  // the FTIStep's DataPackSource and DataPackSink
   py::object empty_class_;    // nrp_core._datapacks.EmptyDataPack

@@ -4,7 +4,6 @@ that NRP-Core's Python module exports for asynchronous engines.
 """
 import abc
 import logging
-import os
 import threading
 import time
 
@@ -171,53 +170,48 @@ class EventLoopInterface(abc.ABC):
 
 
 class EventLoopRun:
-    """The coordinator's SimulationLoop "EventLoop" without engines (NRP-Core 1.4's
-    EventLoopSimManager): connect() makes the config's MQTTNode client (starting mosquitto
-    on a local MQTTBroker no broker answers on) and ROSNode node; load() the
-    ComputationalGraph; run() cycles every EventLoop.Timestep until EventLoop.Timeout wall
-    seconds; close() disconnects and stops what connect() started.
+    """The coordinator's SimulationLoop "EventLoop" (NRP-Core 1.4's EventLoopSimManager):
+    connect() makes the config's MQTTNode client (starting mosquitto on a local MQTTBroker no
+    broker answers on) and ROSNode node; load() the ComputationalGraph; run() cycles every
+    EventLoop.Timestep until EventLoop.Timeout wall seconds; close() disconnects and stops
+    what connect() started.
+
+    With EngineConfigs the coordinator also runs the engines' FTILoop on another thread, its
+    DataPackProcessor the graph in slave mode (NRP-Core's ComputationalGraphHandle with
+    slaveMode): from load() to close(), event_loop_graph() is this loop's graph, whose
+    FromEngine nodes the FTILoop fills and whose ToEngine nodes it drains, without computing.
 
     `config` is the simulation config (a dict with defaults filled or not); `log_dir` holds
     mosquitto's log. Errors are ComputationalGraphError naming the key."""
 
     def __init__(self, config, log_dir):
-        self.config = config
-        self.log_dir = log_dir
+        from ._clients import GraphClients
         loop = config.get("EventLoop") or {}
         self.timeout = float(loop.get("Timeout", 0.0))
         self.timestep = float(loop.get("Timestep", 0.01))
         self.warn_threshold = float(loop.get("TimestepWarnThreshold", 0.001))
         self.exec_mode = loop.get("ExecutionMode", "AllNodes")
-        self.mqtt = self.ros = self.broker = self.graph = self.loop = None
+        self.clients = GraphClients(config, log_dir)
+        self.graph = self.loop = None
+
+    @property
+    def broker(self):
+        return self.clients.broker
 
     def connect(self):
-        from ._mqtt import DEFAULT_BROKER, LocalBroker, MqttConnection, MqttError
-        from ._policies import ComputationalGraphError
-        node = self.config.get("MQTTNode")
-        if node is not None:
-            address = node.get("MQTTBroker", DEFAULT_BROKER)
-            try:
-                self.broker = LocalBroker.ensure(address, os.path.join(self.log_dir,
-                                                                       "mosquitto.log"))
-                if self.broker is not None:
-                    _log.info("started mosquitto on %s for the run", address)
-                self.mqtt = MqttConnection(address, node.get("ClientName", "NRP-core-client"))
-            except (MqttError, ValueError) as e:
-                self.close()
-                raise ComputationalGraphError("MQTTNode.MQTTBroker: %s" % e) from None
-        if self.config.get("ROSNode") is not None:
-            from ._rospy_transport import RospyInterface
-            self.ros = RospyInterface(self.config["ROSNode"].get("NodeName", "nrp_core"))
+        self.clients.connect()
 
     def load(self, files, base_dir):
+        global _running_graph
         from ._loader import load_computational_graph
         from ._policies import ExecutionMode
-        from ._transport import Transports
         mode = ExecutionMode.OUTPUT_DRIVEN if self.exec_mode == "OutputDriven" else \
             ExecutionMode.ALL_NODES
-        self.graph = load_computational_graph(files, mode, Transports(self.mqtt, self.ros),
+        self.graph = load_computational_graph(files, mode, self.clients.transports(),
                                               base_dir=base_dir)
-        self.loop = EventLoop(self.graph, self.timestep, self.warn_threshold, ros=self.ros)
+        self.loop = EventLoop(self.graph, self.timestep, self.warn_threshold,
+                              ros=self.clients.ros)
+        _running_graph = self.graph
 
     def run(self, should_stop=None):
         """Runs the loop; returns the number of cycles."""
@@ -227,12 +221,16 @@ class EventLoopRun:
         return self.loop.iterations
 
     def close(self):
-        if self.mqtt is not None:
-            self.mqtt.close()
-            self.mqtt = None
-        if self.ros is not None:
-            self.ros.shutdown()
-            self.ros = None
-        if self.broker is not None:
-            self.broker.stop()
-            self.broker = None
+        global _running_graph
+        if _running_graph is self.graph:
+            _running_graph = None
+        self.clients.close()
+
+
+_running_graph = None
+
+
+def event_loop_graph():
+    """The graph of the EventLoop that runs in this process (None without one): the FTILoop's
+    DataPackProcessor then works on it in slave mode."""
+    return _running_graph

@@ -94,7 +94,9 @@ class MqttConnection(MQTTClient):
         body = _utf8("MQTT") + bytes([4, 0x02]) + struct.pack("!H", keepalive) + _utf8(client_id)
         try:
             self._sock.sendall(_packet(0x10, body))
-            kind, payload = self._read_packet()
+            # The first byte alone: a server that is no broker may answer little, then close.
+            kind = self._read_exact(1)[0]
+            payload = self._read_rest() if kind == 0x20 else b""
         except (OSError, EOFError) as e:
             self._sock.close()
             raise MqttError("the MQTT broker %s did not answer: %s" % (broker, e)) from None
@@ -163,6 +165,10 @@ class MqttConnection(MQTTClient):
 
     def _read_packet(self):
         kind = self._read_exact(1)[0]
+        return kind, self._read_rest()
+
+    def _read_rest(self):
+        """The remaining length and the rest of a packet whose first byte was read."""
         length, shift = 0, 0
         while True:
             byte = self._read_exact(1)[0]
@@ -170,7 +176,7 @@ class MqttConnection(MQTTClient):
             shift += 7
             if not byte & 0x80:
                 break
-        return kind, self._read_exact(length) if length else b""
+        return self._read_exact(length) if length else b""
 
     def _read_loop(self):
         while not self._closed:

@@ -23,6 +23,7 @@ import time
 import urllib.parse
 import xmlrpc.client
 
+from ._mqtt import _die_with_parent  # the master dies with a killed coordinator
 from ._policies import ComputationalGraphError
 from ._transport import ROSInterface
 
@@ -59,7 +60,7 @@ def start_master(uri, log_path=None, wait=10.0):
     try:
         proc = subprocess.Popen(["rosmaster", "--core", "-p", str(u.port or 11311)],
                                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                start_new_session=True)
+                                start_new_session=True, preexec_fn=_die_with_parent)
     except OSError as e:
         raise ComputationalGraphError("no ROS master at %s and none can be started: rosmaster: %s"
                                       % (uri, e.strerror)) from None
