@@ -36,6 +36,14 @@ third frame, the planner, 20 vehicle agents, 10 pedestrian agents, SUMO, the lig
   - camera frames/s (wall): frames written to camera.mp4 per wall second of the loop
     (target >= 20), detector frames and detections per wall second, the real-time factor.
 
+With --city-road-users N the section runs experiments/city_traffic/simulation_config_pooled.json
+instead: the ego among N vehicles of ONE road_user_pool engine (-o EngineConfigs/5/Density=0
+-o EngineConfigs/5/Count=N), drawn by the world engine as actors; it prints the same lines,
+the world's collisions (pooled vehicles with each other and with the ego; the pool does not see
+the ego) and, from traffic_pool_bench on city.xodr, the collisions among the N pooled vehicles
+over 600 simulated s (target 0). A count the map cannot hold ends the section with the pool's
+message (city.xodr holds about 400).
+
 Section "density": experiments/city_traffic/simulation_config_density.json, 10 simulated
 minutes of the same road users respawning at their starts and SUMO's flows doubled (no ego).
 Prints the collisions among participants (target 0), red-light violations, the road users
@@ -279,9 +287,11 @@ def section_agents(args):
 CITY = os.path.join(REPO, "experiments", "city_traffic")
 
 
-def city_run(args, config, end, run_dir, env=None):
+def city_run(args, config, end, run_dir, env=None, overrides=()):
     cmd = [os.path.join(args.build, "bin", "convoy"), "run", "-c", config, "--run-dir", run_dir,
            "-o", "SimulationTimeout=%g" % end]
+    for o in overrides:
+        cmd += ["-o", o]
     out = subprocess.run(cmd, cwd=CITY, capture_output=True, text=True, env=env)
     if out.returncode != 0:
         sys.exit("city: %s failed (exit %d):\n%s" % (config, out.returncode, out.stderr[-3000:]))
@@ -294,17 +304,36 @@ def city_run(args, config, end, run_dir, env=None):
         return startup, json.load(f)
 
 
+POOLED_CITY = "simulation_config_pooled.json"
+
+
+def pooled_city_collisions(args, n):
+    """The pool alone on city.xodr, N vehicles for 600 simulated s: its collision line."""
+    bench = os.path.join(args.build, "benchmarks", "traffic_pool_bench")
+    if not os.path.exists(bench):
+        return "traffic_pool_bench is not built"
+    r = subprocess.run([bench, os.path.join(CITY, "city.xodr"), "--counts", str(n),
+                        "--seconds", "600"], capture_output=True, text=True)
+    lines = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().startswith("N =")]
+    return lines[0] if r.returncode == 0 and lines else (r.stderr or r.stdout).strip()[-500:]
+
+
 def section_city(args):
-    if not os.path.exists(os.path.join(args.build, "bin", "convoy-engine-sumo")):
-        print("city: the sumo engine is not built")
+    pooled = args.city_road_users > 0
+    engine = "convoy-engine-road_user_pool" if pooled else "convoy-engine-sumo"
+    if not os.path.exists(os.path.join(args.build, "bin", engine)):
+        print("city: %s is not built" % engine)
         return
+    config = POOLED_CITY if pooled else "simulation_config.json"
+    overrides = ["EngineConfigs/5/Density=0", "EngineConfigs/5/Count=%d" % args.city_road_users] \
+        if pooled else []
     work = tempfile.mkdtemp(prefix="convoy-trafficbench-city-")
     try:
         env = dict(os.environ, CONVOY_CACHE_DIR=os.path.join(work, "cache"))
         rows = []
         for i in range(args.runs + 1):  # the first with an empty cache, then --runs warm
-            startup, s = city_run(args, "simulation_config.json", args.city_end,
-                                  os.path.join(work, "run%d" % i), env)
+            startup, s = city_run(args, config, args.city_end, os.path.join(work, "run%d" % i),
+                                  env, overrides)
             wall = s["loop_wall_s"]
             rows.append((startup, s["camera_frames"] / wall, s["detector_frames"] / wall,
                          s["detections"] / wall, s["real_time_factor"], s))
@@ -312,9 +341,10 @@ def section_city(args):
         warm = rows[1:]
         med = lambda k: statistics.median(r[k] for r in warm)  # noqa: E731
         s = rows[-1][5]
-        print("city: experiments/city_traffic, %g s simulated, %d run(s) (the first with an empty "
-              "parsed-world cache); participants %s" % (args.city_end, len(rows),
-                                                         json.dumps(s["participants"])))
+        print("city: experiments/city_traffic/%s, %g s simulated, %d run(s) (the first with an "
+              "empty parsed-world cache); participants %s%s"
+              % (config, args.city_end, len(rows), json.dumps(s["participants"]),
+                 ", pooled road users %d" % args.city_road_users if pooled else ""))
         print("  start-up (engines initialized in): %.2f s with the cache (runs: %s), %.2f s "
               "without it  target <= 2 s" % (med(0), ", ".join("%.2f" % r[0] for r in warm),
                                             rows[0][0]))
@@ -325,6 +355,12 @@ def section_city(args):
         print("  real-time factor: %.2fx; collisions %d, red-light violations %d, ego stops "
               "for pedestrians %s" % (med(4), len(s["collisions"]), s["red_light_violations"],
                                       s["ego_stops_for_pedestrians"]))
+        if pooled:
+            for c in s["collisions"]:
+                print("    %s" % json.dumps(c))
+            print("  collisions among the %d pooled vehicles, 600 simulated s (the pool alone): "
+                  "%s  target 0" % (args.city_road_users,
+                                    pooled_city_collisions(args, args.city_road_users)))
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -441,6 +477,9 @@ def main():
     ap.add_argument("--agents", default="8,16,32,64,128,256", help="agent counts, comma-separated")
     ap.add_argument("--city-end", type=float, default=60.0,
                     help="simulated seconds of each city run")
+    ap.add_argument("--city-road-users", type=int, default=0,
+                    help="city section: run simulation_config_pooled.json with N pooled "
+                         "vehicles instead of the agent engines and SUMO (0: the usual config)")
     ap.add_argument("--density-end", type=float, default=600.0,
                     help="simulated seconds of the density run")
     ap.add_argument("--agent-end", type=float, default=10.0,

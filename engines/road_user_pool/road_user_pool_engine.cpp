@@ -2,13 +2,14 @@
 // with its own parameters, seed and policy. The behaviour (IDM, MOBIL, junctions, lights, the
 // neighbour grid) is src/traffic_pool; this file only reads the config and writes the datapack.
 //
-// Config keys (schema.json): Map, Vehicles (listed), Count + Seed + Policy + DesiredSpeed
-// (spawned), RoadUsersDataPack. Datapack: <RoadUsersDataPack> convoy.data.RoadUsers, every
-// vehicle's state after the last step (reference point: the rear axle, a quarter of the length
-// ahead of the rear bumper), ids "<engine>/<id>"; protobuf's binary form, not JSON.
-// Bad input (an unknown policy, two road users on one spot, a count the map cannot hold, a
-// destination with no path) fails initialize with one message naming the road user.
+// Config keys (schema.json): Map, Vehicles (listed), Count or Density + Seed + Policy +
+// DesiredSpeed + KeepClear (spawned), RoadUsersDataPack. Datapack: <RoadUsersDataPack>
+// convoy.data.RoadUsers, every vehicle's state after the last step (reference point: the rear axle,
+// a quarter of the length ahead of the rear bumper), ids "<engine>/<id>"; protobuf's binary form,
+// not JSON. Bad input (an unknown policy, two road users on one spot, a count the map cannot hold,
+// a destination with no path) fails initialize with one message naming the road user.
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <stdexcept>
 
@@ -125,12 +126,13 @@ class RoadUserPoolEngine final : public Engine {
     const json& list = config_.value("Vehicles", json::array());
     if (!list.is_array()) throw std::runtime_error("Vehicles must be a list");
     for (size_t k = 0; k < list.size(); ++k) specs.push_back(listed(list[k], k));
-    const size_t count = config_.value("Count", 0);
+    tp::VehicleSpec base;
+    base.policy = config_.value("Policy", "idm_mobil");
+    base.idm.v0 = config_.value("DesiredSpeed", 13.9);
+    const std::vector<tp::ClearZone> clear = keep_clear();
+    const size_t count = spawn_count(base, clear);
     if (count > 0) {
-      tp::VehicleSpec base;
-      base.policy = config_.value("Policy", "idm_mobil");
-      base.idm.v0 = config_.value("DesiredSpeed", 13.9);
-      auto more = tp::spawn(*net_, count, config_.value("Seed", 1), base);
+      auto more = tp::spawn(*net_, count, config_.value("Seed", 1), base, "pool/", clear);
       specs.insert(specs.end(), more.begin(), more.end());
     }
     pool_ = std::make_unique<tp::Pool>(*net_, std::move(specs));
@@ -147,6 +149,52 @@ class RoadUserPoolEngine final : public Engine {
       u->set_length_offset(s.length * (0.5 - kRearAxleFraction));
     }
     publish();
+  }
+
+  std::vector<tp::ClearZone> keep_clear() const {
+    std::vector<tp::ClearZone> out;
+    const json& list = config_.value("KeepClear", json::array());
+    for (size_t k = 0; k < list.size(); ++k) {
+      const std::string who = "KeepClear[" + std::to_string(k) + "]";
+      if (!list[k].is_object()) throw std::runtime_error(who + " must be {X, Y, Radius}");
+      tp::ClearZone z;
+      z.x = number(list[k], "X", 0, who);
+      z.y = number(list[k], "Y", 0, who);
+      z.radius = number(list[k], "Radius", 0, who);
+      if (!(z.radius > 0)) throw std::runtime_error(who + ": Radius must be > 0 m");
+      out.push_back(z);
+    }
+    return out;
+  }
+
+  // Count, or Density (vehicles per km of driving lane outside junctions) times the map's
+  // length of them; a density the map cannot hold names the key and the map's capacity.
+  size_t spawn_count(const tp::VehicleSpec& base, const std::vector<tp::ClearZone>& clear) const {
+    const size_t given = config_.value("Count", 0);
+    if (!config_.contains("Density")) return given;
+    const json& d = config_.at("Density");
+    if (!d.is_number() || !(d.get<double>() >= 0)) {
+      throw std::runtime_error(
+          "Density must be a number >= 0 (vehicles per km of driving lane), "
+          "got " +
+          d.dump());
+    }
+    if (d.get<double>() == 0) return given;  // 0: unused, Count counts
+    if (given != 0) throw std::runtime_error("give Count or Density, not both (or Density 0)");
+    const double km = tp::driving_km(*net_), density = d.get<double>();
+    const auto count = static_cast<size_t>(std::llround(density * km));
+    const size_t capacity = tp::spawn_capacity(*net_, base, clear);
+    if (count > capacity) {
+      char m[400];
+      std::snprintf(m, sizeof m,
+                    "Density %g vehicles/km cannot fit the map %s: %zu vehicles on its %.2f km of "
+                    "driving lanes outside junctions, which hold at most %zu (%.1f vehicles/km, "
+                    "%.1f m apart)",
+                    density, config_.value("Map", "").c_str(), count, km, capacity,
+                    km > 0 ? capacity / km : 0.0, base.length + base.idm.s0 + 2);
+      throw std::runtime_error(m);
+    }
+    return count;
   }
 
   void publish() {

@@ -46,11 +46,23 @@ struct VehicleSpec {
   uint32_t pool_lane = kNone;  // spawned: the PoolNetwork lane itself (road/lane/s are shown)
 };
 
+// A disc kept clear of spawned vehicles (another road user's start, e.g. the ego's).
+struct ClearZone {
+  double x = 0, y = 0, radius = 0;
+};
+
 // `count` vehicles like `base` (ids "<prefix><k>", seeds seed + k) on free slots of the
 // network's driving lanes outside junctions, spaced at least base.length + base.idm.s0 + 2 m,
-// drawn by `seed`. Throws PoolError when the network has fewer slots than `count`.
+// none with its centre in a `keep_clear` zone, drawn by `seed`. Throws PoolError when the
+// network has fewer slots than `count`.
 std::vector<VehicleSpec> spawn(const PoolNetwork& net, size_t count, uint64_t seed,
-                               const VehicleSpec& base, const std::string& prefix = "pool/");
+                               const VehicleSpec& base, const std::string& prefix = "pool/",
+                               const std::vector<ClearZone>& keep_clear = {});
+// How many vehicles like `base` spawn() can place (its slots).
+size_t spawn_capacity(const PoolNetwork& net, const VehicleSpec& base,
+                      const std::vector<ClearZone>& keep_clear = {});
+// Length of the driving lanes outside junctions, km (what a density is per).
+double driving_km(const PoolNetwork& net);
 
 struct PoolStats {
   uint64_t lane_changes = 0, junction_entries = 0, respawns = 0;
@@ -103,6 +115,7 @@ class Pool {
   std::vector<uint64_t> rng_;
   std::vector<std::vector<uint32_t>> route_;  // lanes still to drive (destination given)
   std::vector<uint8_t> mobil_;
+  std::vector<uint32_t> entries_;  // lanes no lane leads into (the map's edges): respawns
   // Per lane: vehicles on it by s (rebuilt each step), claims of junction lanes, changes in.
   std::vector<uint32_t> order_, lane_begin_, rank_;
   std::vector<uint16_t> claims_;

@@ -57,6 +57,13 @@ Pool::Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m
   route_.assign(n, {});
   mobil_.assign(n, 0);
   claims_.assign(net_.lanes().size(), 0);
+  std::vector<uint8_t> led_into(net_.lanes().size(), 0);
+  for (const PoolLane& l : net_.lanes()) {
+    for (uint32_t k : l.next) led_into[k] = 1;
+  }
+  for (uint32_t l = 0; l < net_.lanes().size(); ++l) {
+    if (!led_into[l] && net_.lane(l).junction < 0) entries_.push_back(l);
+  }
   validate();
   for (size_t i = 0; i < n; ++i) place(i);
   build_grid();
@@ -156,13 +163,15 @@ void Pool::place(size_t i) {
   update_pose(i);
 }
 
-// A vehicle at a dead end starts again, standing, at the start of a lane drawn by its seed
-// whose first metres are free; it waits at the dead end while none of 16 draws is.
+// A vehicle at a dead end (it leaves the map) starts again, standing, at the start of a lane
+// drawn by its seed whose first metres are free: one of the map's entries (lanes no lane leads
+// into) when it has some, else any lane; it waits at the dead end while none of 16 draws is.
 void Pool::respawn(size_t i) {
   const VehicleSpec& v = specs_[i];
-  const size_t nl = net_.lanes().size();
+  const size_t nl = entries_.empty() ? net_.lanes().size() : entries_.size();
   for (int attempt = 0; attempt < 16; ++attempt) {
-    const uint32_t l = static_cast<uint32_t>(mix(rng_[i] += 0x51ed27) % nl);
+    const size_t draw = mix(rng_[i] += 0x51ed27) % nl;
+    const uint32_t l = entries_.empty() ? static_cast<uint32_t>(draw) : entries_[draw];
     const PoolLane& lane = net_.lane(l);
     // One entry into a lane per step (lane changes and respawns): the lists are the step's.
     if (lane.junction >= 0 || lane.length < 2 * v.length + 20 || changed_into_[l]) continue;
@@ -172,9 +181,15 @@ void Pool::respawn(size_t i) {
       const uint32_t j = order_[lane_begin_[l]];
       free = s_[j] - specs_[j].length > s + v.idm.s0 + 5;
     }
+    // Nobody's box within 2 * (s0 + 1) m ahead or behind, or 0.3 m beside (a vehicle on the
+    // next lane, or queued on the lane out of the map beside this entry, does not block it).
     const opendrive::Pose2 p = lane.at(s - 0.5 * v.length);
-    for_near(p.x, p.y, 12, [&](uint32_t k) {
-      if (k != i && std::hypot(x_[k] - p.x, y_[k] - p.y) < 12) free = false;
+    const double clear_l = v.length + 4 * (v.idm.s0 + 1), clear_w = v.width + 0.6;
+    for_near(p.x, p.y, 0.5 * clear_l + 8, [&](uint32_t k) {
+      if (k != i && boxes_overlap(p.x, p.y, p.heading, clear_l, clear_w, x_[k], y_[k], yaw_[k],
+                                  specs_[k].length, specs_[k].width)) {
+        free = false;
+      }
     });
     if (!free) continue;
     if (claim_[i] != kNone) --claims_[claim_[i]];
@@ -211,15 +226,44 @@ std::vector<std::pair<uint32_t, uint32_t>> Pool::overlaps() const {
   return out;
 }
 
-std::vector<VehicleSpec> spawn(const PoolNetwork& net, size_t count, uint64_t seed,
-                               const VehicleSpec& base, const std::string& prefix) {
+namespace {
+std::vector<std::pair<uint32_t, double>> slots_of(const PoolNetwork& net, const VehicleSpec& base,
+                                                  const std::vector<ClearZone>& keep_clear) {
   const double spacing = base.length + base.idm.s0 + 2;
   std::vector<std::pair<uint32_t, double>> slots;
   for (uint32_t l = 0; l < net.lanes().size(); ++l) {
     const PoolLane& lane = net.lane(l);
     if (lane.junction >= 0) continue;
-    for (double s = base.length + 1; s <= lane.length - 1; s += spacing) slots.emplace_back(l, s);
+    for (double s = base.length + 1; s <= lane.length - 1; s += spacing) {
+      const opendrive::Pose2 p = lane.at(s - 0.5 * base.length);
+      const bool clear = std::none_of(
+          keep_clear.begin(), keep_clear.end(),
+          [&](const ClearZone& z) { return std::hypot(p.x - z.x, p.y - z.y) < z.radius; });
+      if (clear) slots.emplace_back(l, s);
+    }
   }
+  return slots;
+}
+}  // namespace
+
+size_t spawn_capacity(const PoolNetwork& net, const VehicleSpec& base,
+                      const std::vector<ClearZone>& keep_clear) {
+  return slots_of(net, base, keep_clear).size();
+}
+
+double driving_km(const PoolNetwork& net) {
+  double m = 0;
+  for (const PoolLane& lane : net.lanes()) {
+    if (lane.junction < 0) m += lane.length;
+  }
+  return m / 1000;
+}
+
+std::vector<VehicleSpec> spawn(const PoolNetwork& net, size_t count, uint64_t seed,
+                               const VehicleSpec& base, const std::string& prefix,
+                               const std::vector<ClearZone>& keep_clear) {
+  const double spacing = base.length + base.idm.s0 + 2;
+  std::vector<std::pair<uint32_t, double>> slots = slots_of(net, base, keep_clear);
   if (count > slots.size()) {
     std::ostringstream m;
     m << "road user '" << prefix << slots.size() << "': a count of " << count

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <set>
 
@@ -100,6 +102,28 @@ TEST(PoolErrors, TwoOnOneSpot) {
 TEST(PoolErrors, CountThatCannotFit) {
   const std::string e = error_of([&] { spawn(map().pool, 100000, 1, VehicleSpec{}); });
   EXPECT_NE(e.find("a count of 100000 cannot fit the network"), std::string::npos) << e;
+}
+
+TEST(PoolSpawn, CapacityKmAndKeepClear) {
+  const PoolNetwork& net = map().pool;
+  const VehicleSpec base;
+  const size_t all = spawn_capacity(net, base);
+  EXPECT_EQ(spawn(net, all, 1, base).size(), all);
+  const double km = driving_km(net);
+  EXPECT_GT(km, 1.0);
+  // Slots are length + s0 + 2 = 8.5 m apart on each lane: ~118 a km, one more or less a lane.
+  EXPECT_LE(all, static_cast<size_t>(km * 1000 / 8.5) + net.lanes().size());
+  EXPECT_GT(all, static_cast<size_t>(km * 1000 / 8.5 * 0.7));
+  // A disc round the middle of the map is kept clear, and costs slots.
+  const ClearZone z{0.5 * (net.min_x + net.max_x), 0.5 * (net.min_y + net.max_y), 60};
+  const size_t kept = spawn_capacity(net, base, {z});
+  EXPECT_LT(kept, all);
+  for (const VehicleSpec& v : spawn(net, kept, 3, base, "pool/", {z})) {
+    const opendrive::Pose2 p = net.lane(v.pool_lane).at(v.s - 0.5 * v.length);
+    EXPECT_GE(std::hypot(p.x - z.x, p.y - z.y), z.radius) << v.id;
+  }
+  EXPECT_NE(error_of([&] { spawn(net, kept + 1, 3, base, "pool/", {z}); }).find("cannot fit"),
+            std::string::npos);
 }
 
 TEST(PoolErrors, RouteWithNoPathAndUnknownLane) {
@@ -217,6 +241,42 @@ TEST(PoolRun, RoutedVehicleFollowsItsRoute) {
     seen.insert(pool.lane(0));
   }
   EXPECT_TRUE(seen.count(net.pool_lane(exit.graph_lane))) << seen.size();
+}
+
+// The city map (experiments/city_traffic/city.xodr): its roads end at the map's edges, so
+// vehicles leave the map there and come back at an entry (a lane no lane leads into). Over 10
+// simulated minutes at 300 vehicles: no collision, vehicles keep leaving and coming back, and
+// every jump to a lane that does not follow (nor sit beside) the last one lands on an entry.
+TEST(PoolRun, CityLeavesAtEdgesComesBackAtEntries) {
+  static const opendrive::Network net = opendrive::load(CONVOY_CITY_XODR);
+  static const opendrive::LaneGraph graph{net};
+  static const PoolNetwork pnet{graph};
+  std::vector<uint8_t> led_into(pnet.lanes().size(), 0);
+  for (const PoolLane& l : pnet.lanes()) {
+    for (uint32_t k : l.next) led_into[k] = 1;
+  }
+  Pool pool(pnet, spawn(pnet, 300, 5, VehicleSpec{}));
+  std::vector<uint32_t> last(pool.size());
+  for (size_t i = 0; i < pool.size(); ++i) last[i] = pool.lane(i);
+  size_t overlaps = 0, jumps = 0;
+  for (int k = 0; k < 20 * 600; ++k) {
+    pool.step(0.05);
+    for (size_t i = 0; i < pool.size(); ++i) {
+      const uint32_t now = pool.lane(i), was = last[i];
+      last[i] = now;
+      if (now == was) continue;
+      const PoolLane& w = pnet.lane(was);
+      const bool follows = std::find(w.next.begin(), w.next.end(), now) != w.next.end() ||
+                           now == w.left || now == w.right;
+      if (follows) continue;
+      ++jumps;
+      EXPECT_FALSE(led_into[now]) << "vehicle " << i << " came back on lane " << now;
+    }
+    overlaps += pool.overlaps().size();
+  }
+  EXPECT_EQ(overlaps, 0u);
+  EXPECT_GT(pool.stats().respawns, 50u);
+  EXPECT_EQ(jumps, pool.stats().respawns);
 }
 
 }  // namespace
