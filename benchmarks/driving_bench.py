@@ -9,6 +9,10 @@ Figures:
   - control only: physics real-time factor, simulated time over the wall-clock time of the
     loop (start-up and shutdown not counted), as the evaluator measures it;
   - detection only, both: distinct camera frames per wall-clock second of the loop;
+  - with --sensors, also "both + LiDAR + radar": the both experiment with a 32 x 1024 roof
+    LiDAR at 10 Hz (preset hdl32) and a front radar at 20 Hz mounted on the smart car by the
+    world engine's Sensors list, read every step by driving/sensors_read_tf.py (issue 27's
+    "both" figure: camera frames/s >= 20);
   - framework share: 1 - t_standalone / t_cosim, the median over groups of runs made one
     after the other, with the engines stepping 0.02 s (as in the experiment) and 1/30 s (one
     camera frame a step, as frame_bench), where
@@ -52,6 +56,35 @@ def camera_rate():
         return float(re.search(r"<update_rate>\s*([0-9.]+)", f.read()).group(1))
 
 
+SENSORS = [
+    {"Type": "gpu_lidar", "Name": "lidar", "Model": "smart_car", "Link": "base_link",
+     "Pose": [0, 0, 1.9, 0, 0, 0], "Preset": "hdl32", "UpdateRate": 10},
+    {"Type": "radar", "Name": "radar", "Model": "smart_car", "Link": "base_link",
+     "Pose": [2.2, 0, 0.5, 0, 0, 0], "UpdateRate": 20, "RangeMax": 120, "Clutter": 1}]
+
+
+def sensor_options(config):
+    """Overrides mounting SENSORS on the world engine (EngineConfigs/0) and adding
+    sensors_read_tf.py to the config's functions."""
+    with open(config) as f:
+        functions = json.load(f).get("DataPackProcessingFunctions", [])
+    functions = functions + [{"Name": "sensors_read_tf",
+                              "FileName": os.path.join(HERE, "driving", "sensors_read_tf.py")}]
+    return ["-o", "EngineConfigs/0/Sensors=" + json.dumps(SENSORS),
+            "-o", "DataPackProcessingFunctions=" + json.dumps(functions)]
+
+
+def both_sensors(args, work):
+    config = os.path.join(EXP, "simulation_config_both.json")
+    rows = [run(args, config, backend_options(args, 2) + sensor_options(config),
+                os.path.join(work, "bs%d" % i)) for i in range(args.runs)]
+    fps = [r["camera_frames_per_s"] for r in rows]
+    print("both + LiDAR 32x1024 10 Hz + radar 20 Hz (backend %s): camera frames/s median %.1f "
+          "(runs: %s)  target >= 20; lap %s" % (args.backend, statistics.median(fps),
+                                                  ", ".join("%.1f" % x for x in fps),
+                                                  rows[0].get("lap_completed")))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--runs", type=int, default=3)
@@ -60,11 +93,19 @@ def main():
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
     ap.add_argument("--detection-seconds", type=float, default=30)
     ap.add_argument("--skip-experiment", action="store_true", help="only the framework share")
+    ap.add_argument("--sensors", action="store_true",
+                    help="also the both experiment with a LiDAR and a radar (see above)")
+    ap.add_argument("--only-sensors", action="store_true",
+                    help="only the both experiment with a LiDAR and a radar")
     args = ap.parse_args()
     work = tempfile.mkdtemp(prefix="convoy-driving-")
     med = lambda xs: statistics.median(xs)
     runs_of = lambda xs, fmt="%.1f": ", ".join(fmt % x for x in xs)
 
+    if args.sensors or args.only_sensors:
+        both_sensors(args, work)
+    if args.only_sensors:
+        return
     if not args.skip_experiment:
         rows = {"control": [], "detection": [], "both": []}
         for i in range(args.runs):
