@@ -74,7 +74,7 @@ void LidarSensors::configure(const WorldContext& ctx, const nlohmann::json& conf
         std::vector<std::string> names{d.scoped_name};
         if (!d.plugin_name.empty()) names.push_back(d.plugin_name + "::" + d.name);
         for (const auto& n : names) {
-          by_datapack_[n] = sensors_.size();
+          book_.add_name(n, sensors_.size());
           provided_.push_back({n, datapack::type_name<data::PointCloud>(), static_cast<int>(m)});
         }
         sensors_.push_back(std::move(s));
@@ -96,11 +96,8 @@ void LidarSensors::scan(Sensor& s) {
   pts.erase(std::remove_if(pts.begin(), pts.end(),
                            [&](const lidar::Point& p) { return p.instance == s.own_model; }),
             pts.end());
-  ++s.scans;
-  const double t = ctx_->time_s(), rate = s.desc->lidar.update_rate;
-  const double period = rate > 0 ? 1.0 / rate : 0;
-  s.next_update = period > 0 ? std::max(s.next_update + period, t) : t;
-  if (period > 0 && s.next_update <= t) s.next_update = t + period;
+  const double rate = s.desc->lidar.update_rate;
+  ScanBook<Sensor>::scanned(s, ctx_->time_s(), rate > 0 ? 1.0 / rate : 0);
 }
 
 void LidarSensors::fill(const Sensor& s, datapack::Builder& out) const {
@@ -138,42 +135,22 @@ void LidarSensors::fill(const Sensor& s, datapack::Builder& out) const {
 }
 
 void LidarSensors::get_datapack(const std::string& name, datapack::Builder& out) {
-  auto it = by_datapack_.find(name);
-  if (it == by_datapack_.end()) return;
-  Sensor& s = sensors_[it->second];
-  if (!s.wanted) {
-    s.wanted = true;
-    if (s.scans == 0) scan(s);
-  }
-  fill(s, out);
-  sent_[name] = s.scans;
+  Sensor* s = book_.want(name, [this](Sensor& x) { scan(x); });
+  if (!s) return;
+  fill(*s, out);
+  book_.sent(name);
 }
 
-bool LidarSensors::unchanged(const std::string& name) {
-  auto it = by_datapack_.find(name);
-  if (it == by_datapack_.end()) return false;
-  auto sent = sent_.find(name);
-  return sent != sent_.end() && sent->second == sensors_[it->second].scans;
-}
+bool LidarSensors::unchanged(const std::string& name) { return book_.unchanged(name); }
 
 void LidarSensors::after_step() {
-  const double t = ctx_->time_s(), half_step = 0.5 * ctx_->physics->step_size();
-  for (auto& s : sensors_) {
-    // Due from half a physics step early, as the cameras (clocks in whole nanoseconds).
-    if (!s.wanted || (s.scans > 0 && t + half_step < s.next_update)) continue;
-    scan(s);
-  }
+  book_.scan_due(ctx_->time_s(), 0.5 * ctx_->physics->step_size(), [this](Sensor& s) { scan(s); });
 }
 
 void LidarSensors::reset() {
   scene_.reset();  // the cameras' scene was made again
-  sent_.clear();
-  for (auto& s : sensors_) {
-    s.cloud = {};
-    s.next_update = 0;
-    s.wanted = false;
-    s.scans = 0;
-  }
+  book_.reset();
+  for (auto& s : sensors_) s.cloud = {};
 }
 
 }  // namespace convoy::world

@@ -21,6 +21,7 @@
 
 #include "lidar/lidar_scene.h"
 #include "lidar/lidar_sensor.h"
+#include "scan_book.h"
 #include "world_description.h"
 #include "world_system.h"
 
@@ -62,9 +63,8 @@ class LidarSensors final : public WorldSystem {
   const WorldContext* ctx_ = nullptr;
   std::unique_ptr<lidar::LidarScene> scene_;  // made at the first scan (again after a reset)
   std::vector<Sensor> sensors_;
-  std::unordered_map<std::string, size_t> by_datapack_;
+  ScanBook<Sensor> book_{sensors_};  // datapack names, when each scans, what was sent
   std::vector<ProvidedDataPack> provided_;
-  std::unordered_map<std::string, uint64_t> sent_;  // datapack -> the scan sent
 };
 
 }  // namespace convoy::world

@@ -55,7 +55,7 @@ void RadarSensors::configure(const WorldContext& ctx, const nlohmann::json& conf
         std::vector<std::string> names{d.scoped_name};
         if (!d.plugin_name.empty()) names.push_back(d.plugin_name + "::" + d.name);
         for (const auto& n : names) {
-          by_datapack_[n] = sensors_.size();
+          book_.add_name(n, sensors_.size());
           provided_.push_back({n, datapack::type_name<data::Radar>(), static_cast<int>(m)});
         }
         sensors_.push_back(std::move(s));
@@ -90,10 +90,8 @@ void RadarSensors::scan(Sensor& s) {
   s.time = ctx_->time_s();
   s.detections = radar::detect(s.desc->radar, targets, pose.linear().transpose() * v_sensor, s.seed,
                                ctx_->time_ns);
-  ++s.scans;
-  const double rate = s.desc->radar.update_rate, period = rate > 0 ? 1.0 / rate : 0;
-  s.next_update = period > 0 ? std::max(s.next_update + period, s.time) : s.time;
-  if (period > 0 && s.next_update <= s.time) s.next_update = s.time + period;
+  const double rate = s.desc->radar.update_rate;
+  ScanBook<Sensor>::scanned(s, s.time, rate > 0 ? 1.0 / rate : 0);
 }
 
 void RadarSensors::fill(const Sensor& s, datapack::Builder& out) const {
@@ -119,44 +117,27 @@ void RadarSensors::fill(const Sensor& s, datapack::Builder& out) const {
 }
 
 void RadarSensors::get_datapack(const std::string& name, datapack::Builder& out) {
-  auto it = by_datapack_.find(name);
-  if (it == by_datapack_.end()) return;
-  Sensor& s = sensors_[it->second];
-  if (!s.wanted) {
-    s.wanted = true;
-    if (s.scans == 0) scan(s);
-  }
-  fill(s, out);
-  sent_[name] = s.scans;
+  Sensor* s = book_.want(name, [this](Sensor& x) { scan(x); });
+  if (!s) return;
+  fill(*s, out);
+  book_.sent(name);
 }
 
-bool RadarSensors::unchanged(const std::string& name) {
-  auto it = by_datapack_.find(name);
-  if (it == by_datapack_.end()) return false;
-  auto sent = sent_.find(name);
-  return sent != sent_.end() && sent->second == sensors_[it->second].scans;
-}
+bool RadarSensors::unchanged(const std::string& name) { return book_.unchanged(name); }
 
 void RadarSensors::after_step() {
   if (sensors_.empty()) return;
   track();
-  const double t = ctx_->time_s(), half_step = 0.5 * ctx_->physics->step_size();
-  for (auto& s : sensors_) {
-    // Due from half a physics step early, as the cameras (clocks in whole nanoseconds).
-    if (!s.wanted || (s.scans > 0 && t + half_step < s.next_update)) continue;
-    scan(s);
-  }
+  book_.scan_due(ctx_->time_s(), 0.5 * ctx_->physics->step_size(), [this](Sensor& s) { scan(s); });
 }
 
 void RadarSensors::reset() {
   scene_.reset();  // the cameras' scene was made again
   objects_.reset();
-  sent_.clear();
+  book_.reset();
   for (auto& s : sensors_) {
     s.detections.clear();
-    s.time = s.next_update = 0;
-    s.wanted = false;
-    s.scans = 0;
+    s.time = 0;
   }
 }
 

@@ -26,6 +26,7 @@
 #include "lidar/lidar_scene.h"
 #include "radar/radar_detect.h"
 #include "radar/radar_targets.h"
+#include "scan_book.h"
 #include "world_description.h"
 #include "world_system.h"
 
@@ -68,9 +69,8 @@ class RadarSensors final : public WorldSystem {
   std::unique_ptr<lidar::LidarScene> scene_;  // made at the first scan (again after a reset)
   radar::ObjectTracker objects_;
   std::vector<Sensor> sensors_;
-  std::unordered_map<std::string, size_t> by_datapack_;
+  ScanBook<Sensor> book_{sensors_};  // datapack names, when each scans, what was sent
   std::vector<ProvidedDataPack> provided_;
-  std::unordered_map<std::string, uint64_t> sent_;
 };
 
 }  // namespace convoy::world
