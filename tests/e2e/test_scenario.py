@@ -243,8 +243,9 @@ class BadInput(ScenarioCase):
 
 class Run(ScenarioCase):
     SCENARIO = os.path.join(SUITE, "cut_in.xosc")
-    # of its 22 s (it ends at the route's end): both min_speed infractions (8.3 s, 12.9 s) and
-    # 140 detector frames; whole runs: Long (and test_own_ego's run ends at its route's end)
+    # of its 22 s (it ends at the route's end): its min_speed infraction (the reference agent's
+    # cruise follows the traffic since session 18) and 140 detector frames; whole runs: Long
+    # (and test_own_ego's run ends at its route's end)
     SECONDS = "14"
 
     def test_run_and_repeat(self):
