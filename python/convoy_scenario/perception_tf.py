@@ -10,14 +10,18 @@ the run and the campaign's leaderboard say which perception drove the ego.
   then leaves it out): the detector's boxes (its `detections`, from the camera's frames) ranged
   by the roof LiDAR's cloud (`<ego model>::base_link::roof_lidar`, the smart_car_lidar model),
   the camera's depth image when a box has too few returns (convoy_traffic.fusion), tracked
-  over the detector's frames for velocities (ego_planner.Tracker). Traffic lights are not
+  over the detector's frames for velocities (ego_planner.Tracker); and, all around the ego,
+  each new scan's clusters, tracked (convoy_sensors.surround: those the camera does not wholly
+  see and no camera object explains, ranged_by "lidar_surround"; the camera's vehicles also
+  take their cluster's lateral extent), so that the planner can change lanes. Traffic lights are not
   detected: a red (or too late yellow) light of the ego's approach comes from the lights
   engine's state as a standing object at its stop line, as traffic_tf does (labelled
   source "traffic_lights").
 
 The counts (perception_boxes, perception_ranged_by_lidar / _depth, perception_rejected_by_lidar:
 near boxes without LiDAR returns, dropped as phantoms; perception_lidar_only: obstacles in the
-ego's way the LiDAR saw and no box explained, fusion.lidar_obstacles) are written every simulated
+ego's way the LiDAR saw and no box explained, fusion.lidar_obstacles; perception_lidar_surround:
+the surround objects, summed over scans) are written every simulated
 second of detections. CONVOY_PERCEPTION_DUMP=N (debugging) saves the first N frames from
 CONVOY_PERCEPTION_DUMP_FROM s on (default 0; the boxes, the cloud's x, y, z, label, instance and
 flags, the fused objects) as RUN_DIR/perception_<frame>.npz."""
@@ -54,6 +58,7 @@ YELLOW_STOP_DECEL = 3.0  # m/s^2, as traffic_tf.py
 LABELS = {"ground_truth": SOURCE_LABELS["ground_truth"], "sensors": SOURCE_LABELS["sensors"]}
 _state = {"written": False, "tracker": Tracker(), "frame": None, "objects": [],
           "ranged": {"lidar": 0, "depth": 0, "rejected": 0, "lidar_only": 0}, "boxes": 0, "last_write": 0.0,
+          "surround": None, "scan_t": None, "surround_count": 0,
           "dump": int(os.environ.get("CONVOY_PERCEPTION_DUMP", "0") or 0),
           "dump_from": float(os.environ.get("CONVOY_PERCEPTION_DUMP_FROM", "0") or 0)}
 
@@ -61,6 +66,7 @@ if MODE == "sensors":
     import numpy as np  # noqa: E402
     from convoy_sensors.point_cloud import points  # noqa: E402
     from convoy_traffic.fusion import Rig, accepted, fuse, lidar_obstacles  # noqa: E402
+    from convoy_sensors.surround import Surround  # noqa: E402
     RIG = Rig.smart_car_lidar()
     STOP_LINES = []
     if LIGHTS is not None:
@@ -96,11 +102,26 @@ def _summary():
         fields["perception_ranged_by_depth"] = _state["ranged"]["depth"]
         fields["perception_rejected_by_lidar"] = _state["ranged"]["rejected"]
         fields["perception_lidar_only"] = _state["ranged"]["lidar_only"]
+        fields["perception_lidar_surround"] = _state["surround_count"]
     update_summary(fields)
+
+
+def _scan_surround(e, scan):
+    """A new LiDAR scan: its clusters all around the ego, tracked (convoy_sensors.surround)."""
+    if scan is None or scan.isEmpty() or scan.data.time_ns == _state["scan_t"]:
+        return
+    _state["scan_t"] = scan.data.time_ns
+    if _state["surround"] is None:
+        _state["surround"] = Surround(RIG, e["length"], e["width"], e["length_offset"])
+    p = points(scan)
+    _state["surround"].scan(np.stack([p["x"], p["y"], p["z"]], axis=1), p["flags"],
+                            scan.data.time_ns * 1e-9, e)
+    _state["surround_count"] += len(_state["surround"].objects(e, _state["objects"]))
 
 
 def _sensors(ego, detections, scan, depth, lights):
     e = ego_state(ego.data)
+    _scan_surround(e, scan)
     det = None if detections is None or detections.isEmpty() else detections.data
     if det is not None and "detections" in det and det.get("frame") != _state["frame"]:
         _state["frame"] = det.get("frame")
@@ -113,6 +134,8 @@ def _sensors(ego, detections, scan, depth, lights):
         boxes = list(det["detections"])
         objs = fuse(RIG, boxes, xyz, flags=flags, depth=dimg)
         objs += lidar_obstacles(RIG, xyz, flags, objects=accepted(objs))
+        if _state["surround"] is not None:
+            objs = _state["surround"].refine(objs)
         _state["boxes"] += len(boxes)
         for o in objs:
             _state["ranged"][o["ranged_by"]] += 1
@@ -126,6 +149,8 @@ def _sensors(ego, detections, scan, depth, lights):
             _state["dump"] -= 1
             _dump(boxes, scan, objs)
     objects = list(_state["objects"])
+    if _state["surround"] is not None:
+        objects += _state["surround"].objects(e, objects)
     signals = dict(lights.data["signals"]) if lights is not None and not lights.isEmpty() else {}
     line = stop_line_object(e, signals) if STOP_LINES else None
     if line is not None:

@@ -6,7 +6,7 @@ follower's rear wheels (the follower keeps steering):
 - AEB: when the time to collision with an object in the path falls below `TtcAeb`, or the
   IDM command would not stop in time, the target speed is capped by a braking profile that
   stops `StopMargin` m before the object at up to `AebDeceleration` m/s^2.
-- with a route and its lanes (ground truth only): lane changes around stopped vehicles (MOBIL)
+- with a route and its lanes (ground truth or sensors): lane changes around stopped vehicles (MOBIL)
   and a cruise speed that follows faster traffic up to the limit: convoy_traffic.lane_change.
 
 Objects come in the ego's frame (x forward from its reference point, y left) as dicts
@@ -29,7 +29,8 @@ SOURCES = ("ground_truth", "detections", "sensors")
 SOURCE_LABELS = {"ground_truth": "ground-truth objects (the world's RoadUsers, not perception)",
                  "detections": "detector boxes ranged in the camera's depth image",
                  "sensors": "sensor perception: detector boxes ranged by LiDAR points (depth "
-                            "image when too few), tracked (convoy_traffic.fusion)"}
+                            "image when too few), tracked (convoy_traffic.fusion), and LiDAR "
+                            "clusters all around the ego, tracked (convoy_sensors.surround)"}
 
 # key: (default, minimum, maximum)
 PARAMETERS = {
@@ -227,7 +228,7 @@ class Planner:
     def __init__(self, params, route=None, lanes=None):
         """`route`: a route_path.RoutePath in the world frame, or None: the path is then the
         ego's current curvature (its yaw rate over its speed). `lanes`: a lanes.RouteLanes of
-        the route: with it (and LaneChange 1, ground-truth input) the ego passes stopped
+        the route: with it (and LaneChange 1, ground-truth or sensor input) the ego passes stopped
         vehicles by a lane change (convoy_traffic.lane_change)."""
         self.p = params
         self.route = route
@@ -236,8 +237,9 @@ class Planner:
             self.lane_change = "off (no route or no map)"
         elif not params["LaneChange"]:
             self.lane_change = "off (LaneChange 0)"
-        elif params["Input"] != "ground_truth":
+        elif params["Input"] == "detections":
             # a lane change needs the lane behind the ego: the camera's perception looks ahead only
+            # ("sensors" adds the roof LiDAR's objects all around: convoy_sensors.surround)
             self.lane_change = "off (input %s sees nothing behind the ego)" % params["Input"]
         else:
             self.lane_change = "on"

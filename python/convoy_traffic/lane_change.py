@@ -13,7 +13,11 @@ The ego keeps to its route's lane; it leaves it for a neighbour lane of the same
 - room: the manoeuvre (LaneChangeTime x speed, at least MinLaneChangeLength m) has moved the
   ego's path clear of the slow leader (half widths + LateralMargin) by the leader's rear, and
   the target lane lasts beyond the leader by one more manoeuvre.
-From the moment such a leader is slow (and a lane to pass it is there) the ego keeps
+With sensor input (Input "sensors") the cruise speed is also at most OccludedSpeed past a standing
+vehicle beside the path (its side within OccludedGap m of the ego's corridor), from OccludedRange m
+before its rear until the ego's front is 1 m past its front, reached at ComfortDeceleration:
+the ego's sensors do not see behind it, where a walker may step out (occluded_speed). From the
+moment such a leader is slow (and a lane to pass it is there) the ego keeps
 LaneChangeStandoff m more room to it, so that it can still pull out once it may. Once past, it returns to the route's lane when that is safe (same check) and
 not worse by more than ChangeThreshold, or when the passing lane ends.
 
@@ -39,8 +43,12 @@ LANE_PARAMETERS = {
     "FollowFlow": (1.0, 0.0, 1.0),             # 1: cruise with the traffic's flow (up to the limit)
     "FlowRange": (60.0, 0.0, 500.0),           # m: vehicles this close ahead or beside make the flow
     "MaxCruiseSpeed": (50 / 3.6, 0.0, 60.0),   # m/s: the flow's cap where the map gives no limit
+    "OccludedSpeed": (5.0, 0.0, 60.0),         # m/s, sensor input: past a standing vehicle (0: off)
+    "OccludedGap": (2.0, 0.0, 10.0),           # m: ... that stands this close beside the path
+    "OccludedRange": (15.0, 0.0, 100.0),       # m: ... from this far before its rear
 }
 VEHICLE_CLASSES = ("car", "truck", "bus")
+STANDING_SPEED = 0.5  # m/s: a vehicle this slow stands (occluded_speed)
 STEER_GAIN = 1.2   # as experiments/city_traffic/ego_driver.py
 MAX_STEER = 0.55   # rad
 
@@ -187,7 +195,7 @@ class LaneChanger:
         p = self.p
         v = max(ego["speed"], 0.0)
         objs = self.route_objects(ego, s_ego, objects)
-        self.v0 = self.flow_speed(ego, s_ego, objs)
+        self.v0 = self.occluded_speed(ego, s_ego, objs, self.flow_speed(ego, s_ego, objs))
         self.max_v0 = max(self.max_v0, self.v0)
         for o in objs:
             if o["class"] in VEHICLE_CLASSES and o["v"] < p["SlowLeader"] * v0:
@@ -220,6 +228,27 @@ class LaneChanger:
         limit = self.lanes.speed_limit(s_ego)
         cap = min(limit, p["MaxCruiseSpeed"]) if limit else p["MaxCruiseSpeed"]
         return max(cruise, min(math.fsum(flow) / len(flow), cap))
+
+    def occluded_speed(self, ego, s_ego, objs, v0):
+        """v0, at most OccludedSpeed past a standing vehicle beside the path (sensor input
+        only; module docstring)."""
+        p = self.p
+        if p.get("Input") != "sensors" or p["OccludedSpeed"] <= 0.0:
+            return v0
+        front = s_ego + ego["length_offset"] + ego["length"] / 2
+        half = (ego["width"] or 1.8) / 2 + p["LateralMargin"]
+        cap = v0
+        for o in objs:
+            if o["class"] not in VEHICLE_CLASSES or abs(o["v"]) > STANDING_SPEED:
+                continue
+            if front > o["s"] + o["length"] / 2 + 1.0:
+                continue
+            clearance = abs(o["d"] - self.man.offset(o["s"])) - o["width"] / 2 - half
+            if clearance <= 0.0 or clearance > p["OccludedGap"]:
+                continue   # in the path (the planner follows it) or well clear of it
+            dist = max(o["s"] - o["length"] / 2 - front - p["OccludedRange"], 0.0)
+            cap = min(cap, math.sqrt(p["OccludedSpeed"] ** 2 + 2 * p["ComfortDeceleration"] * dist))
+        return cap
 
     def _decide(self, t, ego, s_ego, v, v0, objs):
         p = self.p

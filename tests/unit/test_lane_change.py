@@ -129,11 +129,13 @@ class Decision(unittest.TestCase):
         self.assertGreater(closest["stopped"], 3.0)
         self.assertGreater(trace[-1][1], 100.0, "then it passed")
 
-    def test_sensor_input_does_not_change_lanes(self):
+    def test_camera_only_input_does_not_change_lanes(self):
         route, rl = road()
-        planner = ep.Planner(ep.parse_config({"Input": "sensors"}), route, rl)
+        planner = ep.Planner(ep.parse_config({"Input": "detections"}), route, rl)
         self.assertIsNone(planner.lc)
         self.assertIn("sees nothing behind", planner.lane_change)
+        # sensor input has the LiDAR's objects all around (tests/unit/test_surround.py)
+        self.assertEqual(ep.Planner(ep.parse_config({"Input": "sensors"}), route, rl).lane_change, "on")
 
 
 class Mobil(unittest.TestCase):
