@@ -37,12 +37,13 @@ third frame, the planner, 20 vehicle agents, 10 pedestrian agents, SUMO, the lig
     (target >= 20), detector frames and detections per wall second, the real-time factor.
 
 With --city-road-users N the section runs experiments/city_traffic/simulation_config_pooled.json
-instead: the ego among N vehicles of ONE road_user_pool engine (-o EngineConfigs/5/Density=0
--o EngineConfigs/5/Count=N), drawn by the world engine as actors; it prints the same lines,
-the world's collisions (pooled vehicles with each other and with the ego; the pool does not see
-the ego) and, from traffic_pool_bench on city.xodr, the collisions among the N pooled vehicles
-over 600 simulated s (target 0). A count the map cannot hold ends the section with the pool's
-message (city.xodr holds about 400).
+instead (above 395, what city.xodr holds: simulation_config_pooled_large.json, the 4x4 grid
+city large_city.xodr): the ego among N vehicles of ONE road_user_pool engine (-o
+EngineConfigs/5/Density=0 -o EngineConfigs/5/Count=N), drawn by the world engine as actors; it
+prints the same lines, the world's collisions (pooled vehicles with each other and with the
+ego, which the pool sees) and, from traffic_pool_bench on that map, the collisions among the N
+pooled vehicles over 600 simulated s (target 0). A count the map cannot hold ends the section
+with the pool's message.
 
 Section "density": experiments/city_traffic/simulation_config_density.json, 10 simulated
 minutes of the same road users respawning at their starts and SUMO's flows doubled (no ego).
@@ -300,14 +301,21 @@ def city_run(args, config, end, run_dir, env=None, overrides=()):
 
 
 POOLED_CITY = "simulation_config_pooled.json"
+# Above what city.xodr holds (395 vehicles standing), the large grid city (make_large_city.py).
+POOLED_CITY_LARGE, CITY_XODR_HOLDS = "simulation_config_pooled_large.json", 395
+
+
+def pooled_city_map(n):
+    return "large_city.xodr" if n > CITY_XODR_HOLDS else "city.xodr"
 
 
 def pooled_city_collisions(args, n):
-    """The pool alone on city.xodr, N vehicles for 600 simulated s: its collision line."""
+    """The pool alone on the pooled city's map, N vehicles for 600 simulated s: its collision
+    line."""
     bench = os.path.join(args.build, "benchmarks", "traffic_pool_bench")
     if not os.path.exists(bench):
         return "traffic_pool_bench is not built"
-    r = subprocess.run([bench, os.path.join(CITY, "city.xodr"), "--counts", str(n),
+    r = subprocess.run([bench, os.path.join(CITY, pooled_city_map(n)), "--counts", str(n),
                         "--seconds", "600"], capture_output=True, text=True)
     lines = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().startswith("N =")]
     return lines[0] if r.returncode == 0 and lines else (r.stderr or r.stdout).strip()[-500:]
@@ -319,7 +327,9 @@ def section_city(args):
     if not os.path.exists(os.path.join(args.build, "bin", engine)):
         print("city: %s is not built" % engine)
         return
-    config = POOLED_CITY if pooled else "simulation_config.json"
+    config = "simulation_config.json"
+    if pooled:
+        config = POOLED_CITY_LARGE if args.city_road_users > CITY_XODR_HOLDS else POOLED_CITY
     overrides = ["EngineConfigs/5/Density=0", "EngineConfigs/5/Count=%d" % args.city_road_users] \
         if pooled else []
     work = tempfile.mkdtemp(prefix="convoy-trafficbench-city-")
@@ -392,8 +402,8 @@ def main():
     ap.add_argument("--city-end", type=float, default=60.0,
                     help="simulated seconds of each city run")
     ap.add_argument("--city-road-users", type=int, default=0,
-                    help="city section: run simulation_config_pooled.json with N pooled "
-                         "vehicles instead of the agent engines and SUMO (0: the usual config)")
+                    help="city section: run simulation_config_pooled.json (above 395: "
+                         "simulation_config_pooled_large.json) with N pooled vehicles instead of the agent engines and SUMO (0: the usual config)")
     ap.add_argument("--density-end", type=float, default=600.0,
                     help="simulated seconds of the density run")
     ap.add_argument("--agent-end", type=float, default=10.0,

@@ -3,7 +3,10 @@
 // neighbour grid) is src/traffic_pool; this file only reads the config and writes the datapack.
 //
 // Config keys (schema.json): Map, Vehicles (listed), Count or Density + Seed + Policy +
-// DesiredSpeed + KeepClear (spawned), RoadUsersDataPack. Datapack: <RoadUsersDataPack>
+// DesiredSpeed + KeepClear (spawned), RoadUsersDataPack, ExternalDataPack. In: <ExternalDataPack>
+// convoy.data.RoadUsers (or one RoadUser), the road users it does not drive (the ego, agents):
+// obstacles its vehicles follow, keep gaps to and yield to, kept until the next one; a malformed
+// one stops the run (exit 2) naming the field. Out: <RoadUsersDataPack>
 // convoy.data.RoadUsers, every vehicle's state after the last step (reference point: the rear axle,
 // a quarter of the length ahead of the rear bumper), ids "<engine>/<id>"; protobuf's binary form,
 // not JSON. Bad input (an unknown policy, two road users on one spot, a count the map cannot hold,
@@ -77,6 +80,46 @@ tp::VehicleSpec listed(const json& v, size_t k) {
   }
   return s;
 }
+// The external road users' boxes (centre = reference point + length_offset along the heading);
+// absent ones left out. A field that is not finite, or a size that is not positive, throws
+// naming the road user and the field.
+std::vector<tp::ExternalUser> external_users(const data::RoadUsers& users) {
+  std::vector<tp::ExternalUser> out;
+  for (int k = 0; k < users.users_size(); ++k) {
+    const data::RoadUser& u = users.users(k);
+    if (u.absent()) continue;
+    const std::string who = "users[" + std::to_string(k) + "] ('" + u.id() + "')";
+    const auto finite = [&](const char* field, double v) {
+      if (!std::isfinite(v)) {
+        throw std::runtime_error(who + ": " + field + " must be finite, got " + std::to_string(v));
+      }
+    };
+    const auto positive = [&](const char* field, double v) {
+      if (!(v > 0 && v < 1000)) {
+        throw std::runtime_error(who + ": " + field + " must be > 0 m (the box), got " +
+                                 std::to_string(v));
+      }
+    };
+    if (u.id().empty()) throw std::runtime_error(who + ": id is empty");
+    finite("x", u.x());
+    finite("y", u.y());
+    finite("yaw", u.yaw());
+    finite("speed", u.speed());
+    finite("length_offset", u.length_offset());
+    positive("length", u.length());
+    positive("width", u.width());
+    tp::ExternalUser e;
+    e.id = u.id();
+    e.yaw = u.yaw();
+    e.x = u.x() + u.length_offset() * std::cos(u.yaw());
+    e.y = u.y() + u.length_offset() * std::sin(u.yaw());
+    e.speed = u.speed();
+    e.length = u.length();
+    e.width = u.width();
+    out.push_back(std::move(e));
+  }
+  return out;
+}
 }  // namespace
 
 class RoadUserPoolEngine final : public Engine {
@@ -86,6 +129,7 @@ class RoadUserPoolEngine final : public Engine {
     name_ = name;
     config_ = config;
     dp_name_ = config.value("RoadUsersDataPack", "road_users");
+    ext_name_ = config.value("ExternalDataPack", "external_users");
     try {
       map_ = std::make_unique<opendrive::Network>(opendrive::load(config.at("Map")));
       graph_ = std::make_unique<opendrive::LaneGraph>(*map_);
@@ -109,7 +153,24 @@ class RoadUserPoolEngine final : public Engine {
     return time_ns_;
   }
 
-  void set_datapack(const datapack::View&) override {}
+  void set_datapack(const datapack::View& dp) override {
+    if (dp.empty() || dp.id().name() != ext_name_) return;
+    const std::string where = "road_user_pool engine '" + name_ + "': datapack '" + ext_name_ + "'";
+    data::RoadUsers users;
+    try {
+      if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
+        datapack::read_proto(dp, &users);
+      } else if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUser>()) {
+        datapack::read_proto(dp, users.add_users());
+      } else {
+        throw std::runtime_error(std::string("expected convoy.data.RoadUsers or RoadUser, got ") +
+                                 (dp.is_proto() ? dp.proto_type() : std::string("JSON")));
+      }
+      pool_->set_external(external_users(users));
+    } catch (const std::exception& e) {
+      throw UserError(where + ": " + e.what());
+    }
+  }
 
   void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
     if (id.name() == dp_name_) datapack::write_proto(out, users_);
@@ -220,7 +281,7 @@ class RoadUserPoolEngine final : public Engine {
     }
   }
 
-  std::string name_, dp_name_;
+  std::string name_, dp_name_, ext_name_;
   json config_;
   std::unique_ptr<opendrive::Network> map_;
   std::unique_ptr<opendrive::LaneGraph> graph_;

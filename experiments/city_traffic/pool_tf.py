@@ -1,46 +1,76 @@
-"""The pooled city's information flow (simulation_config_pooled.json), one transceiver function
+"""The pooled city's information flow (simulation_config_pooled*.json), one transceiver function
 at the pool's rate (20 Hz):
 
 - the world engine gets every pooled vehicle as an actor: the pool's convoy.data.RoadUsers
   datapack is copied whole (binary protobuf, no JSON) to the world engine as `pool_users`;
-- the ego's planner gets its ground-truth input: the pooled vehicles within PLANNER_RADIUS m
-  of the ego, in the ego's frame;
-- the recorder gets the ego and the pooled vehicles within RECORD_RADIUS m of it (its per-user
-  checks are Python; the whole pool is in the world engine, not in tracks.jsonl).
+- the pool gets the road users it does not drive as `external_users` (convoy.data.RoadUsers):
+  the ego (the world engine's smart_car::road_user) and every vehicle_agent or
+  pedestrian_agent engine of the run (its StateDataPack, read from the run's config.json).
+  Its vehicles follow them, keep MOBIL's gaps to them and yield to them at junctions;
+- the ego's planner gets its ground-truth input: the pooled vehicles and agents within
+  PLANNER_RADIUS m of the ego, in the ego's frame;
+- the recorder gets the ego and the road users within RECORD_RADIUS m of it (its per-user
+  checks are Python; the whole pool is in the world engine, not in tracks.jsonl)."""
+import json
+import os
 
-The pool does not see the ego (road_user_pool takes no external road users yet)."""
 from nrp_core import *
 from nrp_core.data.nrp_json import JsonDataPack
 from nrp_core.data.nrp_protobuf import RoadUsersDataPack
 
 from convoy_traffic.ego_planner import ego_state, objects_from_road_users
+from convoy_traffic.neighbours import road_users
 
 PLANNER_RADIUS = 100.0  # m
 RECORD_RADIUS = 60.0    # m
+AGENT_TYPES = ("vehicle_agent", "pedestrian_agent")
 
 
-@EngineDataPack(keyword="pool", id=DataPackIdentifier("road_users", "pool"))
-@EngineDataPack(keyword="ego", id=DataPackIdentifier("smart_car::road_user", "gazebo"))
-@TransceiverFunction("pool")
-def pool_traffic(pool, ego):
+def _agents():
+    """(engine name, state datapack name) of the run's agent engines."""
+    try:
+        with open(os.path.join(os.environ.get("CONVOY_RUN_DIR", "."), "config.json")) as f:
+            engines = json.load(f)["EngineConfigs"]
+    except (OSError, ValueError, KeyError):
+        return []
+    return [(e["EngineName"], e.get("StateDataPack", "state")) for e in engines
+            if e.get("EngineType") in AGENT_TYPES]
+
+
+def _near(users, ex, ey, radius):
+    r2 = radius * radius
+    return [u for u in users if (u.x - ex) ** 2 + (u.y - ey) ** 2 < r2]
+
+
+def pool_traffic(pool, ego, **agents):
     if pool.isEmpty():
         return []
     world = RoadUsersDataPack("pool_users", "gazebo")
     world.data.CopyFrom(pool.data)
     out = [world]
+    others = road_users(agents.values())
+    external = RoadUsersDataPack("external_users", "pool")
+    for u in ([] if ego.isEmpty() else [ego.data]) + others:
+        external.data.users.add().CopyFrom(u)
+    out.append(external)
     if ego.isEmpty():
         return out
     e = ego_state(ego.data)
     ex, ey = e["x"], e["y"]
-    r2 = PLANNER_RADIUS * PLANNER_RADIUS
-    near = [u for u in pool.data.users if (u.x - ex) ** 2 + (u.y - ey) ** 2 < r2]
+    near = _near(list(pool.data.users) + others, ex, ey, PLANNER_RADIUS)
     out.append(JsonDataPack("planner_input", "planner", {
         "source": "ground_truth", "ego": e, "objects": objects_from_road_users(e, near)}))
-    rr2 = RECORD_RADIUS * RECORD_RADIUS
     rec = {"signals": {}, "users": []}
-    for u in [v for v in near if (v.x - ex) ** 2 + (v.y - ey) ** 2 < rr2] + [ego.data]:
+    for u in _near(near, ex, ey, RECORD_RADIUS) + [ego.data]:
         rec["users"].append([u.id, u.category, round(u.x, 3), round(u.y, 3), round(u.yaw, 4),
                              round(u.speed, 3), round(u.length, 2), round(u.length_offset, 2)])
     rec["pool_size"] = len(pool.data.users)
     out.append(JsonDataPack("traffic", "recorder", rec))
     return out
+
+
+for _i, (_name, _dp) in enumerate(_agents()):
+    pool_traffic = EngineDataPack(keyword="agent%d" % _i, id=DataPackIdentifier(_dp, _name))(pool_traffic)
+pool_traffic = EngineDataPack(keyword="ego", id=DataPackIdentifier("smart_car::road_user", "gazebo"))(pool_traffic)
+pool_traffic = EngineDataPack(keyword="pool", id=DataPackIdentifier("road_users", "pool"))(pool_traffic)
+pool_traffic = TransceiverFunction("pool")(pool_traffic)

@@ -33,6 +33,18 @@ EGO = "smart_car"
 # the recorder's memory stays flat however long the run (no list of every point)
 X0, X1, Y0, Y1 = -260.0, 460.0, -160.0, 160.0
 SCALE = 2.0  # px per m
+# Another map (the large pooled city): $CONVOY_CITY_MAP (an .xodr here; the extent is its
+# header's, 10 m round) and $CONVOY_CITY_ROAD (its road model under share/convoy/models).
+MAP = os.environ.get("CONVOY_CITY_MAP", make_config.MAP)
+ROAD_MODEL = os.environ.get("CONVOY_CITY_ROAD", "city_road")
+
+
+def _use_extent_of(path):
+    global X0, X1, Y0, Y1
+    import xml.etree.ElementTree as ET
+    h = ET.parse(path).getroot().find("header")
+    X0, X1 = float(h.get("west")) - 10, float(h.get("east")) + 10
+    Y0, Y1 = float(h.get("south")) - 10, float(h.get("north")) + 10
 
 
 def px(x, y):
@@ -55,7 +67,9 @@ class Script(EngineScript):
         self._registerDataPack("traffic")
         self._registerDataPack("observation")
         self.dir = os.environ.get("CONVOY_RUN_DIR", ".")
-        self.map = city_map.CityMap(os.path.join(HERE, make_config.MAP))
+        self.map = city_map.CityMap(os.path.join(HERE, MAP))
+        if MAP != make_config.MAP:
+            _use_extent_of(os.path.join(HERE, MAP))
         self.seen = set()         # every road user's id
         self.last_px = {}         # id -> its last drawn pixel
         self.ego_px = []          # the ego's track (drawn last, thick), a point per metre
@@ -74,12 +88,15 @@ class Script(EngineScript):
         self.last_det_key = None
         self.collisions = []
         self.sumo_ids = set()
+        self.pool_size = None
         self.wall0 = None
         self.last_t = None
 
     def _traffic(self, t, d):
         users = d.get("users", [])
         signals = d.get("signals", {})
+        if d.get("pool_size") is not None:  # the pooled city: how many vehicles the pool drives
+            self.pool_size = max(self.pool_size or 0, d["pool_size"])
         row = {"t": round(t, 3), "users": users, "signals": signals}
         line = json.dumps(row, separators=(",", ":"))
         self.tracks_file.write(line + "\n")
@@ -132,7 +149,8 @@ class Script(EngineScript):
             return
         if self.tracks_img is None:
             self.tracks_img = self._background()
-        if last is not None:
+        # No line across a jump (a road user back in the pooled city's radius elsewhere).
+        if last is not None and max(abs(p[0] - last[0]), abs(p[1] - last[1])) < 20 * SCALE:
             cv2.line(self.tracks_img, last, p, COLOURS.get(cls, (200, 200, 200)), 1, cv2.LINE_AA)
 
     def _frame(self, obs):
@@ -182,7 +200,7 @@ class Script(EngineScript):
 
     def _background(self):
         share = os.environ.get("CONVOY_SHARE_DIR", "")
-        obj = os.path.join(share, "models", "city_road", "road.obj")
+        obj = os.path.join(share, "models", ROAD_MODEL, "road.obj")
         W, H = int((X1 - X0) * SCALE), int((Y1 - Y0) * SCALE)
         img = np.full((H, W, 3), (70, 110, 70), np.uint8)
         if os.path.exists(obj):
@@ -241,6 +259,7 @@ class Script(EngineScript):
             "ego_stops_for_pedestrians": planner.get("ego_stops_for_pedestrians"),
             "ego_input": planner.get("input_label"),
             "road_users_seen": len(self.seen),
+            "pooled_vehicles": self.pool_size,
             "tracks_sha1": self.digest.hexdigest(),
             "camera_frames": self.frames,
             "camera_frames_per_s": self.frames / wall if wall > 0 else None,

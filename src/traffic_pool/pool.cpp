@@ -43,28 +43,34 @@ uint32_t Pool::choose(size_t i, uint32_t lane) {
   return keep[splitmix(rng_[i]) % k];
 }
 
+// Per lane, its entries (pooled vehicles and externals' lane entries) sorted by s.
 void Pool::index_lanes() {
   const size_t nl = net_.lanes().size();
   lane_begin_.assign(nl + 1, 0);
-  for (uint32_t l : lane_) ++lane_begin_[l + 1];
+  for (uint32_t l : lane_) {
+    if (l != kNone) ++lane_begin_[l + 1];
+  }
   for (size_t k = 0; k < nl; ++k) lane_begin_[k + 1] += lane_begin_[k];
   std::vector<uint32_t> fill(lane_begin_.begin(), lane_begin_.end() - 1);
-  order_.resize(size());
-  for (uint32_t i = 0; i < size(); ++i) order_[fill[lane_[i]]++] = i;
+  order_.resize(lane_begin_[nl]);
+  for (uint32_t i = 0; i < lane_.size(); ++i) {
+    if (lane_[i] != kNone) order_[fill[lane_[i]]++] = i;
+  }
   for (size_t k = 0; k < nl; ++k) {
     std::sort(order_.begin() + lane_begin_[k], order_.begin() + lane_begin_[k + 1],
               [&](uint32_t a, uint32_t b) { return s_[a] < s_[b] || (s_[a] == s_[b] && a < b); });
   }
-  rank_.resize(size());
+  rank_.assign(lane_.size(), kNone);
   for (uint32_t r = 0; r < order_.size(); ++r) rank_[order_[r]] = r;
 }
 
+// The grid holds the pooled vehicles and one entry per external road user.
 void Pool::build_grid() {
   gx_ = std::max(1, static_cast<int>((net_.max_x - net_.min_x + 40) / cell_) + 1);
   gy_ = std::max(1, static_cast<int>((net_.max_y - net_.min_y + 40) / cell_) + 1);
   cell_head_.assign(static_cast<size_t>(gx_) * gy_, kNone);
-  cell_next_.assign(size(), kNone);
-  for (uint32_t i = 0; i < size(); ++i) {
+  cell_next_.assign(grid_end_, kNone);
+  for (uint32_t i = 0; i < grid_end_; ++i) {
     const int cx = std::clamp(static_cast<int>((x_[i] - net_.min_x + 20) / cell_), 0, gx_ - 1);
     const int cy = std::clamp(static_cast<int>((y_[i] - net_.min_y + 20) / cell_), 0, gy_ - 1);
     const size_t c = static_cast<size_t>(cy) * gx_ + cx;
@@ -288,6 +294,7 @@ void Pool::update_pose(size_t i) {
 }
 
 void Pool::step(double dt) {
+  place_externals();
   index_lanes();
   build_grid();
   changed_into_.assign(net_.lanes().size(), 0);

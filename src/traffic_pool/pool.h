@@ -5,6 +5,11 @@
 // traffic lights (PoolNetwork). State is kept in arrays, one entry per vehicle; neighbours off
 // the lane (vehicles in junctions, and the collision check) are found in a uniform grid.
 //
+// External road users (the ego, agent engines' road users: set_external) are obstacles the
+// pool never moves: each sits in the grid and on every lane its box reaches (pool_external.cpp),
+// so pooled vehicles follow it (IDM leader), keep MOBIL's gaps to it, wait while it occupies a
+// junction lane crossing theirs, and are not respawned onto it.
+//
 // Bad input throws PoolError naming the road user: an unknown policy, a start off the driving
 // lanes, two road users on one spot, a destination with no path, a count that does not fit.
 #pragma once
@@ -64,6 +69,12 @@ size_t spawn_capacity(const PoolNetwork& net, const VehicleSpec& base,
 // Length of the driving lanes outside junctions, km (what a density is per).
 double driving_km(const PoolNetwork& net);
 
+// A road user the pool does not drive: the centre of its box, heading, speed and size.
+struct ExternalUser {
+  std::string id;
+  double x = 0, y = 0, yaw = 0, speed = 0, length = 4.5, width = 1.8;
+};
+
 struct PoolStats {
   uint64_t lane_changes = 0, junction_entries = 0, respawns = 0;
 };
@@ -72,7 +83,10 @@ class Pool {
  public:
   Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m = 20);
   void step(double dt);  // s
-  size_t size() const { return specs_.size(); }
+  // The external road users as of now, replacing the last ones; kept until the next call.
+  void set_external(std::vector<ExternalUser> users);
+  const std::vector<ExternalUser>& external() const { return ext_; }
+  size_t size() const { return n_; }  // pooled vehicles (indices 0..size()-1)
   double time() const { return t_; }
   const VehicleSpec& spec(size_t i) const { return specs_[i]; }
   // The centre of its box, its heading, speed and acceleration.
@@ -86,6 +100,8 @@ class Pool {
   const PoolStats& stats() const { return stats_; }
   // Pairs of vehicles whose boxes overlap now (found through the grid).
   std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
+  // Pairs (pooled vehicle, external road user) whose boxes overlap now.
+  std::vector<std::pair<uint32_t, uint32_t>> external_overlaps() const;
 
  private:
   void validate();
@@ -103,11 +119,24 @@ class Pool {
   uint32_t choose(size_t i, uint32_t lane);
   void respawn(size_t i);
   void update_pose(size_t i);
+  void place_externals();
+  void index_lane_points();
+  void add_lane_entries(uint32_t e);
+  void add_lane_entry(uint32_t e, uint32_t lane, double s_centre, double half_along, double v);
   template <class F>
   void for_near(double x, double y, double r, F&& f) const;
 
   const PoolNetwork& net_;
+  // Entries: 0..n_-1 pooled vehicles, then one grid entry per external road user (lane kNone),
+  // then one lane entry per lane an external's box reaches (on the lanes, not in the grid).
+  size_t n_ = 0, grid_end_ = 0;
   std::vector<VehicleSpec> specs_;
+  std::vector<ExternalUser> ext_;
+  std::vector<uint32_t> ext_of_;  // entry - n_ -> its external road user
+  // Lane sample points by 10 m cell (built on the first external): lane << 32 | pose index.
+  std::vector<uint32_t> point_begin_;
+  std::vector<uint64_t> points_;
+  int px_ = 0, py_ = 0;
   double t_ = 0;
   // Per vehicle.
   std::vector<uint32_t> lane_, prev_, next_, next2_, claim_;

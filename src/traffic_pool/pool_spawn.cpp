@@ -42,6 +42,7 @@ uint64_t mix(uint64_t z) {
 Pool::Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m)
     : net_(net), specs_(std::move(specs)), cell_(cell_m) {
   const size_t n = specs_.size();
+  n_ = grid_end_ = n;
   lane_.assign(n, kNone);
   prev_.assign(n, kNone);
   next_.assign(n, kNone);
@@ -214,11 +215,28 @@ std::vector<std::pair<uint32_t, uint32_t>> Pool::overlaps() const {
   for (uint32_t i = 0; i < size(); ++i) {
     const VehicleSpec& a = specs_[i];
     for_near(x_[i], y_[i], 0.5 * a.length + 8, [&](uint32_t k) {
-      if (k <= i) return;
+      if (k <= i || k >= n_) return;
       const VehicleSpec& b = specs_[k];
       if (boxes_overlap(x_[i], y_[i], yaw_[i], a.length, a.width, x_[k], y_[k], yaw_[k], b.length,
                         b.width)) {
         out.emplace_back(i, k);
+      }
+    });
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> Pool::external_overlaps() const {
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  for (uint32_t k = static_cast<uint32_t>(n_); k < grid_end_; ++k) {
+    const VehicleSpec& b = specs_[k];
+    for_near(x_[k], y_[k], 0.5 * b.length + 8, [&](uint32_t i) {
+      if (i >= n_) return;
+      const VehicleSpec& a = specs_[i];
+      if (boxes_overlap(x_[i], y_[i], yaw_[i], a.length, a.width, x_[k], y_[k], yaw_[k], b.length,
+                        b.width)) {
+        out.emplace_back(i, ext_of_[k - n_]);
       }
     });
   }

@@ -5,8 +5,14 @@ planner) among vehicles of ONE road_user_pool engine on the city map (issue 26).
   ground-truth boxes (smart_camera::camera::boxes, read by a TF added for the test) name
   pooled vehicles, the recorder tracked those near the ego, no two pooled vehicles touched, and
   nothing is left running.
+- EgoSeen: at density 80 (~300 pooled vehicles) the pool sees the ego (pool_tf.py's
+  external_users): 30 simulated s with no collision involving the ego (the world engine's
+  records in summary.json; before the pool saw the ego, two pooled cars ran into it by 23 s).
+- LargeCity: simulation_config_pooled_large.json, 1,000 pooled vehicles on the 4x4 grid city
+  for 4 simulated s: the world draws them, the ego drives, no collision.
 - BadInput: a Density the map cannot hold, and Count with Density, stop the run with one
-  message naming the key (and the map's capacity), exit 2, nothing left running.
+  message naming the key (and the map's capacity), exit 2, nothing left running; so does a
+  malformed external_users datapack, naming the road user and the field.
 """
 
 import json
@@ -41,6 +47,20 @@ BOXES_TF = textwrap.dedent("""\
         with open(OUT, "w") as f:
             json.dump(_seen, f)
         return []
+    """)
+
+
+BAD_EXTERNAL_TF = textwrap.dedent("""\
+    from nrp_core import *
+    from nrp_core.data.nrp_protobuf import RoadUsersDataPack
+
+
+    @TransceiverFunction("pool")
+    def bad_external():
+        dp = RoadUsersDataPack("external_users", "pool")
+        u = dp.data.users.add()
+        u.id, u.x, u.y, u.length, u.width = "truck_9", 10.0, -1.75, -4.0, 2.0
+        return [dp]
     """)
 
 
@@ -81,8 +101,8 @@ class PooledCity(unittest.TestCase):
         self.addCleanup(shutil.rmtree, self.tmp, True)
         self.pool = engine_index("pool")
 
-    def run_city(self, run_dir, seconds, *overrides):
-        args = [CONVOY, "run", "-c", CONFIG, "--run-dir", run_dir, "-q",
+    def run_city(self, run_dir, seconds, *overrides, config=CONFIG):
+        args = [CONVOY, "run", "-c", config, "--run-dir", run_dir, "-q",
                 "-o", "SimulationTimeout=%g" % seconds]
         for o in overrides:
             args += ["-o", o]
@@ -118,6 +138,43 @@ class Runs(PooledCity):
         self.assertEqual(processes_of(run_dir), [])
 
 
+class EgoSeen(PooledCity):
+    def test_no_pooled_car_runs_into_the_ego(self):
+        run_dir = os.path.join(self.tmp, "run")
+        r = self.run_city(run_dir, 30.0, "EngineConfigs/%d/Density=80" % self.pool)
+        self.assertEqual(r.returncode, 0, r.stderr[-3000:])
+        with open(os.path.join(run_dir, "summary.json")) as f:
+            s = json.load(f)
+        self.assertGreaterEqual(s["simulated_s"], 29.0)
+        ego = [c for c in s["collisions"] if "smart_car" in (c["a"], c["b"])]
+        self.assertEqual(ego, [])
+        self.assertEqual(s["collisions"], [])
+        with open(os.path.join(run_dir, "tracks.jsonl")) as f:
+            rows = [json.loads(line) for line in f]
+        ego_x = [u[2] for r in rows for u in r["users"] if u[0] == "smart_car"]
+        self.assertGreater(max(ego_x) - min(ego_x), 60.0)  # the ego drove among them
+        self.assertGreaterEqual(s["pooled_vehicles"], 250)
+        self.assertEqual(processes_of(run_dir), [])
+
+
+class LargeCity(PooledCity):
+    def test_a_thousand_pooled_road_users(self):
+        run_dir = os.path.join(self.tmp, "run")
+        r = self.run_city(run_dir, 4.0, config="simulation_config_pooled_large.json")
+        self.assertEqual(r.returncode, 0, r.stderr[-3000:])
+        with open(os.path.join(run_dir, "summary.json")) as f:
+            s = json.load(f)
+        self.assertEqual(s["participants"]["road_user_pool"], 1)
+        self.assertEqual(s["collisions"], [])
+        self.assertGreater(s["camera_frames"], 60)
+        self.assertEqual(s["pooled_vehicles"], 1000)
+        with open(os.path.join(run_dir, "tracks.jsonl")) as f:
+            rows = [json.loads(line) for line in f]
+        ego_x = [u[2] for r in rows for u in r["users"] if u[0] == "smart_car"]
+        self.assertGreater(max(ego_x) - min(ego_x), 5.0)
+        self.assertEqual(processes_of(run_dir), [])
+
+
 class BadInput(PooledCity):
     def bad(self, *overrides):
         run_dir = os.path.join(self.tmp, "run")
@@ -135,6 +192,16 @@ class BadInput(PooledCity):
     def test_count_and_density(self):
         err = self.bad("EngineConfigs/%d/Count=10" % self.pool)
         self.assertIn("give Count or Density, not both", err)
+
+    def test_malformed_external_datapack(self):
+        tf = os.path.join(self.tmp, "bad_tf.py")
+        with open(tf, "w") as f:
+            f.write(BAD_EXTERNAL_TF)
+        tfs = [t for t in functions() if t["Name"] != "pool_tf"] + \
+            [{"Name": "bad_external", "FileName": tf}]
+        err = self.bad("DataPackProcessingFunctions=" + json.dumps(tfs))
+        self.assertIn("road_user_pool engine 'pool': datapack 'external_users': users[0] "
+                      "('truck_9'): length must be > 0 m", err)
 
     def test_negative_density(self):
         err = self.bad("EngineConfigs/%d/Density=-1" % self.pool)

@@ -123,12 +123,18 @@ def build():
         Road("7", "J2 south", (200.0, -150.0, math.pi / 2), [("line", 150.0 - HALF)], side_lanes(),
              SIDE_KMH),
     ]
-    by_id = {r.id: r for r in roads}
     # (junction id, [(road id, at_end, group)]): group 0 = main road, 1 = side road.
     junctions = [
         ("100", [("1", True, 0), ("2", False, 0), ("4", False, 1), ("5", True, 1)]),
         ("200", [("2", True, 0), ("3", False, 0), ("6", False, 1), ("7", True, 1)]),
     ]
+    return connect(roads, junctions)
+
+
+def connect(roads, junctions):
+    """The junctions' connecting roads (appended to `roads`), lights, crosswalks and
+    controllers; also used by experiments/city_traffic/make_large_city.py."""
+    by_id = {r.id: r for r in roads}
     junction_xml, controllers = [], []
     next_road, next_signal, next_object = 1000, 1, 1
     for jid, arms in junctions:
@@ -340,14 +346,14 @@ def road_xml(r):
     return out
 
 
-def write(path):
-    roads, junctions, controllers = build()
+def write(path, built=None, name="city"):
+    roads, junctions, controllers = built or build()
     xs = [g[1] for r in roads for g in r.geoms] + [r.end[0] for r in roads]
     ys = [g[2] for r in roads for g in r.geoms] + [r.end[1] for r in roads]
     lines = ['<?xml version="1.0" standalone="yes"?>', "<OpenDRIVE>",
-             '  <header revMajor="1" revMinor="6" name="city" version="1.0" date="2026-11-23" '
+             '  <header revMajor="1" revMinor="6" name="%s" version="1.0" date="2026-11-23" '
              'north="%s" south="%s" east="%s" west="%s" vendor="Convoy">' %
-             (fmt(max(ys)), fmt(min(ys)), fmt(max(xs)), fmt(min(xs))),
+             (name, fmt(max(ys)), fmt(min(ys)), fmt(max(xs)), fmt(min(xs))),
              "  </header>"]
     for r in roads:
         lines += road_xml(r)
