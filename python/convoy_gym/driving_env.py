@@ -17,8 +17,9 @@ over WHEEL_RADIUS), and a status function
 returning done=True and one JSON observation every step with the keys t, x, y, yaw, speed,
 heading_error, off_path, waypoint, waypoints, episode_over and (optionally) ahead, a list of
 [forward, left] route points in the car's frame. One step() is one run_loop(1), i.e. one
-step of the smallest EngineTimestep (0.05 s on the Parkring), at a 5 ms physics step
-(PHYSICS_STEP; physics_step=None keeps the world's own, 1 ms). A config with a python_json
+step of the smallest EngineTimestep (0.05 s on the Parkring), at a 10 ms physics step
+(PHYSICS_STEP; physics_step=None keeps the world's own, 1 ms) with steering gains stable at
+that step (STEERING_PID). A config with a python_json
 engine "agent" (rl_parkring's simulation_config.json) gets the action as its datapack
 "action" = {"steer": rad, "speed": m/s} instead, for a transceiver function to turn into the
 joint targets (one more process and one more step of delay). With camera=(H, W), the
@@ -43,7 +44,16 @@ __all__ = ["DrivingEnv", "default_reward", "OBSERVATION_KEYS"]
 
 _REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_CONFIG = os.path.join(_REPO, "experiments", "rl_parkring", "gym_config.json")
-PHYSICS_STEP = 0.005  # s: the world's physics step by default (the Parkring world's own: 1 ms)
+PHYSICS_STEP = 0.01  # s: the world's physics step by default (the Parkring world's own: 1 ms)
+# The steering joints' position controller (P, I, D) by default. The report's gains (40000, 200,
+# 1) were tuned for its 1 ms step: on a steering axis of about 0.4 kg m^2 (the wheel about its
+# diameter) they make an oscillator of omega = sqrt(P / I) = 316 rad/s, which the integrator
+# keeps stable only while omega * dt < 2 (dt <= 5 ms; at 10 ms DART aborts). P 4000 gives
+# omega 100 rad/s (omega * dt = 1 at 10 ms) and D 40 a damping ratio of 0.5: the wheels still
+# reach a new angle within about 30 ms, under one 0.05 s step.
+STEERING_PID = (4000.0, 0.0, 40.0)
+# The server's and engines' environment without spinning waits (DrivingEnv(spin=False))
+NO_SPIN = {"CONVOY_SPIN_US": "0", "CONVOY_ENGINE_SPIN_US": "0"}
 
 MAX_STEER = 0.55   # rad, the smart car's steering limit (drive_tf.py clamps to it too)
 MAX_SPEED = 15.0   # m/s
@@ -108,7 +118,8 @@ class DrivingEnv(ClosesOnExit):
 
     def __init__(self, config=DEFAULT_CONFIG, max_steps=1000, reward_fn=None,
                  start_steps=20, start_speed=6.0, start_steer=0.05, physics_step=PHYSICS_STEP,
-                 args="", address=None, log_output="", camera=None, shadows=True):
+                 args="", address=None, log_output="", camera=None, shadows=True,
+                 max_contacts=None, steering_pid="auto", spin=True):
         """:param config: the simulation config; its folder is the experiment folder
         :param max_steps: steps per episode before `truncated`
         :param reward_fn: reward_fn(before, after, action) -> float; default_reward if None
@@ -116,7 +127,7 @@ class DrivingEnv(ClosesOnExit):
             steps at a speed in [0, start_speed] m/s and a steer in +-start_steer rad, all
             drawn from the seed, so each seed starts the episode from its own state
         :param physics_step: the Gazebo world's physics step in s (default PHYSICS_STEP,
-            5 ms; None: the world's own, 1 ms on the Parkring, about 2.5x slower)
+            10 ms; None: the world's own, 1 ms on the Parkring, several times slower)
         :param args: more NRPCoreSim options, e.g. "-o SimulationTimeout=600"
         :param address: HOST:PORT for the server (default: a free loopback port)
         :param log_output: file in the experiment folder for the server's output ("" none)
@@ -125,6 +136,16 @@ class DrivingEnv(ClosesOnExit):
             shadow map sized to it (world_variant.shadow_map_size)
         :param shadows: with a camera, False renders it without the sun's shadows (about
             1.6x the steps/s at 84 x 84 on a CPU renderer)
+        :param max_contacts: the world's <physics><max_contacts>: contacts kept per pair of
+            collision shapes, the deepest (None: every contact, as the world's own physics)
+        :param steering_pid: (P, I, D) of the steering joints' position controllers in the
+            world's copy; "auto" (default): STEERING_PID (stable at a 10 ms physics step) when
+            physics_step is over 5 ms, else the car's own (stable up to 5 ms); None: the car's
+            own
+        :param spin: True lets the server and its engine wait for each other's next message by
+            yielding the CPU for a while rather than sleeping (quicker hand-overs when a core is
+            free for each process); False makes them sleep at once (no CPU spent waiting: for
+            several environments sharing few cores, VectorDrivingEnv's default)
         """
         self._nrp = None
         self._tmp = None
@@ -155,6 +176,7 @@ class DrivingEnv(ClosesOnExit):
                 "state": self.state_space,
                 "camera": spaces.Box(0, 255, self.camera + (3,), dtype=np.uint8)})
         self._frame = None
+        self._pending = None  # the action step_begin() sent
         self.action_space = spaces.Box(low=np.array([-MAX_STEER, 0.0]),
                                        high=np.array([MAX_STEER, MAX_SPEED]), dtype=np.float32)
         self.np_random = np.random.Generator(np.random.PCG64())
@@ -164,15 +186,22 @@ class DrivingEnv(ClosesOnExit):
         with open(config) as f:
             engines = json.load(f).get("EngineConfigs", [])
         self._agent = any(e.get("EngineName") == "agent" for e in engines)
-        if physics_step is not None or camera is not None:
+        gains = None
+        if isinstance(steering_pid, str) and steering_pid == "auto":
+            steering_pid = STEERING_PID if (physics_step or 0) > 0.005 else None
+        if steering_pid is not None:
+            gains = {name.split("::")[-1]: tuple(steering_pid) for name in STEERING_JOINTS}
+        if physics_step is not None or camera is not None or max_contacts is not None or gains:
             run_config, self._tmp = variant_config(config, physics_step, self.camera,
-                                                   shadows=bool(shadows))
+                                                   shadows=bool(shadows),
+                                                   max_contacts=max_contacts, gains=gains)
         self._nrp_config = run_config  # the config the server runs
         try:
             self._nrp = NrpCore(address or _free_address(),
                                 experiment_folder=os.path.dirname(config),
                                 config_file=run_config, args=args, log_output=log_output,
-                                local_channel=True)
+                                local_channel=True,
+                                environment=None if spin else NO_SPIN)
             self._nrp.initialize()
             self._joint = None if self._agent else self._nrp._message_class(JOINT_TYPE)
         except BaseException:
@@ -187,6 +216,8 @@ class DrivingEnv(ClosesOnExit):
         start_steps / start_speed / start_steer to fix the start instead of drawing it.
         Returns (observation, info)."""
         self._check_open()
+        if self._pending is not None:
+            raise RuntimeError("DrivingEnv.reset() between step_begin() and step_finish()")
         if seed is not None:
             self.np_random = np.random.Generator(np.random.PCG64(seed))
         options = dict(options or {})
@@ -213,12 +244,32 @@ class DrivingEnv(ClosesOnExit):
         """Applies `action` for one step. Returns (obs, reward, terminated, truncated,
         info): terminated when the car left the track or finished the lap, truncated after
         max_steps steps."""
+        self.step_begin(action)
+        return self.step_finish()
+
+    def step_begin(self, action):
+        """step()'s first half: checks `action` (ValueError) and sends it; the server steps
+        while the caller goes on, until step_finish() returns the step's result. Between
+        the two, the environment takes no other call. VectorDrivingEnv steps its
+        environments so, all at once from one thread."""
         self._check_open()
         if self._raw is None:
             raise RuntimeError("DrivingEnv.step() before reset()")
+        if self._pending is not None:
+            raise RuntimeError("DrivingEnv.step_begin() twice without step_finish()")
         a = self._check_action(action)
+        self._set_action(float(a[0]), float(a[1]))
+        self._nrp.run_loop_begin(1)
+        self._pending = a
+
+    def step_finish(self):
+        """step()'s second half: (obs, reward, terminated, truncated, info) of the step
+        step_begin() started."""
+        a, self._pending = self._pending, None
+        if a is None:
+            raise RuntimeError("DrivingEnv.step_finish() without step_begin()")
         before = self._raw
-        self._raw = self._run(float(a[0]), float(a[1]))
+        self._raw = self._observed(self._nrp.run_loop_finish()[1])
         self._steps += 1
         reward = float(self.reward_fn(before, self._raw, a))
         terminated = bool(self._raw["episode_over"])
@@ -285,7 +336,11 @@ class DrivingEnv(ClosesOnExit):
 
     def _run(self, steer, speed):
         self._set_action(steer, speed)
-        _, observations = self._nrp.run_loop(1)
+        return self._observed(self._nrp.run_loop(1)[1])
+
+    def _observed(self, observations):
+        """The status function's observation dict among a step's `observations` (and the
+        camera frame taken from them)."""
         dicts = [o for o in observations if isinstance(o, dict)]
         if self.camera is not None and (dicts or self._frame is None):
             self._take_frame([o for o in observations if not isinstance(o, dict)])

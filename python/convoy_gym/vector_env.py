@@ -11,9 +11,12 @@
 
 Each sub-environment is a DrivingEnv, i.e. its own NRPCoreSim server process (and its
 engines' processes) on its own port: the simulations already run in parallel processes. This
-class only drives them at the same time, from one thread per environment: a step is a few
-gRPC calls that release the GIL while the server works, so the Python side is not the
-bottleneck (see docs/gym.md, "Parallel environments", for the measured speed-up).
+class only drives them at the same time, from one thread: a step sends every environment its
+action (DrivingEnv.step_begin, over each server's local socket) before it waits for any reply
+(step_finish), so the servers step together while this process waits; resets run on a thread
+per environment. Their servers and engines wait without spinning (DrivingEnv's spin=False),
+since the environments share the cores (see docs/gym.md, "Parallel environments", for the
+measured speed-up).
 
 Autoreset: gymnasium's default for AsyncVectorEnv (gymnasium >= 1.0, AutoresetMode.NEXT_STEP).
 When a sub-environment's episode ends at step t, step t returns its last observation with
@@ -74,7 +77,9 @@ class VectorDrivingEnv(ClosesOnExit):
         :param env_fns: optional list of num_envs callables returning a DrivingEnv-like
             environment (instead of DrivingEnv(**env_kwargs))
         :param env_kwargs: DrivingEnv's arguments, the same for every sub-environment
-            (address must not be given: each gets a free port)"""
+            (address must not be given: each gets a free port); spin defaults to False here:
+            the environments' processes share the cores, and a process spinning while it
+            waits takes a core another environment could use"""
         self.envs = []
         self._pool = None
         num_envs = int(num_envs)
@@ -97,6 +102,7 @@ class VectorDrivingEnv(ClosesOnExit):
         self._lock = threading.Lock()
         self._pool = concurrent.futures.ThreadPoolExecutor(
             max_workers=num_envs, thread_name_prefix="VectorDrivingEnv")
+        env_kwargs.setdefault("spin", False)  # the environments share the cores
         make = env_fns or [lambda: DrivingEnv(**env_kwargs)] * num_envs
         # start the servers at the same time; if one fails, close the others
         futures = [self._pool.submit(fn) for fn in make]
@@ -159,13 +165,16 @@ class VectorDrivingEnv(ClosesOnExit):
             raise RuntimeError("VectorDrivingEnv.step() before reset()")
         actions = self._check_actions(actions)
         n = self.num_envs
-        jobs = {}
-        for i, env in enumerate(self.envs):
-            if self._autoreset[i]:
-                jobs[i] = lambda e=env: ("reset",) + tuple(e.reset())
-            else:
-                jobs[i] = self._step_job(env, actions[i])
-        results = self._run(jobs)
+        if all(hasattr(env, "step_begin") for env in self.envs):
+            results = self._step_together(actions)
+        else:
+            jobs = {}
+            for i, env in enumerate(self.envs):
+                if self._autoreset[i]:
+                    jobs[i] = lambda e=env: ("reset",) + tuple(e.reset())
+                else:
+                    jobs[i] = self._step_job(env, actions[i])
+            results = self._run(jobs)
         obs = self._obs
         rewards = np.zeros(n, dtype=np.float64)
         terminations = np.zeros(n, dtype=bool)
@@ -245,6 +254,37 @@ class VectorDrivingEnv(ClosesOnExit):
             return out
         return job
 
+    def _step_together(self, actions):
+        """step()'s results {index: ("step", ...) or ("reset", ...)}: the environments due an
+        autoreset reset first (concurrently), then every other one is sent its action
+        (step_begin) before any reply is awaited (step_finish), all from this thread: the
+        servers step at the same time without a thread per environment."""
+        resets = {i: (lambda e=env: ("reset",) + tuple(e.reset()))
+                  for i, env in enumerate(self.envs) if self._autoreset[i]}
+        results = self._run(resets) if resets else {}
+        same_step = self.autoreset_mode == "same_step"
+        begun, errors = [], []
+        for i, env in enumerate(self.envs):
+            if i in resets:
+                continue
+            try:
+                env.step_begin(actions[i])
+                begun.append(i)
+            except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
+                errors.append((i, e))
+                break
+        for i in begun:
+            try:
+                out = ("step",) + tuple(self.envs[i].step_finish())
+                if same_step and (out[3] or out[4]):
+                    out += tuple(self.envs[i].reset())
+                results[i] = out
+            except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
+                errors.append((i, e))
+        if errors:
+            self._fail(sorted(errors, key=lambda x: x[0]))
+        return results
+
     def _check_open(self):
         if not self.envs:
             raise RuntimeError("VectorDrivingEnv is closed; make a new one")
@@ -283,14 +323,18 @@ class VectorDrivingEnv(ClosesOnExit):
                 except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
                     errors.append((i, e))
         if errors:
-            try:
-                self.close()
-            finally:
-                i, e = errors[0]
-                if isinstance(e, KeyboardInterrupt):
-                    raise e
-                raise SubEnvError(i, e) from e
+            self._fail(errors)
         return results
+
+    def _fail(self, errors):
+        """Closes everything and raises the first of [(index, error)] as SubEnvError."""
+        try:
+            self.close()
+        finally:
+            i, e = errors[0]
+            if isinstance(e, KeyboardInterrupt):
+                raise e
+            raise SubEnvError(i, e) from e
 
 
 def _batch_box(space, n):

@@ -23,6 +23,8 @@ import shutil
 import tempfile
 
 _STEP = re.compile(r"<max_step_size>\s*[^<]*\s*</max_step_size>")
+_PHYSICS = re.compile(r"<physics\b[^>]*>.*?</physics>", re.S)
+_MAX_CONTACTS = re.compile(r"<max_contacts>\s*[^<]*\s*</max_contacts>")
 _CAMERA = re.compile(r"<sensor\b[^>]*\btype\s*=\s*['\"]camera['\"][^>]*>.*?</sensor>", re.S)
 
 
@@ -56,9 +58,27 @@ def _resized_cameras(sdf, camera, rate):
     return _CAMERA.subn(resize, sdf)
 
 
-def _models_with_camera(models, dest, camera, rate):
-    """dest/: a link to each model of the folder `models`, but a copy of those with a camera
-    (their files linked, model.sdf rewritten). Returns how many cameras were resized."""
+def _with_gains(sdf, gains):
+    """(the SDF with the joint controller entries named in `gains` ({joint: (P, I, D)}, as in
+    NRPGazeboGrpcJointControllerPlugin's `<joint P='..' I='..' D='..' .../>`) given those
+    gains, how many entries changed)."""
+    count = 0
+    for joint, pid in gains.items():
+        def put(m):
+            attrs = m.group(2)
+            for name, value in zip("PID", pid):
+                attrs = re.sub(r"\b%s\s*=\s*(['\"])[^'\"]*\1" % name, "%s='%r'" % (name, float(value)),
+                               attrs)
+            return m.group(1) + attrs
+        sdf, n = re.subn(r"(<%s\b)([^>]*\bType\s*=[^>]*)" % re.escape(joint), put, sdf)
+        count += n
+    return sdf, count
+
+
+def _models_rewritten(models, dest, rewrite):
+    """dest/: a link to each model of the folder `models`, but a copy of those that
+    rewrite(sdf) -> (sdf, n) changes (n > 0; their files linked, model.sdf rewritten).
+    Returns the sum of the n."""
     os.mkdir(dest)
     count = 0
     for name in sorted(os.listdir(models)):
@@ -67,7 +87,7 @@ def _models_with_camera(models, dest, camera, rate):
         n = 0
         if os.path.isfile(sdf_path):
             with open(sdf_path) as f:
-                sdf, n = _resized_cameras(f.read(), camera, rate)
+                sdf, n = rewrite(f.read())
         if not n:
             os.symlink(src, os.path.join(dest, name))
             continue
@@ -128,7 +148,22 @@ def _camera_status(cfg, config):
     status["FileName"] = camera_file
 
 
-def _world_copy(world, sub, physics_step, camera, rate):
+def _with_max_contacts(sdf, world, max_contacts):
+    """The world's <physics> with <max_contacts>max_contacts</max_contacts>."""
+    tag = "<max_contacts>%d</max_contacts>" % max_contacts
+
+    def put(m):
+        block = m.group(0)
+        if _MAX_CONTACTS.search(block):
+            return _MAX_CONTACTS.sub(tag, block)
+        return block.replace("</physics>", tag + "</physics>")
+    sdf, n = _PHYSICS.subn(put, sdf)
+    if not n:
+        raise ValueError("max_contacts: %s has no <physics>" % world)
+    return sdf
+
+
+def _world_copy(world, sub, physics_step, camera, rate, max_contacts=None, gains=None):
     """Writes `world` (with its changes) into the folder `sub`; returns the copy's path."""
     with open(world) as f:
         sdf = f.read()
@@ -136,26 +171,50 @@ def _world_copy(world, sub, physics_step, camera, rate):
         if not _STEP.search(sdf):
             raise ValueError("physics_step: %s has no <max_step_size>" % world)
         sdf = _STEP.sub("<max_step_size>%r</max_step_size>" % physics_step, sdf)
+    if max_contacts is not None:
+        sdf = _with_max_contacts(sdf, world, max_contacts)
     models = os.path.join(os.path.dirname(world), "models")
-    cameras = 0
-    if camera is not None:
-        sdf, cameras = _resized_cameras(sdf, camera, rate)
-        if os.path.isdir(models):
-            cameras += _models_with_camera(models, os.path.join(sub, "models"), camera, rate)
-        if not cameras:
-            raise ValueError("camera: %s and its models/ have no camera sensor" % world)
-    elif os.path.isdir(models):
-        os.symlink(models, os.path.join(sub, "models"))
+    tally = {"cameras": 0, "gains": 0}
+
+    def rewrite(text):
+        """(text with this variant's changes, how many changes)."""
+        n = 0
+        if camera is not None:
+            text, k = _resized_cameras(text, camera, rate)
+            tally["cameras"] += k
+            n += k
+        if gains:
+            text, k = _with_gains(text, gains)
+            tally["gains"] += k
+            n += k
+        return text, n
+    sdf = rewrite(sdf)[0]
+    if os.path.isdir(models):
+        if camera is None and not gains:
+            os.symlink(models, os.path.join(sub, "models"))
+        else:
+            _models_rewritten(models, os.path.join(sub, "models"), rewrite)
+    if camera is not None and not tally["cameras"]:
+        raise ValueError("camera: %s and its models/ have no camera sensor" % world)
+    if gains and tally["gains"] < len(gains):
+        raise ValueError("joint gains: %s and its models/ have no joint controller entry for "
+                         "some of %s" % (world, ", ".join(sorted(gains))))
     copy = os.path.join(sub, os.path.basename(world))
     with open(copy, "w") as f:
         f.write(sdf)
     return copy
 
 
-def variant_config(config, physics_step=None, camera=None, shadows=True):
+def variant_config(config, physics_step=None, camera=None, shadows=True, max_contacts=None,
+                   gains=None):
     """Returns (path of the new config, its temporary folder: remove it after the run).
     physics_step: the worlds' physics step in s (None: unchanged); camera: (H, W) or None;
-    shadows: False turns the cameras' sun shadows off."""
+    shadows: False turns the cameras' sun shadows off; max_contacts: the worlds'
+    <physics><max_contacts>, contacts kept per pair of collision shapes (None: unchanged);
+    gains: {joint name: (P, I, D)} for the joint controller plugin entries of those joints in
+    the world and its models/ (None: unchanged)."""
+    if max_contacts is not None and (not isinstance(max_contacts, int) or max_contacts < 1):
+        raise ValueError("max_contacts must be an int >= 1, got %r" % (max_contacts,))
     if physics_step is not None:
         physics_step = float(physics_step)
         if not 0.0 < physics_step <= 0.05:
@@ -184,7 +243,8 @@ def variant_config(config, physics_step=None, camera=None, shadows=True):
             sub = os.path.join(tmp, "world%d" % i)
             os.mkdir(sub)
             engine["GazeboWorldFile"] = _world_copy(engine["GazeboWorldFile"], sub,
-                                                    physics_step, camera, rate)
+                                                    physics_step, camera, rate, max_contacts,
+                                                    gains)
         path = os.path.join(tmp, os.path.basename(config))
         with open(path, "w") as f:
             json.dump(cfg, f, indent=2)

@@ -89,11 +89,12 @@ def _check_port_free(address):
 class _Server:
     """The NRPCoreSim child process."""
 
-    def __init__(self, command, cwd, log_file):
+    def __init__(self, command, cwd, log_file, environment=None):
         self.log_file = log_file  # where the server writes its output, or None
         self._early = tempfile.TemporaryFile(mode="w+b")  # its output before that
+        env = dict(os.environ, **environment) if environment else None
         self.process = subprocess.Popen(command, cwd=cwd or None, stdin=subprocess.DEVNULL,
-                                        stdout=self._early, stderr=subprocess.STDOUT)
+                                        stdout=self._early, stderr=subprocess.STDOUT, env=env)
 
     def alive(self):
         return self.process.poll() is None
@@ -152,7 +153,7 @@ class NrpCore:
 
     def __init__(self, address, experiment_folder="", config_file="simulation_config.json",
                  args="", log_output=".console_output.log", server_timeout=10,
-                 local_channel=False):
+                 local_channel=False, environment=None):
         """Starts NRPCoreSim in server mode at `address` and connects to it.
 
         :param address: HOST:PORT where the server listens (a loopback address, unless
@@ -167,6 +168,8 @@ class NrpCore:
         :param local_channel: (Convoy) also reach the server through a Unix socket in a
             private temporary folder, and send run_loop() and reset() there: the same calls
             and answers at a fraction of gRPC's cost per call (_local.py)
+        :param environment: (Convoy) more environment variables for the server and its
+            engines, e.g. {"CONVOY_SPIN_US": "0"}
         """
         self._sim_state = "None"
         self._closed = True
@@ -200,7 +203,7 @@ class NrpCore:
         if log_output:
             command += ["--logoutput=all", "--logfilename=" + log_output]
             log_file = os.path.join(folder, log_output)
-        self._server = _Server(command, folder, log_file)
+        self._server = _Server(command, folder, log_file, environment)
         self._address = address
         _live_servers.add(self)
 
@@ -264,6 +267,24 @@ class NrpCore:
         if run_async:
             return self._async(lambda: self._run_loop(message), response)
         return self._run_loop(message)
+
+    def run_loop_begin(self, num_iterations):
+        """(Convoy) run_loop(num_iterations) in two halves: this one sends the call, with the
+        datapacks set, and returns at once; run_loop_finish() waits for its (done, data). One
+        thread can so have several servers step at the same time (VectorDrivingEnv). Needs
+        local_channel=True; between the two halves this client takes no other call."""
+        if self._local is None:
+            raise NrpCoreError("run_loop_begin(): needs NrpCore(local_channel=True)")
+        if not isinstance(num_iterations, int) or num_iterations < 0:
+            raise ValueError("num_iterations must be an int >= 0, got %r" % (num_iterations,))
+        message = _pb.RunLoopMessage(numIterations=num_iterations)
+        self._move_datapacks(message.dataPacks)
+        self._checked("runLoop", lambda: self._local.begin("runLoop", message))
+
+    def run_loop_finish(self):
+        """(Convoy) The (done, data) of the run_loop_begin() call."""
+        r = self._checked("runLoop", lambda: self._local.finish(_pb.RunLoopResponse))
+        return r.doneFlag, self._read_trajectory(r.trajectory)
 
     def run_until_timeout(self, run_async=False, response=None):
         """Runs until the status function says done or SimulationTimeout. Returns (done,
@@ -378,12 +399,17 @@ class NrpCore:
         return t
 
     def _call(self, method, request, keep_state=False):
+        return self._checked(method, lambda: self._calls[method](request), keep_state)
+
+    def _checked(self, method, call, keep_state=False):
+        """call()'s response, its errors raised as NrpCoreError / ConnectionError, the
+        simulation's state noted from it (a call that returns None: only sent)."""
         what = {"runLoop": "run_loop()", "runUntilTimeout": "run_until_timeout()",
                 "stopLoop": "stop()"}.get(method, method + "()")
         if self._closed:
             raise NrpCoreError("%s: this client was shut down; make a new NrpCore" % what)
         try:
-            response = self._calls[method](request)
+            response = call()
         except grpc.RpcError as e:
             code = e.code()
             if code in (grpc.StatusCode.FAILED_PRECONDITION, grpc.StatusCode.INVALID_ARGUMENT):
@@ -395,6 +421,8 @@ class NrpCore:
                                       (what, self._server.describe_exit())) from None
             raise ConnectionError("%s: NRPCoreSim at %s: %s (%s)" %
                                   (what, self._address, e.details(), code.name)) from None
+        if response is None:
+            return None
         if not keep_state:
             self._sim_state = response.simState.currentState
         if response.simState.currentState == "Failed":

@@ -60,6 +60,25 @@ class LocalChannel:
             return response_class.FromString(payload)
         return call
 
+    def begin(self, method, request):
+        """Sends a call without waiting for its reply: finish() receives it. Meanwhile, this
+        channel takes no other call (begin() holds the channel until finish()), so that one
+        thread can have calls to several servers in flight at once."""
+        self._lock.acquire()
+        try:
+            self._send(bytes([METHODS.index(method)]) + request.SerializeToString())
+        except BaseException:
+            self._lock.release()
+            raise
+
+    def finish(self, response_class):
+        """The reply to the call begin() sent (raises its error as _call does)."""
+        try:
+            reply = self._receive()
+        finally:
+            self._lock.release()
+        return response_class.FromString(self._payload(reply))
+
     def close(self):
         sock, self._sock = self._sock, None
         if sock is not None:
@@ -67,14 +86,30 @@ class LocalChannel:
 
     def _call(self, frame):
         with self._lock:
-            if self._sock is None:
-                raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "the local channel is closed")
-            try:
-                self._sock.sendall(_LEN.pack(len(frame)) + frame)
-                (n,) = _LEN.unpack(self._recv(4))
-                reply = self._recv(n)
-            except OSError as e:
-                raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "local socket: %s" % e) from None
+            self._send(frame)
+            reply = self._receive()
+        return self._payload(reply)
+
+    def _send(self, frame):
+        if self._sock is None:
+            raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "the local channel is closed")
+        try:
+            self._sock.sendall(_LEN.pack(len(frame)) + frame)
+        except OSError as e:
+            raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "local socket: %s" % e) from None
+
+    def _receive(self):
+        if self._sock is None:
+            raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "the local channel is closed")
+        try:
+            (n,) = _LEN.unpack(self._recv(4))
+            return self._recv(n)
+        except OSError as e:
+            raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "local socket: %s" % e) from None
+
+    @staticmethod
+    def _payload(reply):
+        """The reply's message bytes, or its error raised."""
         if not reply:
             raise LocalRpcError(grpc.StatusCode.INTERNAL, "an empty reply from the server")
         if reply[0] != 0:

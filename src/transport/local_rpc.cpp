@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
@@ -79,8 +80,12 @@ void LocalRpcServer::serve_connection(int fd) {
   // A client that calls again within kMaxSpinNs of a reply (a learning agent stepping) is
   // waited for by yielding the CPU rather than sleeping: no scheduler wake-up per call.
   int64_t usual_gap_ns = -1;
+  const char* fixed = std::getenv("CONVOY_SPIN_US");  // as the engines' channels: 0 never spins
+  const int64_t fixed_spin_ns = fixed ? std::max<int64_t>(0, std::atoll(fixed)) * 1000 : -1;
   while (!stop_) {
-    if (usual_gap_ns >= 0 && usual_gap_ns <= kMaxSpinNs)
+    if (fixed_spin_ns >= 0)
+      conn.set_spin(fixed_spin_ns, true);
+    else if (usual_gap_ns >= 0 && usual_gap_ns <= kMaxSpinNs)
       conn.set_spin(std::min(kMaxSpinNs, usual_gap_ns + usual_gap_ns / 4 + 20'000), true);
     else
       conn.set_spin(0);

@@ -129,6 +129,28 @@ class DrivingEnvTest(unittest.TestCase):
             self.env.step([float("nan"), 1.0])
         self.env.step([0.0, 1.0])  # still usable
 
+    def test_step_in_two_halves(self):
+        # step_begin() + step_finish() is step(): the same episode, bit for bit
+        a, ra = self.episode(seed=13, steps=20)
+        obs, _ = self.env.reset(seed=13)
+        halves, rewards = [obs], []
+        for _ in range(20):
+            self.env.step_begin(policy(obs))
+            with self.assertRaisesRegex(RuntimeError, "step_begin\\(\\) twice"):
+                self.env.step_begin(policy(obs))
+            with self.assertRaisesRegex(RuntimeError, "between step_begin"):
+                self.env.reset()
+            obs, reward, _, _, _ = self.env.step_finish()
+            halves.append(obs)
+            rewards.append(reward)
+        np.testing.assert_array_equal(a, np.array(halves))
+        self.assertEqual(ra, rewards)
+        with self.assertRaisesRegex(RuntimeError, "without step_begin"):
+            self.env.step_finish()
+        with self.assertRaisesRegex(ValueError, "steer"):
+            self.env.step_begin([0.9, 1.0])  # checked before anything is sent
+        self.env.step([0.0, 1.0])  # still usable
+
     def test_leaving_the_track_terminates(self):
         obs, info = self.env.reset(seed=0)
         for i in range(200):
@@ -186,7 +208,8 @@ class LifecycleTest(unittest.TestCase):
         self.assertFalse(os.path.exists(folder))
 
     def test_lap_at_the_default_physics_step(self):
-        # DrivingEnv's default 5 ms physics step (PHYSICS_STEP) keeps the world's lap: the
+        # DrivingEnv's default 10 ms physics step (PHYSICS_STEP, with STEERING_PID) keeps the
+        # world's lap: the
         # heading-error policy at 8 m/s completes it (about 2,640 steps, 132 s simulated)
         with DrivingEnv(max_steps=4000) as env:
             obs, info = env.reset(options={"start_steps": 1, "start_speed": 0.0,
