@@ -337,19 +337,33 @@ int CameraSensors::add_actor(const ModelDesc& model, const std::string& cls,
   return index;
 }
 
+// Only the instances shown follow the actor (an animated walker hides all but one pose's),
+// and its first, whose pose the radar tracks; the others are posed when they are shown.
 void CameraSensors::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
   if (actor < 0) return;
   Actor& a = actors_[actor];
   a.pose = pose;
   for (size_t k = 0; k < a.instances.size(); ++k)
-    scene_.set_pose(a.instances[k], render::compose(to_pose(pose * a.link_poses[k]), a.offsets[k]));
+    if (k == 0 || shows(a, k)) pose_instance(a, k);
+}
+
+void CameraSensors::pose_instance(const Actor& a, size_t k) {
+  scene_.set_pose(a.instances[k], render::compose(to_pose(a.pose * a.link_poses[k]), a.offsets[k]));
+}
+
+void CameraSensors::show_actor(const Actor& a) {
+  for (size_t k = 0; k < a.instances.size(); ++k) {
+    const bool shown = shows(a, k);
+    if (shown && !scene_.instances()[a.instances[k]].visible) pose_instance(a, k);
+    scene_.set_visible(a.instances[k], shown);
+  }
 }
 
 void CameraSensors::set_actor_visible(int actor, bool visible) {
   if (actor < 0) return;
   Actor& a = actors_[actor];
   a.visible = visible;
-  for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
+  show_actor(a);
 }
 
 void CameraSensors::set_actor_name(int actor, const std::string& name) {
@@ -360,7 +374,7 @@ void CameraSensors::set_actor_shown(int actor, int pose) {
   if (actor < 0 || actors_[actor].shown == pose) return;
   Actor& a = actors_[actor];
   a.shown = pose;
-  for (size_t k = 0; k < a.instances.size(); ++k) scene_.set_visible(a.instances[k], shows(a, k));
+  show_actor(a);
 }
 
 void CameraSensors::update(double t) {
@@ -401,6 +415,7 @@ void CameraSensors::render(Camera& cam) {
   cam.frame.keep_ids = cam.want_ids;
   renderer_->render(scene_, pose, spec, &cam.frame, cam.want_depth, cam.want_boxes || cam.want_ids);
   ++cam.frames;
+  ++frames_rendered_;
   cam.has_depth = cam.want_depth;
   cam.has_boxes = cam.want_boxes || cam.want_ids;
   cam.has_ids = cam.want_ids;

@@ -91,6 +91,11 @@ class CameraSensors {
   // Ground truth of a scene instance's model_id (1-based: the world's models, then actors).
   const std::string& model_name(uint32_t id) const { return model_names_.at(id - 1); }
   const std::string& model_class(uint32_t id) const { return model_classes_.at(id - 1); }
+  // What the last frame rendered drew (instances and triangles after culling); null
+  // before the first.
+  const render::RenderStats* last_render_stats() const {
+    return renderer_ && frames_rendered_ > 0 ? &renderer_->last_stats() : nullptr;
+  }
   // The weather set last (null until set_weather).
   const Weather* weather() const { return has_weather_ ? &weather_ : nullptr; }
 
@@ -171,6 +176,8 @@ class CameraSensors {
   bool shows(const Actor& a, size_t instance) const {
     return a.visible && (a.pose_of[instance] < 0 || a.pose_of[instance] == a.shown);
   }
+  void pose_instance(const Actor& a, size_t k);  // instance k to the actor's pose
+  void show_actor(const Actor& a);  // its instances shown or hidden (those shown posed)
   // A mesh file's parts, loaded, simplified into levels of detail and added to the scene once
   // for every visual and actor that uses the file at that scale.
   struct FilePart {
@@ -217,7 +224,8 @@ class CameraSensors {
   std::vector<Vehicle> vehicles_;
   bool has_weather_ = false;
   bool has_scene_ = false;
-  Weather weather_;  // simulated time of the last update()
+  uint64_t frames_rendered_ = 0;  // by every camera
+  Weather weather_;               // simulated time of the last update()
 };
 
 }  // namespace convoy::world

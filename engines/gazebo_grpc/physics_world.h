@@ -14,6 +14,8 @@
 
 namespace convoy::world {
 
+class CappedBulletDetector;
+
 struct JointState {
   double position = 0, velocity = 0, effort = 0;
 };
@@ -80,12 +82,17 @@ class PhysicsWorld {
   // Actors: road users posed from outside. Each is one immobile body on a free joint with
   // the collision shapes of `model` (link poses in the actor's frame): the physically
   // simulated models collide with it; it does not move in response. Returns its index.
+  // Like static scenery, an actor is in the DART world (collision detection) only while a
+  // moving body is near it (decided again before the step after actors were posed, and with
+  // the scenery): thousands of actors far from the simulated vehicles cost its step nothing.
   int add_actor(const std::string& name, const ModelDesc& model);
   void set_actor_pose(int actor, const Eigen::Isometry3d& pose);
   // Its skeleton's name becomes "actor:NAME" (an actor taken over by another road user).
   void set_actor_name(int actor, const std::string& name);
   // In the world (colliding) or not.
   void set_actor_present(int actor, bool present);
+  // In the DART world after the last step (present and near a moving body).
+  bool actor_colliding(int actor) const { return actors_[actor].colliding; }
 
   // The skeleton of a world model (null if it has none) or of an actor.
   const dart::dynamics::Skeleton* model_skeleton(const std::string& model) const;
@@ -151,6 +158,7 @@ class PhysicsWorld {
   int64_t gate_every_ = 1;
 
   dart::simulation::WorldPtr world_;
+  std::shared_ptr<CappedBulletDetector> detector_;  // Bullet's, contacts capped (contact_cap.h)
   std::vector<JointRef> joints_;
   std::unordered_map<std::string, int> joint_by_name_;
   // A link: the body it is part of (links joined by a fixed joint share one) and its frame
@@ -164,8 +172,15 @@ class PhysicsWorld {
   struct Actor {
     dart::dynamics::SkeletonPtr skeleton;
     bool present = false;
+    bool colliding = false;  // in the DART world: present, and near a moving body
+    double radius = 0;       // a sphere about its origin holding its collision shapes
   };
   std::vector<Actor> actors_;
+  bool actors_posed_ = false;  // since the last gate_actors()
+  // The moving bodies' reach (reach_) until the next decision, for the gates.
+  void compute_reach();
+  // Enters the present actors near a moving body into the DART world, the others out.
+  void gate_actors();
   std::unordered_map<std::string, dart::dynamics::SkeletonPtr> skeleton_by_model_;
   std::vector<std::string> link_names_;
   std::unordered_map<std::string, int> link_by_name_;

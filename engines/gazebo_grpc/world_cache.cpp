@@ -20,7 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', 'B'};  // bump on format change
+constexpr char kMagic[8] = {'C', 'V', 'W', 'D', 'E', 'S', 'C', 'C'};  // bump on format change
 
 using cache_io::Reader;
 using cache_io::Writer;
@@ -75,6 +75,7 @@ void put(Writer& w, const LinkDesc& l) {
     w.iso(c.pose);
     put(w, c.shape);
     w.pod(c.mu);
+    w.pod<int32_t>(c.max_contacts);
   }
   w.size(l.visuals.size());
   for (const auto& v : l.visuals) {
@@ -114,6 +115,7 @@ void get(Reader& r, LinkDesc& l) {
     c.pose = r.iso();
     get(r, c.shape);
     c.mu = r.pod<double>();
+    c.max_contacts = r.pod<int32_t>();
   }
   l.visuals.resize(r.size());
   for (auto& v : l.visuals) {
@@ -346,6 +348,7 @@ std::string serialize_world(const WorldDesc& d) {
   w.str(d.name);
   w.v3(d.gravity);
   w.pod(d.max_step_size);
+  w.pod<int32_t>(d.max_contacts);
   for (double v : {d.geo.latitude_deg, d.geo.longitude_deg, d.geo.elevation_m, d.geo.heading_deg})
     w.pod(v);
   w.rgba(d.ambient);
@@ -377,6 +380,7 @@ WorldDesc deserialize_world(const std::string& bytes) {
   d.name = r.str();
   d.gravity = r.v3();
   d.max_step_size = r.pod<double>();
+  d.max_contacts = r.pod<int32_t>();
   for (double* v :
        {&d.geo.latitude_deg, &d.geo.longitude_deg, &d.geo.elevation_m, &d.geo.heading_deg})
     *v = r.pod<double>();

@@ -82,6 +82,15 @@ fs::path resolve_uri(const std::string& uri, const fs::path& base_dir,
   return fs::exists(path) ? fs::absolute(path) : fs::path{};
 }
 
+// A <max_contacts> value (0 and more; 0 keeps every contact, as no bound).
+int checked_max_contacts(const fs::path& file, int value, const std::string& where) {
+  if (value < 0) {
+    throw std::runtime_error(file.string() + ": " + where + ": <max_contacts> is " +
+                             std::to_string(value) + "; it must be 0 or more");
+  }
+  return value;
+}
+
 // Gazebo's stock script materials, for worlds that use them.
 bool script_colour(const std::string& name, Rgba* out) {
   static const std::map<std::string, Rgba> colours = {
@@ -252,6 +261,9 @@ class Loader {
       auto f = s ? s->FindElement("friction") : nullptr;
       auto o = f ? f->FindElement("ode") : nullptr;
       if (o && o->HasElement("mu")) cd.mu = o->Get<double>("mu");
+      if (e->HasElement("max_contacts"))
+        cd.max_contacts = checked_max_contacts(file_, e->Get<int>("max_contacts"),
+                                               where + " collision '" + col->Name() + "'");
     }
     return cd;
   }
@@ -440,7 +452,13 @@ WorldDesc load_world(const fs::path& file_in, const std::vector<ModelInsert>& ex
   world.name = w->Name();
   world.gravity = to_eigen(w->Gravity());
   world.geo = geo_origin(w, file);
-  if (w->PhysicsCount() > 0) world.max_step_size = w->PhysicsByIndex(0)->MaxStepSize();
+  if (w->PhysicsCount() > 0) {
+    const sdf::Physics* physics = w->PhysicsByIndex(0);
+    world.max_step_size = physics->MaxStepSize();
+    if (physics->Element() && physics->Element()->HasElement("max_contacts"))
+      world.max_contacts =
+          checked_max_contacts(file, physics->Element()->Get<int>("max_contacts"), "<physics>");
+  }
   if (const sdf::Scene* scene = w->Scene()) {
     world.ambient = to_rgba(scene->Ambient());
     world.background = to_rgba(scene->Background());

@@ -43,7 +43,8 @@ struct CollisionDesc {
   std::string name;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // in the link frame
   Shape shape;
-  double mu = 1.0;  // surface/friction/ode/mu
+  double mu = 1.0;       // surface/friction/ode/mu
+  int max_contacts = 0;  // <max_contacts> with any other shape (0: not set, no bound)
 };
 
 struct VisualDesc {
@@ -206,6 +207,7 @@ struct WorldDesc {
   std::string name;
   Eigen::Vector3d gravity{0, 0, -9.8};
   double max_step_size = 0.001;
+  int max_contacts = 0;  // <physics><max_contacts> per pair of shapes (0: not set, no bound)
   Rgba ambient{0.4f, 0.4f, 0.4f, 1}, background{0.7f, 0.7f, 0.7f, 1};
   bool shadows = true;  // <scene><shadows>
   bool world_plugin = false;

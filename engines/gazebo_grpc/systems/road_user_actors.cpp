@@ -36,22 +36,42 @@ void RoadUserActors::configure(const WorldContext& ctx, const nlohmann::json& co
   table_ = config.value("ActorModels", std::string());
 }
 
+// The batch for the next road users of datapack `dp_name`: a fresh one (its message kept from
+// earlier steps, cleared) unless the last one is that datapack's.
+RoadUserActors::Batch& RoadUserActors::next_batch(const std::string& dp_name) {
+  if (pending_ > 0 && batches_[pending_ - 1].dp_name == dp_name) return batches_[pending_ - 1];
+  if (pending_ == batches_.size()) batches_.emplace_back();
+  Batch& b = batches_[pending_++];
+  b.dp_name = dp_name;
+  b.users.Clear();
+  return b;
+}
+
 // A RoadUser / RoadUsers datapack (protobuf or JSON): its users wait for the next step.
 bool RoadUserActors::set_datapack(const datapack::View& dp) {
   const std::string& dp_name = dp.id().name();
   try {
     if (dp.is_json()) {
-      for (auto& u : road_users_from_json(datapack::read_json(dp)))
-        pending_.emplace_back(dp_name, std::move(u));
+      auto users = road_users_from_json(datapack::read_json(dp));
+      auto& batch = next_batch(dp_name).users;
+      for (auto& u : users) *batch.add_users() = std::move(u);
       return true;
     }
     if (dp.proto_type() == datapack::type_name<data::RoadUser>()) {
-      pending_.emplace_back(dp_name, datapack::read_proto<data::RoadUser>(dp));
+      datapack::read_proto(dp, next_batch(dp_name).users.add_users());
       return true;
     }
     if (dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
-      const auto users = datapack::read_proto<data::RoadUsers>(dp);  // (kept alive)
-      for (const auto& u : users.users()) pending_.emplace_back(dp_name, u);
+      // Parsed into a message of its own (a RoadUsers' other fields must not mix with a
+      // batch's), then its users moved over: no copy of a string.
+      Batch& b = next_batch(dp_name);
+      if (b.users.users_size() == 0) {
+        datapack::read_proto(dp, &b.users);
+      } else {
+        data::RoadUsers more;
+        datapack::read_proto(dp, &more);
+        for (auto& u : *more.mutable_users()) b.users.add_users()->Swap(&u);
+      }
       return true;
     }
   } catch (const std::exception& e) {
@@ -175,31 +195,36 @@ void RoadUserActors::set_present(Actor& a, bool present) {
   ctx_->cameras->set_actor_visible(a.camera, present);
 }
 
+// Poses road user u's actor, or removes it (absent).
+void RoadUserActors::pose_actor(const std::string& dp_name, const data::RoadUser& u, int64_t now) {
+  if (u.absent()) {
+    if (auto it = by_id_.find(u.id()); it != by_id_.end()) set_present(actors_[it->second], false);
+    return;
+  }
+  Actor& a = actor_for(dp_name, u);
+  double offset = u.length() > 0 ? u.length_offset() : a.length_offset;
+  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+  shift.translation().x() = offset;
+  a.pose = road_user_pose(u) * shift;
+  a.velocity = (u.vx() != 0 || u.vy() != 0) ? Eigen::Vector3d(u.vx(), u.vy(), 0)
+                                            : Eigen::Vector3d(u.speed() * std::cos(u.yaw()),
+                                                              u.speed() * std::sin(u.yaw()), 0);
+  a.last_seen_ns = now;
+  ctx_->physics->set_actor_pose(a.physics, a.pose);
+  ctx_->cameras->set_actor_pose(a.camera, a.pose);
+  if (a.walk_poses > 0) ctx_->cameras->set_actor_shown(a.camera, walker_pose(a, u));
+  set_present(a, true);
+}
+
 // Poses the actors from the road users received since the last step; removes those gone
 // (absent, or not heard of for ActorTimeout).
 void RoadUserActors::before_step() {
   const int64_t now = ctx_->time_ns;
-  for (const auto& [dp_name, u] : pending_) {
-    if (u.absent()) {
-      if (auto it = by_id_.find(u.id()); it != by_id_.end())
-        set_present(actors_[it->second], false);
-      continue;
-    }
-    Actor& a = actor_for(dp_name, u);
-    double offset = u.length() > 0 ? u.length_offset() : a.length_offset;
-    Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
-    shift.translation().x() = offset;
-    a.pose = road_user_pose(u) * shift;
-    a.velocity = (u.vx() != 0 || u.vy() != 0) ? Eigen::Vector3d(u.vx(), u.vy(), 0)
-                                              : Eigen::Vector3d(u.speed() * std::cos(u.yaw()),
-                                                                u.speed() * std::sin(u.yaw()), 0);
-    a.last_seen_ns = now;
-    ctx_->physics->set_actor_pose(a.physics, a.pose);
-    ctx_->cameras->set_actor_pose(a.camera, a.pose);
-    if (a.walk_poses > 0) ctx_->cameras->set_actor_shown(a.camera, walker_pose(a, u));
-    set_present(a, true);
+  for (size_t k = 0; k < pending_; ++k) {
+    const std::string& dp_name = batches_[k].dp_name;
+    for (const data::RoadUser& u : batches_[k].users.users()) pose_actor(dp_name, u, now);
   }
-  pending_.clear();
+  pending_ = 0;
   if (timeout_s_ > 0) {
     const auto timeout_ns = static_cast<int64_t>(timeout_s_ * 1e9);
     for (auto& a : actors_)
@@ -207,32 +232,60 @@ void RoadUserActors::before_step() {
   }
 }
 
-// Actors do not collide with each other in the physics (they are immobile there): their
-// boxes are compared here, once per engine step.
-void RoadUserActors::after_step() {
-  const int64_t now = ctx_->time_ns;
+void RoadUserActors::candidate_pairs() {
+  spans_.clear();
+  pairs_.clear();
   for (size_t i = 0; i < actors_.size(); ++i) {
     const Actor& a = actors_[i];
     if (!a.present) continue;
-    for (size_t j = i + 1; j < actors_.size(); ++j) {
-      const Actor& b = actors_[j];
-      if (!b.present || !boxes_overlap(a, b)) continue;
-      if (a.created_ns == now && b.created_ns == now) {
-        // Both appear in this step, on top of each other: a placement error, not a crash.
-        const Eigen::Vector3d p = a.pose.translation();
-        char where[64];
-        std::snprintf(where, sizeof where, "(%.2f, %.2f)", p.x(), p.y());
-        throw std::runtime_error(
-            "engine '" + ctx_->engine + "': road users '" + a.id + "' and '" + b.id +
-            "' are placed on the same spot: their boxes overlap where they first appear, at " +
-            where + ", t = " + std::to_string(ctx_->time_s()) +
-            " s. Give one of them another start (its engine's Route, StartS or Position)");
-      }
-      if (contacts_)
-        contacts_->note_contact(ctx_->physics->actor_skeleton(a.physics),
-                                ctx_->physics->actor_skeleton(b.physics));
+    // boxes_overlap's bounding circle: its centre and radius (a little more, for rounding).
+    const double x = a.pose.translation().x() + a.pose.linear()(0, 2) * a.half.z();
+    const double y = a.pose.translation().y() + a.pose.linear()(1, 2) * a.half.z();
+    const double r = a.half.head<2>().norm() * (1 + 1e-9) + 1e-9;
+    spans_.push_back({x - r, x + r, y, r, i});
+  }
+  std::sort(spans_.begin(), spans_.end(), [](const Span& p, const Span& q) {
+    return p.lo != q.lo ? p.lo < q.lo : p.index < q.index;
+  });
+  for (size_t k = 0; k < spans_.size(); ++k) {
+    const Span& p = spans_[k];
+    for (size_t m = k + 1; m < spans_.size() && spans_[m].lo <= p.hi; ++m) {
+      const Span& q = spans_[m];
+      if (std::abs(q.y - p.y) > q.r + p.r) continue;
+      pairs_.emplace_back(std::min(p.index, q.index), std::max(p.index, q.index));
     }
   }
+  std::sort(pairs_.begin(), pairs_.end());  // (few: the circles overlap in x and y)
+}
+
+// Actors do not collide with each other in the physics (they are immobile there): their
+// boxes are compared here, once per engine step, those that may meet (candidate_pairs) in
+// the order of a loop over every pair.
+void RoadUserActors::after_step() {
+  const int64_t now = ctx_->time_ns;
+  candidate_pairs();
+  for (const auto& [i, j] : pairs_) {
+    const Actor& a = actors_[i];
+    const Actor& b = actors_[j];
+    if (boxes_overlap(a, b)) note_overlap(a, b, now);
+  }
+}
+
+void RoadUserActors::note_overlap(const Actor& a, const Actor& b, int64_t now) {
+  if (a.created_ns == now && b.created_ns == now) {
+    // Both appear in this step, on top of each other: a placement error, not a crash.
+    const Eigen::Vector3d p = a.pose.translation();
+    char where[64];
+    std::snprintf(where, sizeof where, "(%.2f, %.2f)", p.x(), p.y());
+    throw std::runtime_error(
+        "engine '" + ctx_->engine + "': road users '" + a.id + "' and '" + b.id +
+        "' are placed on the same spot: their boxes overlap where they first appear, at " + where +
+        ", t = " + std::to_string(ctx_->time_s()) +
+        " s. Give one of them another start (its engine's Route, StartS or Position)");
+  }
+  if (contacts_)
+    contacts_->note_contact(ctx_->physics->actor_skeleton(a.physics),
+                            ctx_->physics->actor_skeleton(b.physics));
 }
 
 // Separating axes of two boxes yawed about z, plus their heights.
@@ -260,7 +313,7 @@ void RoadUserActors::reset() {
   actors_.clear();
   by_id_.clear();
   free_.clear();
-  pending_.clear();
+  pending_ = 0;
 }
 
 }  // namespace convoy::world

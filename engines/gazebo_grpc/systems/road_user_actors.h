@@ -11,7 +11,10 @@
 // every engine step (before_step) from its latest state, removed (hidden, out of the physics)
 // when a state says `absent` or none has come for ActorTimeout, back when its id is sent
 // again. After every engine step (after_step) the actors' boxes are compared (they do not
-// collide with each other in the physics) and overlaps reported to the Contacts system.
+// collide with each other in the physics) and overlaps reported to the Contacts system: a
+// sweep along x finds the pairs whose bounding circles can meet, so thousands of actors cost
+// about N log N, not N^2; the pairs are then taken in the order of their indices, as a loop
+// over every pair would (docs/road_users.md, Pooled road users).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -64,17 +67,38 @@ class RoadUserActors final : public WorldSystem {
 
  private:
   Actor& actor_for(const std::string& dp_name, const data::RoadUser& u);
+  void pose_actor(const std::string& dp_name, const data::RoadUser& u, int64_t now);
   Actor& add_actor(const std::string& dp_name, const data::RoadUser& u);
   Actor* reuse_actor(const std::string& shape, const data::RoadUser& u);
   void set_present(Actor& a, bool present);
   static bool boxes_overlap(const Actor& a, const Actor& b);
+  void note_overlap(const Actor& a, const Actor& b, int64_t now);
+  // The pairs of present actors (i < j, in order) whose bounding circles overlap in x and y.
+  void candidate_pairs();
+
+  // The road users received since the last step, by datapack in the order they came: a
+  // RoadUsers message kept from step to step (its users' memory reused).
+  struct Batch {
+    std::string dp_name;
+    data::RoadUsers users;
+  };
+  Batch& next_batch(const std::string& dp_name);
+  // after_step's, reused: the actors' bounding circles along x, and the candidate pairs.
+  struct Span {
+    double lo, hi;  // along x
+    double y, r;    // the centre's y, the circle's radius
+    size_t index;
+  };
 
   const WorldContext* ctx_ = nullptr;
   Contacts* contacts_ = nullptr;  // null: no contacts system
   double timeout_s_ = 1.0;
   std::string table_;
-  std::unique_ptr<ActorLibrary> library_;                        // loaded with the first actor
-  std::vector<std::pair<std::string, data::RoadUser>> pending_;  // datapack name, state
+  std::unique_ptr<ActorLibrary> library_;  // loaded with the first actor
+  std::vector<Batch> batches_;             // batches_[0, pending_) hold this step's road users
+  size_t pending_ = 0;
+  std::vector<Span> spans_;
+  std::vector<std::pair<size_t, size_t>> pairs_;
   std::deque<Actor> actors_;  // a deque: the contacts system keeps pointers to velocities
   std::unordered_map<std::string, size_t> by_id_;
   std::unordered_map<std::string, std::deque<size_t>> free_;  // by shape, oldest removed first
