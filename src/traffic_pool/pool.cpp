@@ -71,6 +71,7 @@ void Pool::build_grid() {
   cell_head_.assign(static_cast<size_t>(gx_) * gy_, kNone);
   cell_next_.assign(grid_end_, kNone);
   for (uint32_t i = 0; i < grid_end_; ++i) {
+    if (i < n_ && lane_[i] == kNone) continue;  // absent (a flow's vehicle not in yet or gone)
     const int cx = std::clamp(static_cast<int>((x_[i] - net_.min_x + 20) / cell_), 0, gx_ - 1);
     const int cy = std::clamp(static_cast<int>((y_[i] - net_.min_y + 20) / cell_), 0, gy_ - 1);
     const size_t c = static_cast<size_t>(cy) * gx_ + cx;
@@ -299,12 +300,16 @@ void Pool::step(double dt) {
   build_grid();
   changed_into_.assign(net_.lanes().size(), 0);
   const uint64_t tick = static_cast<uint64_t>(std::llround(t_ / dt));
-  for (size_t i = 0; i < size(); ++i) acc_[i] = accel_of(i);
   for (size_t i = 0; i < size(); ++i) {
-    if ((tick + i) % kMobilEverySteps == 0) consider_lane_change(i);
+    if (present(i)) acc_[i] = accel_of(i);
   }
   for (size_t i = 0; i < size(); ++i) {
+    if (present(i) && (tick + i) % kMobilEverySteps == 0) consider_lane_change(i);
+  }
+  for (size_t i = 0; i < size(); ++i) {
+    if (!present(i)) continue;
     advance(i, dt);
+    if (!present(i)) continue;  // it left the network
     update_pose(i);
   }
   t_ += dt;

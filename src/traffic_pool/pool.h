@@ -49,6 +49,7 @@ struct VehicleSpec {
   double length = 4.5, width = 1.8;
   uint64_t seed = 0;           // its choices at forks
   uint32_t pool_lane = kNone;  // spawned: the PoolNetwork lane itself (road/lane/s are shown)
+  bool absent = false;         // waits outside the network until Pool::enter (a flow's vehicle)
 };
 
 // A disc kept clear of spawned vehicles (another road user's start, e.g. the ego's).
@@ -98,6 +99,15 @@ class Pool {
   uint32_t lane(size_t i) const { return lane_[i]; }
   double s(size_t i) const { return s_[i]; }
   const PoolStats& stats() const { return stats_; }
+  // Flows (a demand given from outside): a vehicle at a dead end leaves the network and stays
+  // absent, instead of starting again at an entry.
+  void set_leave_at_exits(bool on) { leave_at_exits_ = on; }
+  bool present(size_t i) const { return lane_[i] != kNone; }
+  // Puts absent vehicle i, standing, at the start of pool lane `lane` (outside junctions), on
+  // the route to its spec's `to` when it has one. False, changing nothing, while that start is
+  // not free (as for a respawn) or another vehicle entered the lane this step. Throws PoolError
+  // when it is present, the lane is in a junction, or its `to` has no path from there.
+  bool enter(size_t i, uint32_t lane);
   // Pairs of vehicles whose boxes overlap now (found through the grid).
   std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
   // Pairs (pooled vehicle, external road user) whose boxes overlap now.
@@ -118,6 +128,9 @@ class Pool {
   void advance(size_t i, double dt);
   uint32_t choose(size_t i, uint32_t lane);
   void respawn(size_t i);
+  bool start_free(size_t i, uint32_t lane, double s) const;
+  void start_at(size_t i, uint32_t lane, double s);
+  void plan_route(size_t i, uint32_t lane, double s);
   void update_pose(size_t i);
   void place_externals();
   void index_lane_points();
@@ -154,6 +167,7 @@ class Pool {
   int gx_ = 1, gy_ = 1;
   std::vector<uint32_t> cell_head_, cell_next_;
   PoolStats stats_;
+  bool leave_at_exits_ = false;
 };
 
 template <class F>

@@ -67,6 +67,8 @@ Pool::Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m
   }
   validate();
   for (size_t i = 0; i < n; ++i) place(i);
+  changed_into_.assign(net_.lanes().size(), 0);
+  index_lanes();
   build_grid();
   const auto o = overlaps();
   if (!o.empty()) {
@@ -102,6 +104,7 @@ void Pool::validate() {
 // the lanes that follow while s is beyond a lane's end, and plans its route.
 void Pool::place(size_t i) {
   const VehicleSpec& v = specs_[i];
+  if (v.absent) return;  // until enter()
   const opendrive::LaneGraph& g = net_.graph();
   opendrive::LaneIndex gl = opendrive::kNoLane;
   try {
@@ -133,6 +136,17 @@ void Pool::place(size_t i) {
   v_[i] = std::max(0.0, v.speed);
   rng_[i] = mix(v.seed);
   mobil_[i] = v.policy == "idm_mobil" && !v.to;
+  plan_route(i, l, s);
+  next_[i] = choose(i, l);
+  next2_[i] = choose(i, next_[i]);
+  update_pose(i);
+}
+
+// Its route (lanes still to drive) from s on pool lane l to its spec's destination, if any.
+void Pool::plan_route(size_t i, uint32_t l, double s) {
+  const VehicleSpec& v = specs_[i];
+  const opendrive::LaneGraph& g = net_.graph();
+  route_[i].clear();
   if (v.to) {
     opendrive::LaneIndex to = opendrive::kNoLane;
     try {
@@ -150,8 +164,8 @@ void Pool::place(size_t i) {
                   opt);
     }
     if (!r) {
-      throw PoolError(who(v) + ": no path from road '" + v.road + "' lane " +
-                      std::to_string(v.lane) + " to road '" + v.to->first + "' lane " +
+      throw PoolError(who(v) + ": no path from road '" + pl.road_id + "' lane " +
+                      std::to_string(pl.lane_id) + " to road '" + v.to->first + "' lane " +
                       std::to_string(v.to->second));
     }
     for (size_t k = r->segments.size(); k-- > 1;) {
@@ -159,48 +173,63 @@ void Pool::place(size_t i) {
       if (p != kNone) route_[i].push_back(p);
     }
   }
-  next_[i] = choose(i, l);
-  next2_[i] = choose(i, next_[i]);
-  update_pose(i);
+}
+
+// Whether vehicle i could start, standing, at s on lane l: no vehicle ahead on the lane within
+// s0 + 5 m, nobody's box within 2 * (s0 + 1) m ahead or behind, or 0.3 m beside (a vehicle on
+// the next lane, or queued on the lane out of the map beside an entry, does not block it), and
+// nobody entered the lane this step (the lanes' lists are the step's).
+bool Pool::start_free(size_t i, uint32_t l, double s) const {
+  const VehicleSpec& v = specs_[i];
+  const PoolLane& lane = net_.lane(l);
+  if (lane.junction >= 0 || lane.length < 2 * v.length + 20 || changed_into_[l]) return false;
+  bool free = true;
+  if (lane_begin_[l + 1] > lane_begin_[l]) {
+    const uint32_t j = order_[lane_begin_[l]];
+    free = s_[j] - specs_[j].length > s + v.idm.s0 + 5;
+  }
+  const opendrive::Pose2 p = lane.at(s - 0.5 * v.length);
+  const double clear_l = v.length + 4 * (v.idm.s0 + 1), clear_w = v.width + 0.6;
+  for_near(p.x, p.y, 0.5 * clear_l + 8, [&](uint32_t k) {
+    if (k != i && boxes_overlap(p.x, p.y, p.heading, clear_l, clear_w, x_[k], y_[k], yaw_[k],
+                                specs_[k].length, specs_[k].width)) {
+      free = false;
+    }
+  });
+  return free;
+}
+
+void Pool::start_at(size_t i, uint32_t l, double s) {
+  if (claim_[i] != kNone) --claims_[claim_[i]];
+  claim_[i] = kNone;
+  changed_into_[l] = 1;
+  lane_[i] = l;
+  prev_[i] = kNone;
+  s_[i] = s;
+  v_[i] = 0;
 }
 
 // A vehicle at a dead end (it leaves the map) starts again, standing, at the start of a lane
 // drawn by its seed whose first metres are free: one of the map's entries (lanes no lane leads
 // into) when it has some, else any lane; it waits at the dead end while none of 16 draws is.
+// With leave_at_exits it leaves the network instead (absent).
 void Pool::respawn(size_t i) {
   const VehicleSpec& v = specs_[i];
+  if (leave_at_exits_) {
+    if (claim_[i] != kNone) --claims_[claim_[i]];
+    claim_[i] = kNone;
+    lane_[i] = prev_[i] = next_[i] = next2_[i] = kNone;
+    v_[i] = 0;
+    return;
+  }
   const size_t nl = entries_.empty() ? net_.lanes().size() : entries_.size();
   for (int attempt = 0; attempt < 16; ++attempt) {
     const size_t draw = mix(rng_[i] += 0x51ed27) % nl;
     const uint32_t l = entries_.empty() ? static_cast<uint32_t>(draw) : entries_[draw];
-    const PoolLane& lane = net_.lane(l);
-    // One entry into a lane per step (lane changes and respawns): the lists are the step's.
-    if (lane.junction >= 0 || lane.length < 2 * v.length + 20 || changed_into_[l]) continue;
     const double s = v.length + 1;
-    bool free = true;
-    if (lane_begin_[l + 1] > lane_begin_[l]) {
-      const uint32_t j = order_[lane_begin_[l]];
-      free = s_[j] - specs_[j].length > s + v.idm.s0 + 5;
-    }
-    // Nobody's box within 2 * (s0 + 1) m ahead or behind, or 0.3 m beside (a vehicle on the
-    // next lane, or queued on the lane out of the map beside this entry, does not block it).
-    const opendrive::Pose2 p = lane.at(s - 0.5 * v.length);
-    const double clear_l = v.length + 4 * (v.idm.s0 + 1), clear_w = v.width + 0.6;
-    for_near(p.x, p.y, 0.5 * clear_l + 8, [&](uint32_t k) {
-      if (k != i && boxes_overlap(p.x, p.y, p.heading, clear_l, clear_w, x_[k], y_[k], yaw_[k],
-                                  specs_[k].length, specs_[k].width)) {
-        free = false;
-      }
-    });
-    if (!free) continue;
-    if (claim_[i] != kNone) --claims_[claim_[i]];
-    claim_[i] = kNone;
+    if (!start_free(i, l, s)) continue;
+    start_at(i, l, s);
     route_[i].clear();
-    changed_into_[l] = 1;
-    lane_[i] = l;
-    prev_[i] = kNone;
-    s_[i] = s;
-    v_[i] = 0;
     next_[i] = choose(i, l);
     next2_[i] = choose(i, next_[i]);
     ++stats_.respawns;
@@ -210,9 +239,28 @@ void Pool::respawn(size_t i) {
   v_[i] = 0;
 }
 
+bool Pool::enter(size_t i, uint32_t l) {
+  const VehicleSpec& v = specs_[i];
+  if (present(i)) throw PoolError(who(v) + ": enters the network while on it");
+  if (l >= net_.lanes().size() || net_.lane(l).junction >= 0) {
+    throw PoolError(who(v) + ": enters on a lane that is not a driving lane outside junctions");
+  }
+  const double s = v.length + 1;
+  if (!start_free(i, l, s)) return false;
+  rng_[i] = mix(v.seed);
+  mobil_[i] = v.policy == "idm_mobil" && !v.to;
+  plan_route(i, l, s);  // throws (before the vehicle is placed) when `to` has no path
+  start_at(i, l, s);
+  next_[i] = choose(i, l);
+  next2_[i] = choose(i, next_[i]);
+  update_pose(i);
+  return true;
+}
+
 std::vector<std::pair<uint32_t, uint32_t>> Pool::overlaps() const {
   std::vector<std::pair<uint32_t, uint32_t>> out;
   for (uint32_t i = 0; i < size(); ++i) {
+    if (!present(i)) continue;
     const VehicleSpec& a = specs_[i];
     for_near(x_[i], y_[i], 0.5 * a.length + 8, [&](uint32_t k) {
       if (k <= i || k >= n_) return;
