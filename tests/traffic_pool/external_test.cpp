@@ -7,31 +7,13 @@
 
 #include <cmath>
 
+#include "grid_map.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
 #include "traffic_pool/pool.h"
 
 namespace convoy::traffic_pool {
 namespace {
-
-struct Map {
-  opendrive::Network net = opendrive::load(CONVOY_POOL_GRID_XODR);
-  opendrive::LaneGraph graph{net};
-  PoolNetwork pool{graph};
-};
-const Map& map() {
-  static const Map* m = new Map();
-  return *m;
-}
-
-VehicleSpec at(const std::string& id, const PoolLane& lane, double s) {
-  VehicleSpec v;
-  v.id = id;
-  v.road = lane.road_id;
-  v.lane = lane.lane_id;
-  v.s = s;
-  return v;
-}
 
 // An external car whose box centre is `s` m along `lane`, heading along it.
 ExternalUser car_on(const std::string& id, const PoolLane& lane, double s, double speed = 0) {

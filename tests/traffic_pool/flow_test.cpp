@@ -5,6 +5,7 @@
 
 #include <set>
 
+#include "grid_map.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
 #include "traffic_pool/pool.h"
@@ -12,13 +13,8 @@
 namespace convoy::traffic_pool {
 namespace {
 
-struct City {
-  opendrive::Network net = opendrive::load(CONVOY_CITY_XODR);
-  opendrive::LaneGraph graph{net};
-  PoolNetwork pool{graph};
-};
-const City& city() {
-  static const City* c = new City();
+const Map& city() {
+  static const Map* c = new Map(CONVOY_CITY_XODR);
   return *c;
 }
 

@@ -10,21 +10,12 @@
 #include <memory>
 #include <set>
 
+#include "grid_map.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
 
 namespace convoy::traffic_pool {
 namespace {
-
-struct Map {
-  opendrive::Network net = opendrive::load(CONVOY_POOL_GRID_XODR);
-  opendrive::LaneGraph graph{net};
-  PoolNetwork pool{graph};
-};
-const Map& map() {
-  static const Map* m = new Map();
-  return *m;
-}
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -63,15 +54,6 @@ TEST(PoolNetwork, LightGroupsTakeTurns) {
   EXPECT_EQ(c.state(1, 0, 0), road_users::Light::kGreen);
   EXPECT_EQ(c.state(c.green_s + 1, 0, 0), road_users::Light::kYellow);
   EXPECT_EQ(c.state(1, 0, 1), road_users::Light::kRed);
-}
-
-VehicleSpec at(const std::string& id, const PoolLane& lane, double s) {
-  VehicleSpec v;
-  v.id = id;
-  v.road = lane.road_id;
-  v.lane = lane.lane_id;
-  v.s = s;
-  return v;
 }
 
 const PoolLane& long_lane() {
