@@ -3,11 +3,13 @@
 sensor perception (stops without an object in the lane): target 0").
 
   /usr/bin/python3 benchmarks/phantom/phantom_bench.py [--perception sensors] [--scenario X.xosc]
-      [--world WORLD.sdf] [--build build] [--out DIR] [--run-dir EXISTING_RUN]
+      [--scenery | --world WORLD.sdf] [--build build] [--out DIR] [--run-dir EXISTING_RUN]
 
 Runs `convoy run --scenario X --perception P` (default: parkring_lap.xosc here, the ego alone
 on the Parkring lap, 950 m of its lane's 1001: a route ending on the straight behind
-the start would end the run at once; 140 s at most) and reads the run's planner result and tracks.csv. A
+the start would end the run at once; 140 s at most; the scenario's default world is the road
+only, --scenery runs it in the Parkring's scenery: experiments/autonomous_driving/
+parkring_world.sdf without its smart_car, written into the run folder) and reads the run's planner result and tracks.csv. A
 braking episode is a stretch of the planner's trace (10 Hz) in which it brakes for an object:
 mode "aeb", or a lead object (not a traffic light's stop line) while the ego is below 0.5 m/s
 after having driven; rows less than 2 s apart are one episode. An episode is a phantom when no
@@ -28,6 +30,24 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 MERGE_S = 2.0
 STOPPED_MPS = 0.5
 LANE_HALF_M = 2.0
+SCENERY = os.path.join(REPO, "experiments", "autonomous_driving", "parkring_world.sdf")
+
+
+def scenery_world(out_dir, src=SCENERY):
+    """Writes src without its `model://smart_car` include (the scenario inserts the ego) as
+    out_dir/parkring_world_no_ego.sdf; returns its path."""
+    text = open(src).read()
+    start = text.find("<uri>model://smart_car</uri>")
+    if start < 0:
+        raise ValueError("%s: no model://smart_car include to remove" % src)
+    a = text.rfind("<include>", 0, start)
+    b = text.find("</include>", start)
+    if a < 0 or b < 0:
+        raise ValueError("%s: the smart_car include is not an <include> element" % src)
+    path = os.path.join(out_dir, "parkring_world_no_ego.sdf")
+    with open(path, "w") as f:
+        f.write(text[:a] + text[b + len("</include>"):])
+    return path
 
 
 def episodes(trace):
@@ -82,6 +102,8 @@ def main():
     ap.add_argument("--scenario", default=os.path.join(HERE, "parkring_lap.xosc"))
     ap.add_argument("--perception", default="sensors", choices=["ground_truth", "sensors"])
     ap.add_argument("--world", default=None, help="the world SDF without the ego (convoy run --world)")
+    ap.add_argument("--scenery", action="store_true",
+                    help="the Parkring's scenery world (parkring_world.sdf without its ego)")
     ap.add_argument("--build", default=os.path.join(REPO, "build"))
     ap.add_argument("--out", default=None, help="the run folder (default: a new temporary one)")
     ap.add_argument("--run-dir", default=None, help="read this existing run instead of running")
@@ -91,8 +113,10 @@ def main():
         run = a.out or tempfile.mkdtemp(prefix="convoy-phantom-")
         cmd = [os.path.join(a.build, "bin", "convoy"), "run", "--scenario", a.scenario,
                "--perception", a.perception, "--run-dir", run, "--quiet"]
-        if a.world:
-            cmd += ["--world", a.world]
+        os.makedirs(run, exist_ok=True)
+        world = scenery_world(run) if a.scenery and not a.world else a.world
+        if world:
+            cmd += ["--world", world]
         rc = subprocess.call(cmd)
         if rc != 0:
             print("phantom_bench: %s exited %d (run folder %s)" % (" ".join(cmd), rc, run), file=sys.stderr)

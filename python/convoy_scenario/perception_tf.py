@@ -58,7 +58,8 @@ YELLOW_STOP_DECEL = 3.0  # m/s^2, as traffic_tf.py
 LABELS = {"ground_truth": SOURCE_LABELS["ground_truth"], "sensors": SOURCE_LABELS["sensors"]}
 _state = {"written": False, "tracker": Tracker(), "frame": None, "objects": [],
           "ranged": {"lidar": 0, "depth": 0, "rejected": 0, "lidar_only": 0}, "boxes": 0, "last_write": 0.0,
-          "surround": None, "scan_t": None, "surround_count": 0,
+          "surround": None, "scan_t": None, "surround_count": 0, "confirmer": None,
+          "held": {"scenery": 0, "unconfirmed": 0}, "poses": [],
           "dump": int(os.environ.get("CONVOY_PERCEPTION_DUMP", "0") or 0),
           "dump_from": float(os.environ.get("CONVOY_PERCEPTION_DUMP_FROM", "0") or 0)}
 
@@ -67,6 +68,7 @@ if MODE == "sensors":
     from convoy_sensors.point_cloud import points  # noqa: E402
     from convoy_traffic.fusion import Rig, accepted, fuse, lidar_obstacles  # noqa: E402
     from convoy_sensors.surround import Surround  # noqa: E402
+    from convoy_sensors.confirm import Confirmer  # noqa: E402
     RIG = Rig.smart_car_lidar()
     STOP_LINES = []
     if LIGHTS is not None:
@@ -103,7 +105,35 @@ def _summary():
         fields["perception_rejected_by_lidar"] = _state["ranged"]["rejected"]
         fields["perception_lidar_only"] = _state["ranged"]["lidar_only"]
         fields["perception_lidar_surround"] = _state["surround_count"]
+        fields["perception_dropped_on_scenery"] = _state["held"]["scenery"]
+        fields["perception_unconfirmed"] = _state["held"]["unconfirmed"]
     update_summary(fields)
+
+
+POSE_HISTORY_S = 1.0  # s of the ego's poses kept, to place a camera frame or a scan by its own time
+
+
+def _remember(ego_msg, e):
+    """Keeps the ego's pose by its state's simulation time (RoadUser.time_ns)."""
+    raw = ego_msg.get("time_ns", 0) if isinstance(ego_msg, dict) else getattr(ego_msg, "time_ns", 0)
+    t = float(raw or 0) * 1e-9
+    poses = _state["poses"]
+    if t <= 0.0:
+        return   # no time on the state: the objects stay in the ego's frame now
+    if not poses or t > poses[-1][0]:
+        poses.append((t, e["x"], e["y"], e["yaw"]))
+    while poses and poses[0][0] < t - POSE_HISTORY_S:
+        poses.pop(0)
+
+
+def pose_at(e, t):
+    """The ego `e` at its pose of time t (s): the kept pose nearest in time (a camera frame or a
+    scan is older than the ego's state; on a bend the ego has turned since, and a standing thing
+    seen then would seem to slide sideways)."""
+    if not _state["poses"]:
+        return e
+    tp, x, y, yaw = min(_state["poses"], key=lambda p: abs(p[0] - t))
+    return dict(e, x=x, y=y, yaw=yaw)
 
 
 def _scan_surround(e, scan):
@@ -114,13 +144,15 @@ def _scan_surround(e, scan):
     if _state["surround"] is None:
         _state["surround"] = Surround(RIG, e["length"], e["width"], e["length_offset"])
     p = points(scan)
-    _state["surround"].scan(np.stack([p["x"], p["y"], p["z"]], axis=1), p["flags"],
-                            scan.data.time_ns * 1e-9, e)
+    t = scan.data.time_ns * 1e-9
+    _state["surround"].scan(np.stack([p["x"], p["y"], p["z"]], axis=1), p["flags"], t,
+                            pose_at(e, t), intensity=p["intensity"])
     _state["surround_count"] += len(_state["surround"].objects(e, _state["objects"]))
 
 
 def _sensors(ego, detections, scan, depth, lights):
     e = ego_state(ego.data)
+    _remember(ego.data, e)
     _scan_surround(e, scan)
     det = None if detections is None or detections.isEmpty() else detections.data
     if det is not None and "detections" in det and det.get("frame") != _state["frame"]:
@@ -139,15 +171,14 @@ def _sensors(ego, detections, scan, depth, lights):
         _state["boxes"] += len(boxes)
         for o in objs:
             _state["ranged"][o["ranged_by"]] += 1
-        _state["objects"] = _state["tracker"].update(accepted(objs), det.get("time_ns", 0) * 1e-9,
-                                                     e["speed"])
         t = det.get("time_ns", 0) * 1e-9
+        _state["objects"] = _confirmed(_state["tracker"].update(accepted(objs), t, e["speed"]), t, e)
         if t - _state["last_write"] >= 1.0:
             _state["last_write"] = t
             _summary()
         if _state["dump"] > 0 and t >= _state["dump_from"]:
             _state["dump"] -= 1
-            _dump(boxes, scan, objs)
+            _dump(boxes, scan, objs, e, t)
     objects = list(_state["objects"])
     if _state["surround"] is not None:
         objects += _state["surround"].objects(e, objects)
@@ -158,12 +189,37 @@ def _sensors(ego, detections, scan, depth, lights):
     return [JsonDataPack("planner_input", "planner", {"source": "sensors", "ego": e, "objects": objects})]
 
 
-def _dump(boxes, scan, objs):
+def _instance_classes(scan):
+    """Ground truth, for the debugging dump only: {instance id: class} of the scan's points."""
+    from convoy_sensors.point_cloud import instances
+    if scan is None or scan.isEmpty():
+        return {}
+    return {str(k): cls for k, (_, cls) in instances(scan).items()}
+
+
+def _confirmed(objects, t, e):
+    """The tracked camera and LiDAR-only objects confirmed by the LiDAR's clusters or over
+    frames (convoy_sensors.confirm); the others counted."""
+    if _state["confirmer"] is None:
+        _state["confirmer"] = Confirmer()
+    e = pose_at(e, t)   # the camera frame's: the objects are in the ego's frame then
+    boxes = _state["surround"].boxes_now(e) if _state["surround"] is not None else []
+    out = _state["confirmer"].update(objects, t, e, boxes)
+    for reason in _state["confirmer"].last.values():
+        if reason in _state["held"]:
+            _state["held"][reason] += 1
+    return out
+
+
+def _dump(boxes, scan, objs, e, t):
     import json
     p = points(scan) if scan is not None and not scan.isEmpty() else None
     path = os.path.join(os.environ.get("CONVOY_RUN_DIR", "."), "perception_%s.npz" % _state["frame"])
-    np.savez(path, boxes=json.dumps(boxes), objects=json.dumps(objs),
-             **({k: np.array(p[k]) for k in ("x", "y", "z", "label", "instance", "flags")} if p is not None else {}))
+    fields = ("x", "y", "z", "intensity", "label", "instance", "flags")
+    sur = _state["surround"].objects(e, _state["objects"]) if _state["surround"] is not None else []
+    np.savez(path, boxes=json.dumps(boxes), objects=json.dumps(objs), tracked=json.dumps(_state["objects"]),
+             surround=json.dumps(sur), ego=json.dumps(e), t=t, classes=json.dumps(_instance_classes(scan)),
+             **({k: np.array(p[k]) for k in fields} if p is not None else {}))
 
 
 def _perception(ego, detections=None, scan=None, depth=None, lights=None):

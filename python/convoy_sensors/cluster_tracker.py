@@ -12,17 +12,25 @@ MAX_SPEED. A track is confirmed after
 `confirm` hits; one not matched coasts at its velocity for `coast` scans, then is dropped.
 Once a vehicle (two hits as "car" or "truck"), a track stays one: the box of a car changes
 shape as it drives past (its front, then its side), it stays a car. Track ids are "lidar<n>",
-n counting up from 0."""
+n counting up from 0.
+
+The velocity reported (confirmed()) is, per world axis, the filtered one where it agrees in
+sign with the robust rate of the track's last `history` centres (Theil-Sen,
+convoy_sensors.confirm), the smaller in magnitude, else 0: a standing hedge or house corner
+whose cluster grows and shrinks as the ego drives by jumps, it does not move."""
 
 import math
+
+from convoy_sensors.confirm import agreed, theil_sen
 
 MAX_SPEED = 40.0  # m/s
 VEHICLES = ("car", "truck")
 
 
 class ClusterTracker:
-    def __init__(self, gate=3.0, alpha=0.4, confirm=2, coast=3):
+    def __init__(self, gate=3.0, alpha=0.4, confirm=2, coast=3, history=10):
         self.gate, self.alpha, self.confirm, self.coast = float(gate), float(alpha), int(confirm), int(coast)
+        self.history = int(history)
         self.tracks = []   # dicts: id, x, y, vx, vy, t, hits, misses, class, vehicle_hits, box
         self.next_id = 0
 
@@ -68,7 +76,8 @@ class ClusterTracker:
     def _new(self, box, cent, t):
         tr = {"id": "lidar%d" % self.next_id, "x": cent[0], "y": cent[1], "vx": 0.0, "vy": 0.0,
               "t": t, "hits": 1, "misses": 0, "class": box["class"], "box": box,
-              "vehicle_hits": 1 if box["class"] in VEHICLES else 0, "moved": False}
+              "vehicle_hits": 1 if box["class"] in VEHICLES else 0, "moved": False,
+              "hist": [(t, cent[0], cent[1])]}
         self.next_id += 1
         return tr
 
@@ -83,6 +92,7 @@ class ClusterTracker:
             tr["vy"] += self.alpha * (vy - tr["vy"])
             tr["moved"] = True
         tr["x"], tr["y"], tr["t"] = cent[0], cent[1], t
+        tr["hist"] = (tr["hist"] + [(t, cent[0], cent[1])])[-self.history:]
         tr["hits"] += 1
         tr["misses"] = 0
         tr["box"] = box
@@ -100,9 +110,13 @@ class ClusterTracker:
         for tr in self.tracks:
             if tr["hits"] < self.confirm or not tr["moved"]:
                 continue
-            x, y = self._predicted(tr, t)
+            ts = [h[0] for h in tr["hist"]]
+            vx = agreed(tr["vx"], theil_sen(ts, [h[1] for h in tr["hist"]]))
+            vy = agreed(tr["vy"], theil_sen(ts, [h[2] for h in tr["hist"]]))
+            dt = t - tr["t"]
+            x, y = tr["x"] + vx * dt, tr["y"] + vy * dt
             b = tr["box"]
-            out.append({"id": tr["id"], "class": tr["class"], "x": x, "y": y, "vx": tr["vx"],
-                        "vy": tr["vy"], "length": b["x1"] - b["x0"], "width": b["y1"] - b["y0"],
+            out.append({"id": tr["id"], "class": tr["class"], "x": x, "y": y, "vx": vx,
+                        "vy": vy, "length": b["x1"] - b["x0"], "width": b["y1"] - b["y0"],
                         "points": b["points"], "misses": tr["misses"], "hits": tr["hits"]})
         return sorted(out, key=lambda o: int(o["id"][5:]))

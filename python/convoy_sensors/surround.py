@@ -30,7 +30,7 @@ import math
 import numpy as np
 
 from convoy_sensors.cluster_tracker import ClusterTracker
-from convoy_sensors.clusters import segment
+from convoy_sensors.clusters import STATIC_CLASSES, segment_all
 
 SOURCE = "sensors"
 RANGED_BY = "lidar_surround"
@@ -52,15 +52,36 @@ class Surround:
         self.segment_kw = dict(segment_kw, ego_length=ego_length, ego_width=ego_width, ego_offset=ego_offset)
         self.tracker = ClusterTracker()
         self.t = None
-        self.boxes = []
+        self.boxes = []      # the last scan's clusters other than scenery (tracked)
+        self.all_boxes = []  # all of them, scenery (clusters.STATIC_CLASSES) too
+        self.scan_ego = None
 
-    def scan(self, xyz, flags, t, ego):
-        """A new scan (N x 3, the LiDAR's frame; its flags or None) taken at t s, the ego at
-        `ego` (dict x, y, yaw)."""
+    def scan(self, xyz, flags, t, ego, intensity=None):
+        """A new scan (N x 3, the LiDAR's frame; its flags and intensities or None) taken at
+        t s, the ego at `ego` (dict x, y, yaw)."""
         pts = self.rig.to_ego(xyz) if xyz is not None and len(xyz) else np.zeros((0, 3))
-        self.boxes = segment(pts, flags, **self.segment_kw)
+        self.all_boxes = segment_all(pts, flags, intensity, **self.segment_kw)
+        self.boxes = [b for b in self.all_boxes if b["class"] not in STATIC_CLASSES]
         self.t = t
+        self.scan_ego = dict(ego)
         self.tracker.update(self.boxes, t, ego)
+
+    def boxes_now(self, ego):
+        """The last scan's boxes (all of them) moved into the ego's frame at `ego` (the ego
+        drives on between the scan and a camera frame): their extents kept, centres moved."""
+        if self.scan_ego is None:
+            return []
+        s0, c0 = math.sin(self.scan_ego["yaw"]), math.cos(self.scan_ego["yaw"])
+        c, s = math.cos(ego["yaw"]), math.sin(ego["yaw"])
+        out = []
+        for b in self.all_boxes:
+            bx, by = (b["x0"] + b["x1"]) / 2.0, (b["y0"] + b["y1"]) / 2.0
+            wx = self.scan_ego["x"] + c0 * bx - s0 * by - ego["x"]
+            wy = self.scan_ego["y"] + s0 * bx + c0 * by - ego["y"]
+            nx, ny = c * wx + s * wy, -s * wx + c * wy
+            out.append(dict(b, x0=b["x0"] + nx - bx, x1=b["x1"] + nx - bx,
+                            y0=b["y0"] + ny - by, y1=b["y1"] + ny - by))
+        return out
 
     def refine(self, objects):
         """The camera's objects (convoy_traffic.fusion.fuse), vehicles placed across the ego's
