@@ -22,6 +22,7 @@
 #include "datapack/json.h"
 #include "detector.h"
 #include "physics_world.h"
+#include "render/image_io.h"
 #include "world_description.h"
 
 using namespace convoy;
@@ -42,10 +43,10 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: frame_bench WORLD.sdf [--backend B] [--model M.onnx] [--frames N] "
-                 "[--runs R] [--shadows 0|1]\n");
+                 "[--runs R] [--shadows 0|1] [--save LAST_FRAME.ppm]\n");
     return 2;
   }
-  std::string world_file = argv[1], backend = "ground_truth", model;
+  std::string world_file = argv[1], backend = "ground_truth", model, save;
   int frames = 300, runs = 5;
   bool shadows = false;
   for (int i = 2; i + 1 < argc; i += 2) {
@@ -60,6 +61,8 @@ int main(int argc, char** argv) {
       runs = std::stoi(v);
     else if (k == "--shadows")
       shadows = v == "1";
+    else if (k == "--save")
+      save = v;
   }
   try {
     world::WorldDesc desc = world::load_world(world_file);
@@ -123,6 +126,12 @@ int main(int argc, char** argv) {
       double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       ms.push_back(1e3 * s / frames);
       cpu_ms.push_back(1e3 * (cpu_seconds() - c0) / frames);
+    }
+    if (!save.empty()) {  // the last frame, as the detector receives it
+      cv::Mat rgb =
+          detector::image_from_datapack(datapack::View(image, datapack::inline_blob_reader()));
+      if (rgb.channels() != 3 || !rgb.isContinuous()) throw std::runtime_error("--save: not RGB");
+      render::write_ppm(save, rgb.cols, rgb.rows, rgb.data);
     }
     std::sort(ms.begin(), ms.end());
     std::sort(cpu_ms.begin(), cpu_ms.end());

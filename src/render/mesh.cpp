@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 namespace convoy::render {
 namespace {
@@ -165,9 +166,9 @@ MeshLevels cylinder_levels(float radius, float length, int segments) {
 
 namespace {
 
-// One clustering pass over `mesh` (normals present) with cells of side `cell`; *error gets the
-// farthest a vertex moved.
-MeshData cluster(const MeshData& mesh, double cell, float* error) {
+// One clustering pass over `mesh` (normals present) with cells of side `cell`, vertices that
+// face different ways kept apart if `by_normal`; *error gets the farthest a vertex moved.
+MeshData cluster(const MeshData& mesh, double cell, bool by_normal, float* error) {
   const size_t n = mesh.vertex_count();
   const float* p = mesh.positions.data();
   const float* nr = mesh.normals.data();
@@ -187,7 +188,8 @@ MeshData cluster(const MeshData& mesh, double cell, float* error) {
     int axis = 0;
     for (int k = 1; k < 3; ++k)
       if (std::abs(nr[3 * i + k]) > std::abs(nr[3 * i + axis])) axis = k;
-    key = (key << 3) | static_cast<uint64_t>(2 * axis + (nr[3 * i + axis] < 0 ? 1 : 0));
+    key = (key << 3) |
+          (by_normal ? static_cast<uint64_t>(2 * axis + (nr[3 * i + axis] < 0 ? 1 : 0)) : 0);
     auto [it, fresh] = id_of.try_emplace(key, static_cast<uint32_t>(sums.size()));
     if (fresh) sums.push_back({0, 0, 0, 0, 0, 0, 0});
     vertex_cluster[i] = it->second;
@@ -287,12 +289,20 @@ MeshLevels simplified_levels(MeshData mesh) {
       std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
   if (!(diagonal > 0)) return out;
-  for (double fraction : {1.0 / 48, 1.0 / 24, 1.0 / 12}) {
+  // The last two levels merge across facing too: foliage and folds, whose normals scatter,
+  // barely merge by facing.
+  const std::pair<double, bool> passes[] = {
+      {1.0 / 48, true}, {1.0 / 24, true}, {1.0 / 12, true}, {1.0 / 8, false}, {1.0 / 5, false}};
+  for (auto [fraction, by_normal] : passes) {
     float error = 0;
-    MeshData coarse = cluster(out.meshes.front(), diagonal * fraction, &error);
+    MeshData coarse = cluster(out.meshes.front(), diagonal * fraction, by_normal, &error);
     if (coarse.triangle_count() == 0 ||
         coarse.triangle_count() > 0.6 * out.meshes.back().triangle_count())
       continue;
+    if (!by_normal) {  // the merged normals of opposite faces cancel: smooth ones instead
+      coarse.normals.clear();
+      compute_normals(&coarse);
+    }
     out.errors.push_back(std::max(error, out.errors.back()));
     out.meshes.push_back(std::move(coarse));
   }

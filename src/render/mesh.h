@@ -44,6 +44,9 @@ float horizontal_extent(const MeshData& mesh);
 struct MeshLevels {
   std::vector<MeshData> meshes;  // finest first
   std::vector<float> errors;     // growing
+  // Whether Scene::add_mesh_levels may add the bounding box as the coarsest level (box_level.h):
+  // not for the tiles of a road network, which meet without cracks at full detail.
+  bool box = true;
 };
 // make_sphere(radius, stacks, slices), then stacks and slices halved while slices stay >= 8.
 MeshLevels sphere_levels(float radius, int stacks, int slices);
@@ -53,7 +56,8 @@ MeshLevels cylinder_levels(float radius, float length, int segments);
 // `mesh`, then coarser versions of it by vertex clustering, for meshes loaded from files:
 // the vertices in a grid cell that face the same way (the same dominant axis of their normal)
 // merge into their mean, and triangles that collapse go. Cells of 1/48, 1/24 and 1/12 of the
-// mesh's bounding-box diagonal; a level is kept only when it has at most 60 % of the previous
+// mesh's bounding-box diagonal, then 1/8 and 1/5 merging whatever way vertices face (smooth
+// normals computed afresh); a level is kept only when it has at most 60 % of the previous
 // one's triangles. Its error is the farthest any vertex moved. A textured mesh (uvs) keeps its
 // one level: merging would tear its texture mapping.
 MeshLevels simplified_levels(MeshData mesh);

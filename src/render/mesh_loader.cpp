@@ -163,7 +163,7 @@ const std::vector<MeshLevels>& LoadedMesh::drawables() const {
     MeshData whole = mesh;
     if (whole.normals.empty()) compute_normals(&whole);
     for (auto& tile : split_into_tiles(whole, kTile))
-      out.push_back(MeshLevels{{std::move(tile)}, {0.0f}});
+      out.push_back(MeshLevels{{std::move(tile)}, {0.0f}, false});
   } else {
     out.push_back(simplified_levels(mesh));
   }

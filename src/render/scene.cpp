@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "render/box_level.h"
 #include "render/image_io.h"
 
 namespace convoy::render {
@@ -97,6 +98,14 @@ int Scene::add_mesh_levels(const MeshLevels& levels) {
   for (size_t i = 1; i < levels.meshes.size(); ++i) {
     const int coarser = add_mesh(levels.meshes[i]);
     lods_[finest].push_back(Lod{coarser, levels.errors[i]});
+  }
+  // The box last, when it has at most 60 % of the coarsest level's triangles (see box_level.h).
+  if (levels.box && levels.meshes.back().triangle_count() * 3 >= 5 * 12) {
+    if (auto box = box_level(levels.meshes[0])) {
+      const float error = std::max(box->error, levels.errors.back());
+      const int coarsest = add_mesh(box->mesh);
+      lods_[finest].push_back(Lod{coarsest, error});
+    }
   }
   return finest;
 }

@@ -166,7 +166,8 @@ class Scene {
   int add_mesh(const MeshData& mesh);
   // Adds every level of `levels` and returns the finest's index, to use as any mesh's. Where
   // an instance of it is small on screen, the renderer draws the coarsest level whose error
-  // covers at most Renderer::kLodPixelError pixels there.
+  // covers at most Renderer::kLodPixelError pixels there. The mesh's bounding box is added as
+  // its coarsest level (box_level.h) when it pays.
   int add_mesh_levels(const MeshLevels& levels);
   // Copies a w x h RGBA8 image (row 0 = top) and returns its index.
   int add_texture(const uint8_t* rgba, int width, int height);

@@ -384,7 +384,7 @@ TEST(MeshLevels, SimplifiedByVertexClustering) {
     EXPECT_NO_THROW(validate_mesh(m, "level"));
     EXPECT_LE(m.triangle_count(), 0.6 * levels.meshes[i - 1].triangle_count()) << i;
     EXPECT_GT(levels.errors[i], levels.errors[i - 1]) << i;
-    EXPECT_LT(levels.errors[i], 0.5f) << i;  // a cell's diagonal: cells of at most 1/12 of 3.46 m
+    EXPECT_LT(levels.errors[i], 1.2f) << i;  // a cell's diagonal: cells of at most 1/5 of 3.46 m
     ASSERT_EQ(m.normals.size(), m.positions.size());
     for (size_t v = 0; v < m.vertex_count(); ++v) {
       const double r =
@@ -404,7 +404,30 @@ TEST(MeshLevels, SimplifiedByVertexClustering) {
   const MeshLevels sedan = simplified_levels(parts[0].mesh);
   ASSERT_GE(sedan.meshes.size(), 2u);
   EXPECT_LE(sedan.meshes.back().triangle_count(), sedan.meshes[0].triangle_count() / 3);
-  EXPECT_LT(sedan.errors.back(), 0.5f);
+  EXPECT_LT(sedan.errors.back(), 1.2f);  // cells of at most 1/5 of its ~5 m diagonal
+}
+
+// Foliage: normals scattered every way barely merge by facing; the last levels merge across it
+// and give the level smooth normals of its own.
+TEST(MeshLevels, ScatteredNormalsStillSimplify) {
+  MeshData blob = make_sphere(1.0f, 32, 64);
+  blob.uvs.clear();
+  for (size_t v = 0; v < blob.vertex_count(); ++v) {
+    const float flip = (v * 2654435761u) % 3 == 0 ? -1.0f : 1.0f;
+    for (int k = 0; k < 3; ++k) blob.normals[3 * v + k] *= flip;
+    std::swap(blob.normals[3 * v], blob.normals[3 * v + (v % 3)]);
+  }
+  const MeshLevels levels = simplified_levels(blob);
+  ASSERT_GE(levels.meshes.size(), 2u);
+  const MeshData& coarsest = levels.meshes.back();
+  EXPECT_LE(coarsest.triangle_count(), blob.triangle_count() / 4);
+  EXPECT_LT(levels.errors.back(), 1.2f);  // a cell's diagonal: cells of 1/5 of 3.46 m
+  for (size_t v = 0; v < coarsest.vertex_count(); ++v) {
+    const float* p = &coarsest.positions[3 * v];
+    const float* n = &coarsest.normals[3 * v];
+    EXPECT_NEAR(std::hypot(n[0], n[1], n[2]), 1.0, 1e-4);
+    EXPECT_GT(p[0] * n[0] + p[1] * n[1] + p[2] * n[2], 0) << "vertex " << v << " faces inwards";
+  }
 }
 
 }  // namespace
