@@ -42,7 +42,9 @@ city large_city.xodr): the ego among N vehicles of ONE road_user_pool engine (-o
 EngineConfigs/5/Density=0 -o EngineConfigs/5/Count=N), drawn by the world engine as actors; it
 prints the same lines, the world's collisions (pooled vehicles with each other and with the
 ego, which the pool sees) and, from traffic_pool_bench on that map, the collisions among the N
-pooled vehicles over 600 simulated s (target 0). A count the map cannot hold ends the section
+pooled vehicles over 600 simulated s (target 0). --city-pedestrians P adds P pooled walkers (-o
+EngineConfigs/5/Pedestrians=P; default 0): it prints the mix (N vehicles + P pedestrians) and
+the vehicle-walker collisions of the 600 s run too. A count the map cannot hold ends the section
 with the pool's message.
 
 Section "density": experiments/city_traffic/simulation_config_density.json, 10 simulated
@@ -309,16 +311,19 @@ def pooled_city_map(n):
     return "large_city.xodr" if n > CITY_XODR_HOLDS else "city.xodr"
 
 
-def pooled_city_collisions(args, n):
-    """The pool alone on the pooled city's map, N vehicles for 600 simulated s: its collision
-    line."""
+def pooled_city_collisions(args, n, walkers=0):
+    """The pool alone on the pooled city's map, N vehicles (and `walkers` walkers) for 600
+    simulated s: its collision line (and its walkers' line)."""
     bench = os.path.join(args.build, "benchmarks", "traffic_pool_bench")
     if not os.path.exists(bench):
         return "traffic_pool_bench is not built"
     r = subprocess.run([bench, os.path.join(CITY, pooled_city_map(n)), "--counts", str(n),
-                        "--seconds", "600"], capture_output=True, text=True)
-    lines = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().startswith("N =")]
-    return lines[0] if r.returncode == 0 and lines else (r.stderr or r.stdout).strip()[-500:]
+                        "--seconds", "600", "--walkers", str(walkers)],
+                       capture_output=True, text=True)
+    lines = [ln.strip() for ln in r.stdout.splitlines()
+             if ln.strip().startswith(("N =", "walkers"))]
+    return "; ".join(lines) if r.returncode == 0 and lines else \
+        (r.stderr or r.stdout).strip()[-500:]
 
 
 def section_city(args):
@@ -330,8 +335,8 @@ def section_city(args):
     config = "simulation_config.json"
     if pooled:
         config = POOLED_CITY_LARGE if args.city_road_users > CITY_XODR_HOLDS else POOLED_CITY
-    overrides = ["EngineConfigs/5/Density=0", "EngineConfigs/5/Count=%d" % args.city_road_users] \
-        if pooled else []
+    overrides = ["EngineConfigs/5/Density=0", "EngineConfigs/5/Count=%d" % args.city_road_users,
+                 "EngineConfigs/5/Pedestrians=%d" % args.city_pedestrians] if pooled else []
     work = tempfile.mkdtemp(prefix="convoy-trafficbench-city-")
     try:
         env = dict(os.environ, CONVOY_CACHE_DIR=os.path.join(work, "cache"))
@@ -349,7 +354,9 @@ def section_city(args):
         print("city: experiments/city_traffic/%s, %g s simulated, %d run(s) (the first with an "
               "empty parsed-world cache); participants %s%s"
               % (config, args.city_end, len(rows), json.dumps(s["participants"]),
-                 ", pooled road users %d" % args.city_road_users if pooled else ""))
+                 ", pooled road users %d vehicles + %d pedestrians = %d"
+                 % (args.city_road_users, args.city_pedestrians,
+                    args.city_road_users + args.city_pedestrians) if pooled else ""))
         print("  start-up (engines initialized in): %.2f s with the cache (runs: %s), %.2f s "
               "without it  target <= 2 s" % (med(0), ", ".join("%.2f" % r[0] for r in warm),
                                             rows[0][0]))
@@ -363,9 +370,10 @@ def section_city(args):
         if pooled:
             for c in s["collisions"]:
                 print("    %s" % json.dumps(c))
-            print("  collisions among the %d pooled vehicles, 600 simulated s (the pool alone): "
-                  "%s  target 0" % (args.city_road_users,
-                                    pooled_city_collisions(args, args.city_road_users)))
+            print("  collisions among the %d pooled vehicles (and with its %d walkers), 600 "
+                  "simulated s (the pool alone): %s  target 0"
+                  % (args.city_road_users, args.city_pedestrians,
+                     pooled_city_collisions(args, args.city_road_users, args.city_pedestrians)))
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -404,6 +412,9 @@ def main():
     ap.add_argument("--city-road-users", type=int, default=0,
                     help="city section: run simulation_config_pooled.json (above 395: "
                          "simulation_config_pooled_large.json) with N pooled vehicles instead of the agent engines and SUMO (0: the usual config)")
+    ap.add_argument("--city-pedestrians", type=int, default=0,
+                    help="with --city-road-users: the pool's walkers on the sidewalks "
+                         "(EngineConfigs/5/Pedestrians)")
     ap.add_argument("--density-end", type=float, default=600.0,
                     help="simulated seconds of the density run")
     ap.add_argument("--agent-end", type=float, default=10.0,

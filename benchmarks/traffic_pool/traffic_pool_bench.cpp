@@ -5,7 +5,9 @@
 // of vehicles whose boxes begin to overlap (each pair counted once per contact).
 //
 //   traffic_pool_bench MAP.xodr [--counts 1000,5000,10000] [--seconds 60] [--dt 0.05]
-//                      [--seed 1]
+//                      [--seed 1] [--walkers W]
+// --walkers W adds W pooled walkers (spawn_walkers, the same seed) and prints their trips,
+// crossings and the vehicle-walker collisions (a vehicle's box beginning to overlap a walker's).
 // Last line: `pool step alone at real time: N` (the largest N with a factor >= 1).
 //
 // With --flows FILE the vehicles come from flows instead of a count (flow_run.h; used by
@@ -36,28 +38,35 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 // The pool at each count of `counts`, from spawned vehicles; returns the largest count at >= 1x.
+// Pairs that begin to overlap now (not in `touching`), which becomes `now`.
+size_t new_contacts(const std::vector<std::pair<uint32_t, uint32_t>>& now_list,
+                    std::set<std::pair<uint32_t, uint32_t>>& touching) {
+  std::set<std::pair<uint32_t, uint32_t>> now(now_list.begin(), now_list.end());
+  size_t fresh = 0;
+  for (const auto& p : now) fresh += !touching.count(p);
+  touching.swap(now);
+  return fresh;
+}
+
 size_t run_counts(const tp::PoolNetwork& net, const std::string& counts, double seconds, double dt,
-                  uint64_t seed) {
+                  uint64_t seed, size_t walkers) {
   size_t best = 0;
   std::stringstream list(counts);
   for (std::string item; std::getline(list, item, ',');) {
     const size_t n = std::strtoull(item.c_str(), nullptr, 10);
     tp::VehicleSpec base;
     tp::Pool pool(net, tp::spawn(net, n, seed, base));
-    std::set<std::pair<uint32_t, uint32_t>> touching;
-    size_t collisions = 0;
+    if (walkers > 0) pool.set_walkers(tp::spawn_walkers(net, walkers, seed));
+    std::set<std::pair<uint32_t, uint32_t>> touching, touching_walkers;
+    size_t collisions = 0, walker_collisions = 0;
     const int steps = static_cast<int>(seconds / dt + 0.5);
     double step_wall = 0, check_wall = 0, speed_sum = 0;
     for (int k = 0; k < steps; ++k) {
       const auto t0 = Clock::now();
       pool.step(dt);
       const auto t1 = Clock::now();
-      std::set<std::pair<uint32_t, uint32_t>> now;
-      for (const auto& p : pool.overlaps()) {
-        now.insert(p);
-        if (!touching.count(p)) ++collisions;
-      }
-      touching.swap(now);
+      collisions += new_contacts(pool.overlaps(), touching);
+      walker_collisions += new_contacts(pool.walker_overlaps(), touching_walkers);
       check_wall += std::chrono::duration<double>(Clock::now() - t1).count();
       step_wall += std::chrono::duration<double>(t1 - t0).count();
     }
@@ -72,6 +81,17 @@ size_t run_counts(const tp::PoolNetwork& net, const std::string& counts, double 
         static_cast<unsigned long long>(pool.stats().junction_entries),
         static_cast<unsigned long long>(pool.stats().respawns), collisions,
         1e3 * check_wall / steps);
+    if (const tp::PoolWalkers* w = pool.walkers()) {
+      double walked = 0;
+      for (size_t i = 0; i < w->size(); ++i) walked += w->speed(i);
+      std::printf(
+          "    walkers %zu: trips %llu, crossings %llu, respawns %llu, mean speed at the end "
+          "%.2f m/s; vehicle-walker collisions %zu\n",
+          w->size(), static_cast<unsigned long long>(w->stats().trips),
+          static_cast<unsigned long long>(w->stats().crossings),
+          static_cast<unsigned long long>(w->stats().respawns),
+          walked / static_cast<double>(w->size()), walker_collisions);
+    }
     std::fflush(stdout);
     if (rtf >= 1.0) best = std::max(best, n);
   }
@@ -84,11 +104,12 @@ int main(int argc, char** argv) {
   if (argc < 2 || argc % 2 != 0) {
     std::fprintf(stderr,
                  "usage: traffic_pool_bench MAP.xodr [--counts N,N] [--seconds S] "
-                 "[--dt DT] [--seed K] [--flows FILE [--trace FILE] [--warmup S] "
+                 "[--dt DT] [--seed K] [--walkers W] [--flows FILE [--trace FILE] [--warmup S] "
                  "[--trace-every K]] [--routable FILE]\n");
     return 2;
   }
   std::string counts = "1000,5000,10000", routable;
+  size_t walkers = 0;
   convoy::bench::FlowRunOptions flow;
   flow.seconds = 60;
   const std::map<std::string, std::function<void(const std::string&)>> options = {
@@ -101,7 +122,9 @@ int main(int argc, char** argv) {
       {"--warmup", [&](const std::string& v) { flow.warmup_s = std::atof(v.c_str()); }},
       {"--trace-every",
        [&](const std::string& v) { flow.trace_every = std::max(1, std::atoi(v.c_str())); }},
-      {"--routable", [&](const std::string& v) { routable = v; }}};
+      {"--routable", [&](const std::string& v) { routable = v; }},
+      {"--walkers",
+       [&](const std::string& v) { walkers = std::strtoull(v.c_str(), nullptr, 10); }}};
   for (int i = 2; i + 1 < argc; i += 2) {
     const auto it = options.find(argv[i]);
     if (it == options.end()) {
@@ -133,7 +156,7 @@ int main(int argc, char** argv) {
       convoy::bench::run_flows(net, flow);
       return 0;
     }
-    const size_t best = run_counts(net, counts, flow.seconds, flow.dt, flow.seed);
+    const size_t best = run_counts(net, counts, flow.seconds, flow.dt, flow.seed, walkers);
     std::printf("pool step alone at real time: %zu\n", best);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "traffic_pool_bench: %s\n", e.what());

@@ -3,16 +3,19 @@
 // neighbour grid) is src/traffic_pool; this file only reads the config and writes the datapack.
 //
 // Config keys (schema.json): Map, Vehicles (listed), Count or Density + Seed + Policy +
-// DesiredSpeed + KeepClear (spawned), RoadUsersDataPack, ExternalDataPack. In: <ExternalDataPack>
-// convoy.data.RoadUsers (or one RoadUser), the road users it does not drive (the ego, agents):
-// obstacles its vehicles follow, keep gaps to and yield to, kept until the next one; a malformed
-// one stops the run (exit 2) naming the field. Out: <RoadUsersDataPack>
+// DesiredSpeed + KeepClear (spawned), Pedestrians or PedestrianDensity (walkers on the
+// sidewalks, src/traffic_pool/pool_walkers.h), RoadUsersDataPack, ExternalDataPack. In:
+// <ExternalDataPack> convoy.data.RoadUsers (or one RoadUser), the road users it does not drive (the
+// ego, agents): obstacles its vehicles follow, keep gaps to and yield to, kept until the next one;
+// a malformed one stops the run (exit 2) naming the field. Out: <RoadUsersDataPack>
 // convoy.data.RoadUsers, every vehicle's state after the last step (reference point: the rear axle,
-// a quarter of the length ahead of the rear bumper), ids "<engine>/<id>"; protobuf's binary form,
-// not JSON. Bad input (an unknown policy, two road users on one spot, a count the map cannot hold,
-// a destination with no path) fails initialize with one message naming the road user.
+// a quarter of the length ahead of the rear bumper), then every walker's (category pedestrian,
+// model walker, walk_phase; the centre of its feet), ids "<engine>/<id>"; protobuf's binary
+// form, not JSON. Bad input (an unknown policy, two road users on one spot, a count the map cannot
+// hold, a destination with no path) fails initialize with one message naming the road user.
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 
@@ -197,19 +200,35 @@ class RoadUserPoolEngine final : public Engine {
       specs.insert(specs.end(), more.begin(), more.end());
     }
     pool_ = std::make_unique<tp::Pool>(*net_, std::move(specs));
+    const size_t walkers = walker_count(clear);
+    if (walkers > 0) {
+      pool_->set_walkers(
+          tp::spawn_walkers(*net_, walkers, config_.value("Seed", 1), "walker/", clear));
+    }
     users_.Clear();
     for (size_t i = 0; i < pool_->size(); ++i) {
       const tp::VehicleSpec& s = pool_->spec(i);
-      data::RoadUser* u = users_.add_users();
-      u->set_id(name_ + "/" + s.id);
-      u->set_category("car");
-      u->set_model("sedan");
-      u->set_length(s.length);
-      u->set_width(s.width);
-      u->set_height(1.45);
-      u->set_length_offset(s.length * (0.5 - kRearAxleFraction));
+      add_user(s.id, "car", "sedan", s.length, s.width, 1.45)
+          ->set_length_offset(s.length * (0.5 - kRearAxleFraction));
+    }
+    const tp::PoolWalkers* w = pool_->walkers();
+    for (size_t i = 0; w && i < w->size(); ++i) {
+      const tp::WalkerSpec& s = w->spec(i);
+      add_user(s.id, "pedestrian", "walker", s.length, s.width, s.height);
     }
     publish();
+  }
+
+  data::RoadUser* add_user(const std::string& id, const char* category, const char* model,
+                           double length, double width, double height) {
+    data::RoadUser* u = users_.add_users();
+    u->set_id(name_ + "/" + id);
+    u->set_category(category);
+    u->set_model(model);
+    u->set_length(length);
+    u->set_width(width);
+    u->set_height(height);
+    return u;
   }
 
   std::vector<tp::ClearZone> keep_clear() const {
@@ -228,34 +247,55 @@ class RoadUserPoolEngine final : public Engine {
     return out;
   }
 
-  // Count, or Density (vehicles per km of driving lane outside junctions) times the map's
-  // length of them; a density the map cannot hold names the key and the map's capacity.
-  size_t spawn_count(const tp::VehicleSpec& base, const std::vector<tp::ClearZone>& clear) const {
-    const size_t given = config_.value("Count", 0);
-    if (!config_.contains("Density")) return given;
-    const json& d = config_.at("Density");
+  // How many to spawn: the count key, or the density key (per km of `where`) times the map's km
+  // of it, rounded; a density the map cannot hold names the key and the map's capacity.
+  struct CountKeys {
+    const char *count, *density, *what, *per, *where;
+    double km, spacing;
+    std::function<size_t()> capacity;
+  };
+  size_t count_of(const CountKeys& k) const {
+    const size_t given = config_.value(k.count, 0);
+    if (!config_.contains(k.density)) return given;
+    const json& d = config_.at(k.density);
     if (!d.is_number() || !(d.get<double>() >= 0)) {
-      throw std::runtime_error(
-          "Density must be a number >= 0 (vehicles per km of driving lane), "
-          "got " +
-          d.dump());
+      throw std::runtime_error(std::string(k.density) + " must be a number >= 0 (" + k.what +
+                               " per km of " + k.per + "), got " + d.dump());
     }
-    if (d.get<double>() == 0) return given;  // 0: unused, Count counts
-    if (given != 0) throw std::runtime_error("give Count or Density, not both (or Density 0)");
-    const double km = tp::driving_km(*net_), density = d.get<double>();
-    const auto count = static_cast<size_t>(std::llround(density * km));
-    const size_t capacity = tp::spawn_capacity(*net_, base, clear);
+    const std::string density_key = k.density;
+    if (d.get<double>() == 0) return given;  // 0: unused, the count counts
+    if (given != 0) {
+      throw std::runtime_error("give " + std::string(k.count) + " or " + density_key +
+                               ", not both (or " + density_key + " 0)");
+    }
+    const double density = d.get<double>();
+    const auto count = static_cast<size_t>(std::llround(density * k.km));
+    const size_t capacity = k.capacity();
     if (count > capacity) {
       char m[400];
       std::snprintf(m, sizeof m,
-                    "Density %g vehicles/km cannot fit the map %s: %zu vehicles on its %.2f km of "
-                    "driving lanes outside junctions, which hold at most %zu (%.1f vehicles/km, "
-                    "%.1f m apart)",
-                    density, config_.value("Map", "").c_str(), count, km, capacity,
-                    km > 0 ? capacity / km : 0.0, base.length + base.idm.s0 + 2);
+                    "%s %g %s/km cannot fit the map %s: %zu %s on its %.2f km of %s, which hold "
+                    "at most %zu (%.1f %s/km, %.1f m apart)",
+                    k.density, density, k.what, config_.value("Map", "").c_str(), count, k.what,
+                    k.km, k.where, capacity, k.km > 0 ? capacity / k.km : 0.0, k.what, k.spacing);
       throw std::runtime_error(m);
     }
     return count;
+  }
+
+  // Count, or Density (vehicles per km of driving lane outside junctions).
+  size_t spawn_count(const tp::VehicleSpec& base, const std::vector<tp::ClearZone>& clear) const {
+    return count_of({"Count", "Density", "vehicles", "driving lane",
+                     "driving lanes outside junctions", tp::driving_km(*net_),
+                     base.length + base.idm.s0 + 2,
+                     [&] { return tp::spawn_capacity(*net_, base, clear); }});
+  }
+
+  // Pedestrians, or PedestrianDensity (walkers per km of sidewalk).
+  size_t walker_count(const std::vector<tp::ClearZone>& clear) const {
+    return count_of({"Pedestrians", "PedestrianDensity", "pedestrians", "sidewalk", "sidewalk",
+                     tp::sidewalk_km(*net_), tp::kWalkerSpacing,
+                     [&] { return tp::walker_capacity(*net_, clear); }});
   }
 
   void publish() {
@@ -277,6 +317,20 @@ class RoadUserPoolEngine final : public Engine {
       u->set_road(lane.road_id);
       u->set_lane(lane.lane_id);
       u->set_s(node.forward ? node.s0 + pool_->s(i) : node.s1 - pool_->s(i));
+      u->set_time_ns(time_ns_);
+    }
+    const tp::PoolWalkers* w = pool_->walkers();
+    for (size_t i = 0; w && i < w->size(); ++i) {
+      data::RoadUser* u = users_.mutable_users(static_cast<int>(pool_->size() + i));
+      const double yaw = w->yaw(i), v = w->speed(i);
+      u->set_x(w->x(i));
+      u->set_y(w->y(i));
+      u->set_yaw(yaw);
+      u->set_speed(v);
+      u->set_acceleration(w->acceleration(i));
+      u->set_vx(v * std::cos(yaw));
+      u->set_vy(v * std::sin(yaw));
+      u->set_walk_phase(w->walk_phase(i));
       u->set_time_ns(time_ns_);
     }
   }

@@ -1,7 +1,7 @@
 """The pooled city's information flow (simulation_config_pooled*.json), one transceiver function
 at the pool's rate (20 Hz):
 
-- the world engine gets every pooled vehicle as an actor: the pool's convoy.data.RoadUsers
+- the world engine gets every pooled vehicle and walker as an actor: the pool's convoy.data.RoadUsers
   datapack is copied whole (binary protobuf, no JSON) to the world engine as `pool_users`;
 - the pool gets the road users it does not drive as `external_users` (convoy.data.RoadUsers):
   the ego (the world engine's smart_car::road_user) and every vehicle_agent or
@@ -64,7 +64,9 @@ def pool_traffic(pool, ego, **agents):
     for u in _near(near, ex, ey, RECORD_RADIUS) + [ego.data]:
         rec["users"].append([u.id, u.category, round(u.x, 3), round(u.y, 3), round(u.yaw, 4),
                              round(u.speed, 3), round(u.length, 2), round(u.length_offset, 2)])
-    rec["pool_size"] = len(pool.data.users)
+    walkers = sum(1 for u in pool.data.users if u.category == "pedestrian")
+    rec["pool_size"] = len(pool.data.users) - walkers  # vehicles
+    rec["pool_pedestrians"] = walkers
     out.append(JsonDataPack("traffic", "recorder", rec))
     return out
 

@@ -89,6 +89,7 @@ class Script(EngineScript):
         self.collisions = []
         self.sumo_ids = set()
         self.pool_size = None
+        self.pool_walkers = None
         self.wall0 = None
         self.last_t = None
 
@@ -97,6 +98,7 @@ class Script(EngineScript):
         signals = d.get("signals", {})
         if d.get("pool_size") is not None:  # the pooled city: how many vehicles the pool drives
             self.pool_size = max(self.pool_size or 0, d["pool_size"])
+            self.pool_walkers = max(self.pool_walkers or 0, d.get("pool_pedestrians") or 0)
         row = {"t": round(t, 3), "users": users, "signals": signals}
         line = json.dumps(row, separators=(",", ":"))
         self.tracks_file.write(line + "\n")
@@ -260,6 +262,7 @@ class Script(EngineScript):
             "ego_input": planner.get("input_label"),
             "road_users_seen": len(self.seen),
             "pooled_vehicles": self.pool_size,
+            "pooled_pedestrians": self.pool_walkers,
             "tracks_sha1": self.digest.hexdigest(),
             "camera_frames": self.frames,
             "camera_frames_per_s": self.frames / wall if wall > 0 else None,

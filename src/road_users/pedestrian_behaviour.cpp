@@ -12,7 +12,6 @@ namespace odr = convoy::opendrive;
 
 namespace {
 
-constexpr double kCurbWait = 0.3;   // m before the road's edge where it waits
 constexpr double kFollowGap = 1.0;  // m: closer than this behind a walker, it keeps its pace
 
 struct Stepper {
@@ -191,32 +190,10 @@ void Stepper::walk_polyline(const PedestrianCommand& cmd, double v_des, double d
 // The farthest arc it may be at: its path's end, or where the next crossing lets it go (the
 // curb while it waits; on the road, where the vehicles let it).
 double Stepper::crossing_limit_now(double v_des, double dt) {
-  double limit = s.path.length();
-  // The next crossing not yet behind it.
-  size_t ci = SIZE_MAX;
-  for (size_t i = 0; i < s.path.road_crossings.size(); ++i) {
-    if (s.path.road_crossings[i].exit > s.arc + 1e-9 &&
-        s.path.road_crossings[i].exit > s.path.road_crossings[i].enter) {
-      ci = i;
-      break;
-    }
-  }
-  if (ci == SIZE_MAX) return limit;
-  const WalkCrossing& c = s.path.road_crossings[ci];
-  const double wait_at = c.enter - kCurbWait;
-  if (s.committed != ci) {
-    if (s.arc >= wait_at - 3.0) {
-      bool ok = lights_allow(c);
-      if (ok) ok = gap_accepted(threats(c), d.gap);
-      if (ok && s.arc >= wait_at - v_des * dt - 1e-6) s.committed = ci;
-      if (!ok) limit = std::min(limit, wait_at);
-    }
-  }
-  if (s.committed == ci) {
-    limit = crossing_limit(threats(c), c.start, s.arc, v_des,
-                           {d.stop_distance, d.step_back_distance}, limit);
-  }
-  return limit;
+  return path_limit(
+      s.path, s.arc, v_des, dt, s.committed, {d.stop_distance, d.step_back_distance},
+      [&](const WalkCrossing& c) { return lights_allow(c) && gap_accepted(threats(c), d.gap); },
+      [&](const WalkCrossing& c) { return threats(c); });
 }
 
 // Along its path: stopped or stepping back for the road, at its pace (or the commanded one).
@@ -295,15 +272,8 @@ bool Stepper::lights_allow(const WalkCrossing& c) {
 // of its line, going its way or standing) closer than kFollowGap is not overtaken.
 double Stepper::walker_ahead_speed(double v) const {
   if (!s.neighbours) return v;
-  const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
-  for (const Neighbour& u : s.neighbours->walkers) {
-    const double dx = u.x - s.x, dy = u.y - s.y;
-    const double lon = dx * c + dy * sn, lat = -dx * sn + dy * c;
-    if (lon <= 0 || lon > kFollowGap + 0.5 || std::abs(lat) > 0.6) continue;
-    const double along = u.speed * std::cos(u.yaw - s.yaw);
-    if (along < -0.1) continue;  // coming towards it: they pass each other on the right
-    v = std::min(v, lon < kFollowGap ? std::max(0.0, along) : v);
-  }
+  for (const Neighbour& u : s.neighbours->walkers)
+    v = pace_behind(s.x, s.y, s.yaw, u.x, u.y, u.yaw, u.speed, v, kFollowGap);
   return v;
 }
 

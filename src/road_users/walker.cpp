@@ -72,4 +72,39 @@ double crossing_limit(const std::vector<CrossingThreat>& threats, double start, 
   return limit;
 }
 
+double path_limit(const WalkPath& path, double arc, double v_des, double dt, size_t& committed,
+                  const CrossingCaution& caution, const CrossingCheck& may_step_on,
+                  const CrossingThreats& threats) {
+  double limit = path.length();
+  size_t ci = SIZE_MAX;  // the next crossing not yet behind it
+  for (size_t i = 0; i < path.road_crossings.size(); ++i) {
+    if (path.road_crossings[i].exit > arc + 1e-9 &&
+        path.road_crossings[i].exit > path.road_crossings[i].enter) {
+      ci = i;
+      break;
+    }
+  }
+  if (ci == SIZE_MAX) return limit;
+  const WalkCrossing& c = path.road_crossings[ci];
+  const double wait_at = c.enter - kCurbWait;
+  if (committed != ci && arc >= wait_at - 3.0) {
+    const bool ok = may_step_on(c);
+    if (ok && arc >= wait_at - v_des * dt - 1e-6) committed = ci;
+    if (!ok) limit = std::min(limit, wait_at);
+  }
+  if (committed == ci) limit = crossing_limit(threats(c), c.start, arc, v_des, caution, limit);
+  return limit;
+}
+
+double pace_behind(double x, double y, double yaw, double ux, double uy, double uyaw, double uspeed,
+                   double v, double follow_gap) {
+  const double c = std::cos(yaw), sn = std::sin(yaw);
+  const double dx = ux - x, dy = uy - y;
+  const double lon = dx * c + dy * sn, lat = -dx * sn + dy * c;
+  if (lon <= 0 || lon > follow_gap + 0.5 || std::abs(lat) > 0.6) return v;
+  const double along = uspeed * std::cos(uyaw - yaw);
+  if (along < -0.1) return v;  // coming towards it: they pass each other on the right
+  return lon < follow_gap ? std::min(v, std::max(0.0, along)) : v;
+}
+
 }  // namespace convoy::road_users

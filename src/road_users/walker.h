@@ -3,9 +3,13 @@
 // road (stopping before a vehicle's lane, stepping back out of one).
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "road_users/pedestrian_walks.h"
 
 namespace convoy::road_users {
 
@@ -44,6 +48,8 @@ bool gap_accepted(const std::vector<CrossingThreat>& threats, double gap);
 bool walker_lights_allow(const std::vector<std::string>& ped_states,
                          const std::vector<std::string>& veh_states);
 
+inline constexpr double kCurbWait = 0.3;  // m before the road's edge where a walker waits
+
 // While crossing (committed): the farthest arc it may be at, at most `limit`, from the threats
 // to the leg that starts at arc `start`, it being at arc `arc` walking `v_des` m/s.
 struct CrossingCaution {
@@ -52,5 +58,22 @@ struct CrossingCaution {
 };
 double crossing_limit(const std::vector<CrossingThreat>& threats, double start, double arc,
                       double v_des, const CrossingCaution& caution, double limit);
+
+// The farthest arc a walker at `arc` on `path`, walking `v_des` m/s in steps of dt s, may be
+// at: the path's end, or where its next crossing lets it go. Within 3 m of the curb it asks
+// `may_step_on` (lights, gap), waiting at the curb (kCurbWait before the road) until it says
+// yes; it commits (`committed` = the crossing's index) once at the curb with a yes, and from
+// then on goes as far as crossing_limit lets it among `threats`.
+using CrossingCheck = std::function<bool(const WalkCrossing&)>;
+using CrossingThreats = std::function<std::vector<CrossingThreat>(const WalkCrossing&)>;
+double path_limit(const WalkPath& path, double arc, double v_des, double dt, size_t& committed,
+                  const CrossingCaution& caution, const CrossingCheck& may_step_on,
+                  const CrossingThreats& threats);
+
+// The pace a walker at (x, y) heading `yaw`, wanting `v`, may keep behind another walker at
+// (ux, uy) heading `uyaw` at `uspeed`: one in its way (within its body's width of its line,
+// going its way or standing) closer than `follow_gap` m is not overtaken (its pace, along).
+double pace_behind(double x, double y, double yaw, double ux, double uy, double uyaw, double uspeed,
+                   double v, double follow_gap);
 
 }  // namespace convoy::road_users

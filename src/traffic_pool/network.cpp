@@ -38,6 +38,7 @@ PoolNetwork::PoolNetwork(const odr::LaneGraph& graph, double ds) : graph_(&graph
   add_lanes(ds);
   link();
   find_conflicts();
+  find_stop_lines();
 }
 
 uint32_t PoolNetwork::pool_lane(odr::LaneIndex graph_lane) const {
@@ -193,6 +194,20 @@ void PoolNetwork::find_conflicts() {
           b.conflicts.push_back(lanes[i]);
         }
       }
+    }
+  }
+}
+
+void PoolNetwork::find_stop_lines() {
+  constexpr double kReach = 15, kHalfCrosswalk = 2.0, kMargin = 0.5;
+  for (const odr::Crosswalk& cw : graph_->crosswalks()) {
+    for (odr::LaneIndex gl : cw.lanes) {
+      const uint32_t p = pool_lane(gl);
+      if (p == kNone || lanes_[p].approach < 0) continue;
+      const odr::LaneNode& n = graph_->lane(gl);
+      const double to_end = n.forward ? n.s1 - cw.s : cw.s - n.s0;
+      if (to_end < 0 || to_end > kReach) continue;
+      lanes_[p].stop_back = std::max(lanes_[p].stop_back, to_end + kHalfCrosswalk + kMargin);
     }
   }
 }

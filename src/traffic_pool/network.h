@@ -3,6 +3,9 @@
 // group of its approach and, for lanes inside a junction, the junction lanes it crosses or
 // merges with. Built once from an opendrive::LaneGraph (any OpenDRIVE map), then read-only.
 //
+// Stop lines: an approach lane's vehicles wait at its end, or before a crosswalk that crosses it
+// within 15 m of its end (stop_back).
+//
 // Lights: a junction has lights when the map gives it signals (LaneGraph::junction_signals).
 // The pool runs them itself on a fixed cycle: approaches heading mostly east-west (group 0) and
 // mostly north-south (group 1) take turns: green, yellow, all red (LightCycle).
@@ -32,9 +35,15 @@ struct PoolLane {
   int junction = -1;                     // the junction the lane is inside
   int approach = -1;                    // the junction the lane leads into (its end is a stop line)
   int group = -1;                       // light group of that approach (-1: no lights)
+  double stop_back = 0;                 // m before its end where it stops (before a crosswalk)
   std::vector<uint32_t> conflicts;      // junction lanes: those it crosses or merges with
   bool u_turn = false;                  // turns back (heading change > 150 degrees)
   opendrive::Pose2 at(double s) const;  // s from the lane's start in its driving direction
+};
+
+// A disc kept clear of spawned road users (another road user's start, e.g. the ego's).
+struct ClearZone {
+  double x = 0, y = 0, radius = 0;
 };
 
 struct PoolJunction {
@@ -65,6 +74,7 @@ class PoolNetwork {
   void add_lanes(double ds);
   void link();
   void find_conflicts();
+  void find_stop_lines();
   const opendrive::LaneGraph* graph_;
   std::vector<PoolLane> lanes_;
   std::vector<uint32_t> by_graph_lane_;

@@ -118,7 +118,8 @@ bool Pool::exit_has_room(uint32_t exit_lane, double need) const {
   return s_[j] - specs_[j].length > need;
 }
 
-// The gap to the stop line when it must wait there, else infinity. A vehicle of an approach
+// The gap to the stop line (the lane's end, or before its crosswalk: PoolLane::stop_back) when
+// it must wait there, else infinity. A vehicle of an approach
 // (its leader's claim does not stop it: a lane does not conflict with itself) claims its junction
 // lane once it is within its braking distance (+5 m) of the line with a green light, no crossing or
 // merging lane claimed or occupied, and room behind the exit lane's last vehicle; from then on it
@@ -132,12 +133,14 @@ double Pool::junction_gap(size_t i) {
   if (dist > 80) return INFINITY;
   const VehicleSpec& sp = specs_[i];
   const double brake = v_[i] * v_[i] / (2 * sp.idm.b);
+  // Its stop line: before the crosswalk, unless its front is past that already.
+  const double line = dist > lane.stop_back ? dist - lane.stop_back : dist;
   const Light light = net_.light(l, t_);
   const bool stop_light = light == Light::kRed || light == Light::kRedYellow ||
-                          (light == Light::kYellow && dist > brake);
-  if (stop_light) return dist - kStopMargin;
+                          (light == Light::kYellow && line > brake);
+  if (stop_light) return line - kStopMargin;
   if (!conflict_free(j, i) || !exit_has_room(next2_[i], sp.length + sp.idm.s0)) {
-    return dist - kStopMargin;
+    return line - kStopMargin;
   }
   if (dist < std::max(brake + 5, 8.0)) {
     if (claim_[i] != kNone) --claims_[claim_[i]];
@@ -312,6 +315,7 @@ void Pool::step(double dt) {
     if (!present(i)) continue;  // it left the network
     update_pose(i);
   }
+  step_walkers(dt);
   t_ += dt;
 }
 

@@ -10,6 +10,12 @@
 // so pooled vehicles follow it (IDM leader), keep MOBIL's gaps to it, wait while it occupies a
 // junction lane crossing theirs, and are not respawned onto it.
 //
+// Walkers (set_walkers, pool_walkers.h) step with the vehicles, after them (seeing the vehicles
+// and externals where they are then). The crossing a walker has stepped onto is an obstacle to
+// the vehicles like an external road user (PoolWalkers::crossing_box: the on-road part of its
+// line, in the grid and on every lane it reaches), so vehicles stop before the crosswalk while
+// it is on it, and are not respawned onto it.
+//
 // Bad input throws PoolError naming the road user: an unknown policy, a start off the driving
 // lanes, two road users on one spot, a destination with no path, a count that does not fit.
 #pragma once
@@ -25,6 +31,7 @@
 #include "road_users/idm.h"
 #include "road_users/mobil.h"
 #include "traffic_pool/network.h"
+#include "traffic_pool/pool_walkers.h"
 
 namespace convoy::traffic_pool {
 
@@ -50,11 +57,6 @@ struct VehicleSpec {
   uint64_t seed = 0;           // its choices at forks
   uint32_t pool_lane = kNone;  // spawned: the PoolNetwork lane itself (road/lane/s are shown)
   bool absent = false;         // waits outside the network until Pool::enter (a flow's vehicle)
-};
-
-// A disc kept clear of spawned vehicles (another road user's start, e.g. the ego's).
-struct ClearZone {
-  double x = 0, y = 0, radius = 0;
 };
 
 // `count` vehicles like `base` (ids "<prefix><k>", seeds seed + k) on free slots of the
@@ -112,6 +114,12 @@ class Pool {
   std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
   // Pairs (pooled vehicle, external road user) whose boxes overlap now.
   std::vector<std::pair<uint32_t, uint32_t>> external_overlaps() const;
+  // Walkers to step with the vehicles, replacing any (placed now). Throws PoolError as
+  // PoolWalkers does, and when a walker has a vehicle's id.
+  void set_walkers(std::vector<WalkerSpec> specs);
+  const PoolWalkers* walkers() const { return walkers_ ? &*walkers_ : nullptr; }
+  // Pairs (pooled vehicle, walker) whose boxes overlap now.
+  std::vector<std::pair<uint32_t, uint32_t>> walker_overlaps() const;
 
  private:
   void validate();
@@ -133,6 +141,7 @@ class Pool {
   void plan_route(size_t i, uint32_t lane, double s);
   void update_pose(size_t i);
   void place_externals();
+  void step_walkers(double dt);
   void index_lane_points();
   void add_lane_entries(uint32_t e);
   void add_lane_entry(uint32_t e, uint32_t lane, double s_centre, double half_along, double v);
@@ -145,7 +154,9 @@ class Pool {
   size_t n_ = 0, grid_end_ = 0;
   std::vector<VehicleSpec> specs_;
   std::vector<ExternalUser> ext_;
-  std::vector<uint32_t> ext_of_;  // entry - n_ -> its external road user
+  std::vector<ExternalUser> obs_;  // the externals, then the walkers on crossing legs
+  std::vector<uint32_t> ext_of_;   // entry - n_ -> its obstacle (obs_)
+  std::optional<PoolWalkers> walkers_;
   // Lane sample points by 10 m cell (built on the first external): lane << 32 | pose index.
   std::vector<uint32_t> point_begin_;
   std::vector<uint64_t> points_;

@@ -1,11 +1,13 @@
-// External road users in the pool (the ego, agent engines' road users): obstacles it never
-// moves. Each step every external becomes one grid entry (its true box: junction look-ahead,
-// respawn checks, overlaps) and one lane entry on each lane its box reaches (within
-// kLaneReach m of the lane's centre line), placed at the box's extent along that lane and
-// moving at its speed along it (never backwards). Lane entries are what leaders, MOBIL's
-// neighbours, occupied junction lanes and free exits are read from.
+// External road users in the pool (the ego, agent engines' road users), and the crossings walkers
+// have stepped onto (PoolWalkers::crossing_box): obstacles the vehicles' step never moves. Each
+// step every external becomes one grid entry (its true box: junction look-ahead, respawn checks,
+// overlaps) and one lane entry on each lane its box reaches (within kLaneReach m of the lane's
+// centre line), placed at the box's extent along that lane and moving at its speed along it (never
+// backwards). Lane entries are what leaders, MOBIL's neighbours, occupied junction lanes and free
+// exits are read from.
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "traffic_pool/pool.h"
 
@@ -43,7 +45,7 @@ void Pool::index_lane_points() {
 }
 
 void Pool::add_lane_entry(uint32_t e, uint32_t lane, double s_centre, double half_along, double v) {
-  const ExternalUser& u = ext_[e];
+  const ExternalUser& u = obs_[e];
   VehicleSpec sp;
   sp.id = u.id;
   sp.length = 2 * half_along;  // its extent along the lane: the gap to it is measured so
@@ -63,8 +65,17 @@ void Pool::place_externals() {
   for (auto* a : {&s_, &v_, &x_, &y_, &yaw_}) a->resize(n_);
   specs_.resize(n_);
   ext_of_.clear();
-  for (uint32_t e = 0; e < ext_.size(); ++e) {  // grid entries
-    const ExternalUser& u = ext_[e];
+  obs_ = ext_;
+  if (walkers_) {
+    PoolWalkers::Box b;
+    for (size_t w = 0; w < walkers_->size(); ++w) {
+      if (walkers_->crossing_box(w, b)) {
+        obs_.push_back({walkers_->spec(w).id, b.x, b.y, b.yaw, 0, b.length, b.width});
+      }
+    }
+  }
+  for (uint32_t e = 0; e < obs_.size(); ++e) {  // grid entries
+    const ExternalUser& u = obs_[e];
     VehicleSpec sp;
     sp.id = u.id;
     sp.length = u.length;
@@ -79,15 +90,15 @@ void Pool::place_externals() {
     ext_of_.push_back(e);
   }
   grid_end_ = lane_.size();
-  if (ext_.empty()) return;
+  if (obs_.empty()) return;
   if (point_begin_.empty()) index_lane_points();
-  for (uint32_t e = 0; e < ext_.size(); ++e) add_lane_entries(e);
+  for (uint32_t e = 0; e < obs_.size(); ++e) add_lane_entries(e);
 }
 
 // A lane entry for external e on each lane whose centre line its box comes within kLaneReach
 // of (the lane's nearest sample point to its centre), its extent along the lane on the lane.
 void Pool::add_lane_entries(uint32_t e) {
-  const ExternalUser& u = ext_[e];
+  const ExternalUser& u = obs_[e];
   std::vector<std::pair<uint32_t, uint32_t>> nearest;  // (lane, pose index), one per lane
   std::vector<double> d2;
   {
@@ -134,6 +145,30 @@ void Pool::add_lane_entries(uint32_t e) {
       add_lane_entry(e, lane, s_centre, half_along, std::max(0.0, u.speed * std::cos(dyaw)));
     }
   }
+}
+
+void Pool::set_walkers(std::vector<WalkerSpec> specs) {
+  std::set<std::string> ids;
+  for (size_t i = 0; i < n_; ++i) ids.insert(specs_[i].id);
+  for (const WalkerSpec& w : specs) {
+    if (ids.count(w.id)) throw PoolError("road user '" + w.id + "' is listed twice");
+  }
+  walkers_.reset();
+  if (!specs.empty()) walkers_.emplace(net_, std::move(specs));
+}
+
+// The walkers' step, after the vehicles': the threats to a crossing are the pooled vehicles
+// (present) and the externals, found in the grid (built before the vehicles moved: 3 m more).
+void Pool::step_walkers(double dt) {
+  if (!walkers_) return;
+  walkers_->step(
+      dt, t_, [&](double x, double y, double r, std::vector<road_users::CrossingVehicle>& out) {
+        for_near(x, y, r + 3, [&](uint32_t k) {
+          if (k < n_ ? !present(k) : ext_of_[k - n_] >= ext_.size()) return;
+          if (std::hypot(x_[k] - x, y_[k] - y) > r) return;
+          out.push_back({x_[k], y_[k], yaw_[k], v_[k], specs_[k].length, specs_[k].width, 0.0});
+        });
+      });
 }
 
 }  // namespace convoy::traffic_pool

@@ -5,6 +5,7 @@
 #include <set>
 #include <sstream>
 
+#include "traffic_pool/draw.h"
 #include "traffic_pool/pool.h"
 
 namespace convoy::traffic_pool {
@@ -29,13 +30,6 @@ bool boxes_overlap(double ax, double ay, double ayaw, double al, double aw, doub
     }
   }
   return true;
-}
-
-uint64_t mix(uint64_t z) {
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
 }
 }  // namespace
 
@@ -278,13 +272,33 @@ std::vector<std::pair<uint32_t, uint32_t>> Pool::overlaps() const {
 std::vector<std::pair<uint32_t, uint32_t>> Pool::external_overlaps() const {
   std::vector<std::pair<uint32_t, uint32_t>> out;
   for (uint32_t k = static_cast<uint32_t>(n_); k < grid_end_; ++k) {
+    if (ext_of_[k - n_] >= ext_.size()) continue;  // a walker's
     const VehicleSpec& b = specs_[k];
     for_near(x_[k], y_[k], 0.5 * b.length + 8, [&](uint32_t i) {
-      if (i >= n_) return;
+      if (i >= n_ || !present(i)) return;
       const VehicleSpec& a = specs_[i];
       if (boxes_overlap(x_[i], y_[i], yaw_[i], a.length, a.width, x_[k], y_[k], yaw_[k], b.length,
                         b.width)) {
         out.emplace_back(i, ext_of_[k - n_]);
+      }
+    });
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> Pool::walker_overlaps() const {
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  if (!walkers_) return out;
+  const PoolWalkers& w = *walkers_;
+  for (uint32_t k = 0; k < w.size(); ++k) {
+    const WalkerSpec& b = w.spec(k);
+    for_near(w.x(k), w.y(k), 8, [&](uint32_t i) {
+      if (i >= n_ || !present(i)) return;
+      const VehicleSpec& a = specs_[i];
+      if (boxes_overlap(x_[i], y_[i], yaw_[i], a.length, a.width, w.x(k), w.y(k), w.yaw(k),
+                        b.length, b.width)) {
+        out.emplace_back(i, k);
       }
     });
   }
@@ -337,11 +351,7 @@ std::vector<VehicleSpec> spawn(const PoolNetwork& net, size_t count, uint64_t se
       << slots.size() << " vehicles " << spacing << " m apart";
     throw PoolError(m.str());
   }
-  uint64_t state = seed;
-  for (size_t k = slots.size(); k > 1; --k) {  // Fisher-Yates, by the seed
-    state = mix(state);
-    std::swap(slots[k - 1], slots[state % k]);
-  }
+  shuffle_by_seed(slots, seed);
   std::vector<VehicleSpec> out;
   out.reserve(count);
   for (size_t k = 0; k < count; ++k) {

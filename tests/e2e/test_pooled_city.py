@@ -167,7 +167,8 @@ class LargeCity(PooledCity):
         self.assertEqual(s["participants"]["road_user_pool"], 1)
         self.assertEqual(s["collisions"], [])
         self.assertGreater(s["camera_frames"], 60)
-        self.assertEqual(s["pooled_vehicles"], 1000)
+        self.assertEqual(s["pooled_vehicles"], 800)  # and 200 walkers: 1,000 road users
+        self.assertEqual(s["pooled_pedestrians"], 200)
         with open(os.path.join(run_dir, "tracks.jsonl")) as f:
             rows = [json.loads(line) for line in f]
         ego_x = [u[2] for r in rows for u in r["users"] if u[0] == "smart_car"]

@@ -1,10 +1,12 @@
 """The road_user_pool engine (issue 26's pooled host): N vehicles in one engine process.
 
 Runs: a pool of spawned and listed vehicles on tests/traffic_pool/data/grid3.xodr publishes one
-convoy.data.RoadUsers datapack with every vehicle each step, which a TF reads.
-BadInput: an unknown policy, two road users on one spot, a count the map cannot hold and a
-destination with no path each stop the run with one message naming the road user, and leave
-no engine process behind.
+convoy.data.RoadUsers datapack with every vehicle each step, which a TF reads; on the city map
+its walkers (Pedestrians) come after the vehicles, category pedestrian, model walker.
+BadInput: an unknown policy, two road users on one spot, a count the map cannot hold, a
+destination with no path, and pedestrians the sidewalks cannot hold (Pedestrians,
+PedestrianDensity) each stop the run with one message naming the road user or key and the
+capacity, and leave no engine process behind.
 """
 
 import json
@@ -15,6 +17,7 @@ import unittest
 from e2e_util import REPO, E2ETestCase
 
 GRID = os.path.join(REPO, "tests", "traffic_pool", "data", "grid3.xodr")
+CITY = os.path.join(REPO, "experiments", "city_traffic", "city.xodr")
 
 TF = textwrap.dedent("""\
     import json
@@ -34,6 +37,8 @@ TF = textwrap.dedent("""\
         _seen["ids"] = len(set(u.id for u in users))
         _seen["mine"] = [[u.x, u.y, u.speed, u.road, u.lane] for u in users if u.id == "pool/mine"]
         _seen["moving"] = sum(1 for u in users if u.speed > 0.5)
+        _seen["walkers"] = [[u.id, u.model, u.walk_phase, u.speed] for u in users
+                            if u.category == "pedestrian"]
         with open(OUT, "w") as f:
             json.dump(_seen, f)
         return []
@@ -48,23 +53,39 @@ def pool_config(**engine):
 
 
 class Runs(E2ETestCase):
-    def test_pool_publishes_every_vehicle(self):
+    def seen(self, **engine):
+        """What the TF saw of a run of the pool configured with `engine`."""
         out = os.path.join(self.dir, "seen.json")
         self.write("tf.py", TF.replace("OUT", repr(out)))
-        cfg = pool_config(Count=40, Seed=3,
-                          Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
-                                     "Speed": 5, "Policy": "idm"}])
+        cfg = pool_config(**engine)
         cfg["DataPackProcessingFunctions"] = [{"Name": "count", "FileName": "tf.py"}]
         self.write_config(cfg)
         r = self.run_convoy()
         self.assertExit(r, 0)
         with open(out) as f:
-            seen = json.load(f)
+            return json.load(f)
+
+    def test_pool_publishes_every_vehicle(self):
+        seen = self.seen(Count=40, Seed=3,
+                         Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
+                                    "Speed": 5, "Policy": "idm"}])
         self.assertGreaterEqual(seen["steps"], 50)
         self.assertEqual(seen["n"], 41)
         self.assertEqual(seen["ids"], 41)
         self.assertEqual(len(seen["mine"]), 1)
         self.assertGreater(seen["moving"], 10)
+        self.assertNoEngineLeft()
+
+
+    def test_pool_publishes_its_walkers(self):
+        seen = self.seen(Map=CITY, Count=20, Pedestrians=30, Seed=2)
+        self.assertEqual(seen["n"], 50)
+        walkers = seen["walkers"]
+        self.assertEqual(len(walkers), 30)
+        self.assertEqual(walkers[0][0], "pool/walker/0")
+        self.assertEqual({w[1] for w in walkers}, {"walker"})
+        self.assertTrue(all(0 <= w[2] < 1 for w in walkers))
+        self.assertGreater(sum(1 for w in walkers if w[3] > 1.0), 10)  # walking, 1.2-1.5 m/s
         self.assertNoEngineLeft()
 
 
@@ -89,6 +110,14 @@ class BadInput(E2ETestCase):
 
     def test_count_that_cannot_fit(self):
         self.bad("a count of 5000 cannot fit the network", Count=5000)
+
+    def test_pedestrians_that_cannot_fit(self):
+        self.bad("road user 'walker/", "a count of 100000 pedestrians cannot fit the map",
+                 "km of sidewalk hold at most", Map=CITY, Pedestrians=100000)
+
+    def test_pedestrian_density_that_cannot_fit(self):
+        self.bad("PedestrianDensity 1000 pedestrians/km cannot fit the map", "city.xodr",
+                 "km of sidewalk, which hold at most", Map=CITY, PedestrianDensity=1000)
 
     def test_route_with_no_path(self):
         self.bad("road user 'bus': no path from road '90' lane -1 to road 'nowhere' lane -1",

@@ -13,11 +13,6 @@
 namespace convoy::traffic_pool {
 namespace {
 
-const Map& city() {
-  static const Map* c = new Map(CONVOY_CITY_XODR);
-  return *c;
-}
-
 // An entry lane (no lane leads into it) and the exit lane reached by always taking next[0].
 std::pair<uint32_t, uint32_t> entry_and_exit(const PoolNetwork& net) {
   std::vector<uint8_t> led_into(net.lanes().size(), 0);

@@ -17,15 +17,6 @@
 namespace convoy::traffic_pool {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const PoolError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(PoolNetwork, LanesJunctionsConflicts) {
   const PoolNetwork& net = map().pool;
   ASSERT_GT(net.lanes().size(), 50u);

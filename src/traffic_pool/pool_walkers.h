@@ -1,0 +1,141 @@
+// Pooled pedestrians (issue 26's city): walkers on the map's sidewalk lanes (OpenDRIVE
+// type="sidewalk"), stepped with the pool's vehicles. The planning and crossing rules are
+// src/road_users' (pedestrian_walks.h, walker.h); this holds many walkers in one process.
+//
+// A walker makes trips: from where it stands it draws (by its seed) a crosswalk whose end it can
+// reach along the sidewalks (within 300 m when there is one, not the one it has just crossed),
+// walks there (road_users::walk), crosses to the far sidewalk and draws the next trip there. A
+// sidewalk with no crosswalk on reach: it walks on along the sidewalks (forks drawn). It walks
+// at its own speed (drawn 1.2-1.5 m/s), kept 0.55 m right of its path's centre (turning over
+// to it at a new trip's start), and never closer than 1 m behind a walker in its way going its
+// way (within 60 degrees), nor to one crossing its way at a walk; walkers facing it, or standing
+// across its way, are passed (two side by side, each in the other's way: the first goes). It steps
+// onto the road only at a crosswalk, from the curb, when
+//   - the lights let it: at a junction with lights, the crossed road's approach is red now and
+//     will still be red when it has crossed (the pool's LightCycle); no lights: gap only;
+//   - every vehicle (pooled or external) arrives at the line it walks its critical gap (drawn
+//     3.5-5 s) or more from now (road_users::gap_accepted; a vehicle's box counted longer by
+//     the walker's width + 0.6 m), and no moving vehicle comes within 8 m of the crossing;
+// and while crossing it waits before, or steps back out of, a lane a vehicle is about to pass
+// (road_users::crossing_limit). From the curb until it is off the road, the on-road part of its
+// crossing is a box the pool's vehicles stop before (crossing_box). walk_phase: distance walked
+// over its stride, mod 1.
+//
+// Deterministic: its draws come from its seed only (spawn_walkers: Seed, walker k Seed + k).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "opendrive/lane_graph.h"
+#include "road_users/pedestrian_walks.h"
+#include "road_users/walker.h"
+#include "traffic_pool/network.h"
+
+namespace convoy::traffic_pool {
+
+struct WalkerSpec {
+  std::string id;
+  opendrive::LaneIndex lane = opendrive::kNoLane;  // its start: a sidewalk lane of the graph
+  double s = 0;                                    // along the road's reference line
+  double speed = 1.35;                             // m/s
+  double gap = 4.0;                                // s: its critical gap
+  double length = 0.5, width = 0.6, height = 1.75, stride = 1.4;
+  uint64_t seed = 0;
+  std::string crosswalk;    // its first trip: over this crosswalk (the map's object id)
+  bool obey_lights = true;  // false: it crosses on the gap alone
+};
+
+struct WalkerStats {
+  uint64_t trips = 0, crossings = 0, respawns = 0;
+};
+
+// Sidewalk lanes' length, km (what a pedestrian density is per).
+double sidewalk_km(const PoolNetwork& net);
+// How many walkers spawn_walkers can place: slots kWalkerSpacing m apart on the sidewalks.
+inline constexpr double kWalkerSpacing = 4.0;
+size_t walker_capacity(const PoolNetwork& net, const std::vector<ClearZone>& keep_clear = {});
+// `count` walkers (ids "<prefix><k>", seeds seed + k, speeds and gaps drawn from them) on free
+// slots of the sidewalks, drawn by `seed`. Throws PoolError when they hold fewer than `count`.
+std::vector<WalkerSpec> spawn_walkers(const PoolNetwork& net, size_t count, uint64_t seed,
+                                      const std::string& prefix = "walker/",
+                                      const std::vector<ClearZone>& keep_clear = {});
+
+class PoolWalkers {
+ public:
+  // Throws PoolError naming the walker: a start off the sidewalks, an id twice, a size, speed
+  // or gap that is not positive, a crosswalk the map does not have (with sidewalks at both
+  // ends) or that its start cannot reach along the sidewalks.
+  PoolWalkers(const PoolNetwork& net, std::vector<WalkerSpec> specs);
+  // The vehicles within r m of (x, y): appended to `out`.
+  using VehiclesNear =
+      std::function<void(double x, double y, double r, std::vector<road_users::CrossingVehicle>&)>;
+  // One step of dt s at pool time t (the lights' clock).
+  void step(double dt, double t, const VehiclesNear& vehicles);
+  size_t size() const { return w_.size(); }
+  const WalkerSpec& spec(size_t i) const { return specs_[i]; }
+  double x(size_t i) const { return w_[i].x; }
+  double y(size_t i) const { return w_[i].y; }
+  double yaw(size_t i) const { return w_[i].yaw; }
+  double speed(size_t i) const { return w_[i].v; }
+  double acceleration(size_t i) const { return w_[i].acc; }
+  double walk_phase(size_t i) const;
+  // On its crossing leg (from sidewalk centre to sidewalk centre), and off the sidewalks.
+  bool crossing(size_t i) const;
+  bool on_road(size_t i) const;
+  // While it has stepped onto a crossing and not yet left the road: the box vehicles keep out
+  // of, the part of its crossing line on the road, as wide as the walkers on it keep right.
+  struct Box {
+    double x = 0, y = 0, yaw = 0, length = 0, width = 0;
+  };
+  bool crossing_box(size_t i, Box& box) const;
+  const road_users::WalkPath& path(size_t i) const { return w_[i].path; }
+  const WalkerStats& stats() const { return stats_; }
+
+ private:
+  struct Walker {
+    road_users::WalkPath path;
+    double arc = 0, v = 0, acc = 0, walked = 0, x = 0, y = 0, yaw = 0;
+    double ox = 0, oy = 0;        // its offset from its path's centre
+    size_t committed = SIZE_MAX;  // the crossing it has stepped onto
+    uint64_t rng = 0;
+    int last_crosswalk = -1;
+  };
+  struct CrosswalkInfo {
+    size_t graph_index = 0;
+    int junction = -1, group = -1;  // the lights of the crossed road's approach (-1: none)
+    double x = 0, y = 0;            // its centre
+  };
+  void index_sidewalks();
+  void plan_trip(size_t i, road_users::Spot from);
+  void first_trip(size_t i);
+  bool plan_crossing(size_t i, road_users::Spot from, int cw);
+  void walk_on(size_t i, double x, double y, double yaw, bool may_respawn = true);
+  void index_walkers();
+  void step_walker(size_t i, double dt, double t, const VehiclesNear& vehicles);
+  bool may_step_on(size_t i, const road_users::WalkCrossing& c, double t,
+                   const VehiclesNear& vehicles);
+  std::vector<road_users::CrossingThreat> threats(size_t i, const road_users::WalkCrossing& c,
+                                                  const VehiclesNear& vehicles,
+                                                  double* nearest_moving = nullptr) const;
+  double pace_behind_walkers(size_t i, double v) const;
+  const road_users::WalkCrossing* current_crossing(size_t i) const;
+  double keep_right(size_t i) const;  // m right of its path
+  void place(size_t i, double moved);
+
+  const PoolNetwork& net_;
+  std::vector<WalkerSpec> specs_;
+  std::vector<Walker> w_;
+  std::vector<int> component_;             // per graph lane: its sidewalk network, -1 none
+  std::vector<CrosswalkInfo> crosswalks_;  // with a sidewalk at both ends
+  std::vector<std::vector<int>> reach_;    // per component: crosswalks an end of lies on it
+  // Walkers by 5 m cell (rebuilt each step): cell heads and a chain.
+  double min_x_ = 0, min_y_ = 0;
+  int gx_ = 1, gy_ = 1;
+  std::vector<uint32_t> head_, chain_;
+  WalkerStats stats_;
+};
+
+}  // namespace convoy::traffic_pool
