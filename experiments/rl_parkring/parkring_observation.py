@@ -25,14 +25,38 @@ track = None
 
 def distance_to_path(points, index, x, y):
     """The distance from the route's segments near the target waypoint `index`."""
-    near = [points[i % len(points)] for i in range(max(index - 2, 0), index + 3)]
+    n = len(points)
+    segments = _segments(points)
     best = math.inf
-    for (ax, ay), (bx, by) in zip(near, near[1:]):
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        u = 0.0 if length2 == 0 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / length2))
-        best = min(best, math.hypot(ax + u * dx - x, ay + u * dy - y))
+    for i in range(max(index - 2, 0), index + 2):
+        ax, ay, dx, dy, length2 = segments[i % n]
+        u = 0.0
+        if length2 != 0:  # u = max(0.0, min(1.0, ...)), as the builtins choose
+            u = ((x - ax) * dx + (y - ay) * dy) / length2
+            u = u if u < 1.0 else 1.0
+            u = u if u > 0.0 else 0.0
+        d = math.hypot(ax + u * dx - x, ay + u * dy - y)
+        if d < best:
+            best = d
     return best
+
+
+_segments_of = (None, None)  # (the points, their segments)
+
+
+def _segments(points):
+    """[(ax, ay, dx, dy, dx * dx + dy * dy)] of the segment from each point to the next (the
+    last to the first), computed once per list of points."""
+    global _segments_of
+    if _segments_of[0] is not points:
+        n = len(points)
+        out = []
+        for i, (ax, ay) in enumerate(points):
+            bx, by = points[(i + 1) % n]
+            dx, dy = bx - ax, by - ay
+            out.append((ax, ay, dx, dy, dx * dx + dy * dy))
+        _segments_of = (points, out)
+    return _segments_of[1]
 
 
 def route_ahead(points, index, x, y, yaw):
@@ -54,11 +78,14 @@ def observation(car, iteration, time_ns):
         track = relateAngle_computation.Trajectory()
     if car.isEmpty():
         return True, []
-    x, y = float(car.data.pos[0]), float(car.data.pos[1])
-    _, _, yaw = euler_from_quaternion(*[float(v) for v in car.data.rot])
+    link = car.data
+    # tolist(): the float32 values as Python floats at once (what float() of each gives)
+    x, y = link.pos.tolist()[:2]
+    _, _, yaw = euler_from_quaternion(*link.rot.tolist())
     heading_error, _ = track.update(x, y, yaw)
     off_path = distance_to_path(track.points, track.index, x, y)
-    speed = math.hypot(float(car.data.lin_vel[0]), float(car.data.lin_vel[1]))
+    vx, vy = link.lin_vel.tolist()[:2]
+    speed = math.hypot(vx, vy)
     return True, [JsonRawData({
         "t": time_ns * 1e-9, "x": x, "y": y, "yaw": yaw, "speed": speed,
         "heading_error": heading_error, "off_path": off_path,

@@ -72,6 +72,10 @@ WHEEL_JOINTS = ("smart_car_joint_plugin::rear_left_wheel_joint",
 CAR_JOINTS = STEERING_JOINTS + WHEEL_JOINTS
 WHEEL_RADIUS = 0.3  # m
 JOINT_TYPE = "convoy.data.Joint"  # GazeboJointDataPack's message
+# The status function's observation's keys (checked every step)
+RAW_KEYS = ("x", "y", "yaw", "speed", "heading_error", "off_path", "waypoint", "waypoints",
+            "episode_over")
+_RAW_KEY_SET = frozenset(RAW_KEYS)
 
 
 def default_reward(before, after, action):
@@ -179,6 +183,9 @@ class DrivingEnv(ClosesOnExit):
         self._pending = None  # the action step_begin() sent
         self.action_space = spaces.Box(low=np.array([-MAX_STEER, 0.0]),
                                        high=np.array([MAX_STEER, MAX_SPEED]), dtype=np.float32)
+        # The action's bounds as floats, for the check of every step
+        self._action_bounds = tuple(zip(self.action_space.low.tolist(),
+                                        self.action_space.high.tolist()))
         self.np_random = np.random.Generator(np.random.PCG64())
         self._raw = None
         self._steps = 0
@@ -308,6 +315,10 @@ class DrivingEnv(ClosesOnExit):
         if a.shape != self.action_space.shape:
             raise ValueError("action %r has shape %s, the action space %s"
                              % (action, a.shape, self.action_space.shape))
+        (steer_low, steer_high), (speed_low, speed_high) = self._action_bounds
+        steer, speed = a.tolist()
+        if steer_low <= steer <= steer_high and speed_low <= speed <= speed_high:
+            return a  # (NaN fails the comparisons: named below)
         for i, name in enumerate(ACTION_NAMES):
             low, high = float(self.action_space.low[i]), float(self.action_space.high[i])
             if not np.isfinite(a[i]):
@@ -327,12 +338,12 @@ class DrivingEnv(ClosesOnExit):
         if self._agent:
             nrp.set_json_datapack("action", "agent", {"steer": steer, "speed": speed})
             return
-        steer = max(-MAX_STEER, min(MAX_STEER, steer))
+        steering = self._joint(position=max(-MAX_STEER, min(MAX_STEER, steer)))
         for name in STEERING_JOINTS:
-            nrp.set_proto_datapack(name, WORLD_ENGINE, self._joint(position=steer))
-        omega = speed / WHEEL_RADIUS
+            nrp.set_proto_datapack(name, WORLD_ENGINE, steering)
+        wheels = self._joint(velocity=speed / WHEEL_RADIUS)
         for name in WHEEL_JOINTS:
-            nrp.set_proto_datapack(name, WORLD_ENGINE, self._joint(velocity=omega))
+            nrp.set_proto_datapack(name, WORLD_ENGINE, wheels)
 
     def _run(self, steer, speed):
         self._set_action(steer, speed)
@@ -341,6 +352,10 @@ class DrivingEnv(ClosesOnExit):
     def _observed(self, observations):
         """The status function's observation dict among a step's `observations` (and the
         camera frame taken from them)."""
+        if self.camera is None and len(observations) == 1 and type(observations[0]) is dict:
+            raw = observations[0]  # the usual step: one observation (checked as below)
+            if _RAW_KEY_SET.issubset(raw):
+                return raw
         dicts = [o for o in observations if isinstance(o, dict)]
         if self.camera is not None and (dicts or self._frame is None):
             self._take_frame([o for o in observations if not isinstance(o, dict)])
@@ -350,8 +365,7 @@ class DrivingEnv(ClosesOnExit):
                                    "(%s)" % self.config)
             return self._raw
         raw = dicts[-1]
-        missing = [k for k in ("x", "y", "yaw", "speed", "heading_error", "off_path",
-                               "waypoint", "waypoints", "episode_over") if k not in raw]
+        missing = [k for k in RAW_KEYS if k not in raw]
         if missing:
             raise KeyError("DrivingEnv: the status function of %s returned no %s"
                            % (self.config, ", ".join(missing)))

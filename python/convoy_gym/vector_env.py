@@ -363,12 +363,27 @@ def _add_info(infos, info, i, n):
                     array = np.full(n, None, dtype=object)
                 infos[key] = array
             if array.dtype != object:
-                kind = np.asarray(value).dtype.kind if np.isscalar(value) else "O"
+                kind = _kind(value)
                 if kind not in "biuf" or "biuf".index(kind) > "biuf".index(array.dtype.kind):
                     # another type than the first env's: widen (never truncate)
                     array = infos[key] = array.astype(object if kind not in "biuf"
                                                       else np.float64 if kind == "f"
                                                       else np.int64)
             array[i] = value
-        mask = infos.setdefault("_" + key, np.zeros(n, dtype=bool))
+        mask = infos.get("_" + key)
+        if mask is None:
+            mask = infos["_" + key] = np.zeros(n, dtype=bool)
         mask[i] = True
+
+
+def _kind(value):
+    """numpy's dtype kind of a scalar `value` ("O" if not a scalar), the usual Python
+    numbers without asking numpy (an int that int64 holds is "i", as numpy makes it)."""
+    t = type(value)
+    if t is float:
+        return "f"
+    if t is bool:
+        return "b"
+    if t is int and -(1 << 63) <= value < (1 << 63):
+        return "i"
+    return np.asarray(value).dtype.kind if np.isscalar(value) else "O"

@@ -35,13 +35,17 @@ import weakref
 import grpc
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory, symbol_database
 
-from nrp_client import _local
+from nrp_client import _local, _wire
 from nrp_client import nrp_server_pb2 as _pb
 
 __all__ = ["NrpCore", "NrpCoreError"]
 
 _REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 _SERVICE = "/NrpCore.NrpCore/"
+_JSON_TYPE = _pb.JsonMessage.DESCRIPTOR.full_name
+_JSON_URL = _wire.TYPE_URL_PREFIX + _JSON_TYPE
+_CALL_NAMES = {"runLoop": "run_loop()", "runUntilTimeout": "run_until_timeout()",
+               "stopLoop": "stop()"}
 
 
 class NrpCoreError(RuntimeError):
@@ -262,8 +266,7 @@ class NrpCore:
         With run_async, returns a started Thread, which appends (done, data) to `response`."""
         if not isinstance(num_iterations, int) or num_iterations < 0:
             raise ValueError("num_iterations must be an int >= 0, got %r" % (num_iterations,))
-        message = _pb.RunLoopMessage(numIterations=num_iterations)
-        self._move_datapacks(message.dataPacks)
+        message = self._run_loop_request(num_iterations)
         if run_async:
             return self._async(lambda: self._run_loop(message), response)
         return self._run_loop(message)
@@ -277,8 +280,7 @@ class NrpCore:
             raise NrpCoreError("run_loop_begin(): needs NrpCore(local_channel=True)")
         if not isinstance(num_iterations, int) or num_iterations < 0:
             raise ValueError("num_iterations must be an int >= 0, got %r" % (num_iterations,))
-        message = _pb.RunLoopMessage(numIterations=num_iterations)
-        self._move_datapacks(message.dataPacks)
+        message = self._run_loop_request(num_iterations)
         self._checked("runLoop", lambda: self._local.begin("runLoop", message))
 
     def run_loop_finish(self):
@@ -306,7 +308,7 @@ class NrpCore:
         engines and the loop (time 0, iteration 0). Returns the datapacks the functions read,
         after the reset."""
         message = _pb.ResetMessage()
-        self._move_datapacks(message.dataPacks)
+        message.dataPacks.MergeFromString(self._take_datapacks())
         response = self._call("reset", message)
         return self._read_trajectory(response.trajectory)
 
@@ -327,20 +329,15 @@ class NrpCore:
         reset()."""
         if not hasattr(payload, "DESCRIPTOR"):
             raise TypeError("payload must be a protobuf message, got %s" % type(payload).__name__)
-        dp = _pb.DataPackMessage()
-        dp.dataPackId.dataPackName = datapack_name
-        dp.dataPackId.engineName = engine_name
-        dp.data.Pack(payload)
-        self._proto_out.append(dp)
+        self._proto_out.append(_wire.datapack(datapack_name, engine_name,
+                                              payload.DESCRIPTOR.full_name,
+                                              payload.SerializeToString()))
 
     def set_json_datapack(self, datapack_name, engine_name, payload):
         """A JSON value (a dict, usually) for engine `engine_name`, sent with the next
         run_loop() or reset()."""
-        dp = _pb.DataPackMessage()
-        dp.dataPackId.dataPackName = datapack_name
-        dp.dataPackId.engineName = engine_name
-        dp.data.Pack(_pb.JsonMessage(data=json.dumps(payload)))
-        self._json_out.append(dp)
+        text = _pb.JsonMessage(data=json.dumps(payload)).SerializeToString()
+        self._json_out.append(_wire.datapack(datapack_name, engine_name, _JSON_TYPE, text))
 
     def __del__(self):
         try:
@@ -379,10 +376,16 @@ class NrpCore:
         self._calls["runLoop"] = self._local.callable("runLoop", _pb.RunLoopResponse)
         self._calls["reset"] = self._local.callable("reset", _pb.ResetResponse)
 
-    def _move_datapacks(self, datapacks):
-        datapacks.jsonDataPacks.extend(self._json_out)
-        datapacks.protoDataPacks.extend(self._proto_out)
+    def _take_datapacks(self):
+        """The DataPacks message's bytes of the datapacks set since the last call."""
+        out = _wire.datapacks(self._json_out, self._proto_out)
         self._json_out, self._proto_out = [], []
+        return out
+
+    def _run_loop_request(self, num_iterations):
+        """The RunLoopMessage with the datapacks set: its bytes for the local channel."""
+        request = _wire.run_loop_message(num_iterations, self._take_datapacks())
+        return request if self._local is not None else _pb.RunLoopMessage.FromString(request)
 
     def _run_loop(self, message):
         r = self._call("runLoop", message)
@@ -404,8 +407,7 @@ class NrpCore:
     def _checked(self, method, call, keep_state=False):
         """call()'s response, its errors raised as NrpCoreError / ConnectionError, the
         simulation's state noted from it (a call that returns None: only sent)."""
-        what = {"runLoop": "run_loop()", "runUntilTimeout": "run_until_timeout()",
-                "stopLoop": "stop()"}.get(method, method + "()")
+        what = _CALL_NAMES.get(method) or method + "()"
         if self._closed:
             raise NrpCoreError("%s: this client was shut down; make a new NrpCore" % what)
         try:
@@ -459,8 +461,12 @@ class NrpCore:
         items = [None] * (len(trajectory.jsonTrajectoryMessages) +
                           len(trajectory.protoTrajectoryMessages))
         for m in trajectory.jsonTrajectoryMessages:
-            text = _pb.JsonMessage()
-            m.data.Unpack(text)
+            data = m.data
+            if data.type_url == _JSON_URL:  # what the server sends (else Unpack's check)
+                text = _pb.JsonMessage.FromString(data.value)
+            else:
+                text = _pb.JsonMessage()
+                data.Unpack(text)
             items[m.dataIndex] = json.loads(text.data)
         for m in trajectory.protoTrajectoryMessages:
             message = self._message_class(m.data.TypeName())()

@@ -51,12 +51,15 @@ class LocalChannel:
                 time.sleep(0.005)
         self._sock = sock
         self._lock = threading.Lock()
+        self._buffer = bytearray(1 << 16)  # what _receive() has read (grown for larger frames)
+        self._view = memoryview(self._buffer)
+        self._have = 0  # bytes of it read and not yet returned
 
     def callable(self, method, response_class):
         index = bytes([METHODS.index(method)])
 
         def call(request, timeout=None):
-            payload = self._call(index + request.SerializeToString())
+            payload = self._call(index + _serialized(request))
             return response_class.FromString(payload)
         return call
 
@@ -66,7 +69,7 @@ class LocalChannel:
         thread can have calls to several servers in flight at once."""
         self._lock.acquire()
         try:
-            self._send(bytes([METHODS.index(method)]) + request.SerializeToString())
+            self._send(bytes([METHODS.index(method)]) + _serialized(request))
         except BaseException:
             self._lock.release()
             raise
@@ -102,8 +105,7 @@ class LocalChannel:
         if self._sock is None:
             raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "the local channel is closed")
         try:
-            (n,) = _LEN.unpack(self._recv(4))
-            return self._recv(n)
+            return self._frame()
         except OSError as e:
             raise LocalRpcError(grpc.StatusCode.UNAVAILABLE, "local socket: %s" % e) from None
 
@@ -117,15 +119,33 @@ class LocalChannel:
             raise LocalRpcError(code, reply[1:].decode("utf-8", "replace"))
         return reply[1:]
 
-    def _recv(self, n):
-        view = memoryview(bytearray(n))
-        got = 0
-        while got < n:
-            k = self._sock.recv_into(view[got:], n - got)
+    def _frame(self):
+        """The next frame's bytes, read in as few calls as the socket allows (usually one:
+        the length and the reply together)."""
+        while True:
+            have = self._have
+            if have >= 4:
+                end = 4 + _LEN.unpack_from(self._buffer)[0]
+                if have >= end:
+                    frame = bytes(self._view[4:end])
+                    if have > end:  # the start of a next frame (the server sends none unasked)
+                        rest = bytes(self._view[end:have])
+                        self._buffer[:len(rest)] = rest
+                    self._have = have - end
+                    return frame
+                if end > len(self._buffer):
+                    self._view.release()
+                    self._buffer = self._buffer[:have] + bytearray(end - have)
+                    self._view = memoryview(self._buffer)
+            k = self._sock.recv_into(self._view[have:])
             if k == 0:
                 raise OSError("the server closed the connection")
-            got += k
-        return bytes(view) if n else b""
+            self._have = have + k
+
+
+def _serialized(request):
+    """A request's bytes: bytes as they are (nrp_client's _wire), else the message's."""
+    return request if isinstance(request, bytes) else request.SerializeToString()
 
 
 def socket_path(folder):

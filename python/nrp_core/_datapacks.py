@@ -76,6 +76,15 @@ class DataPack:
                                  ", empty" if self._data is None else "")
 
 
+def _received(cls, name, engine_name, data):
+    """A datapack of class `cls` holding an engine's `data`, as Convoy hands it to a function:
+    DataPack.__init__'s fields without the class's default data, which `data` replaces."""
+    dp = object.__new__(cls)
+    dp._id = DataPackIdentifier(name, engine_name, cls._type)
+    dp._data = data
+    return dp
+
+
 class JsonDataPack(DataPack):
     """A datapack whose data is a JSON value (a dict, usually). numpy arrays are allowed
     inside and travel as binary blobs."""

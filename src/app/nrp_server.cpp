@@ -80,7 +80,7 @@ void to_client(const engine::DataPack& dp, ::NrpCore::TrajectoryMessage* out) {
   auto* any = out->mutable_data();
   if (view.is_json()) {
     ::NrpCore::JsonMessage json;
-    json.set_data(datapack::read_json(view).dump());
+    json.set_data(datapack::json_text(view));
     any->PackFrom(json);
     return;
   }
@@ -109,7 +109,19 @@ void to_client(const engine::DataPack& dp, ::NrpCore::TrajectoryMessage* out) {
 NrpServer::NrpServer(const config::SimulationConfig& cfg, fs::path run_dir, RunLog& log)
     : cfg_(cfg), run_dir_(std::move(run_dir)), log_(log) {}
 
-NrpServer::~NrpServer() = default;
+NrpServer::~NrpServer() { stop_local(); }
+
+void NrpServer::stop_local() {
+  if (!local_) return;
+  // Its thread takes the GIL to drop its thread state as it ends: a caller holding the GIL
+  // lets it go meanwhile.
+  if (Py_IsInitialized() && PyGILState_Check()) {
+    py::gil_scoped_release release;
+    local_.reset();
+  } else {
+    local_.reset();
+  }
+}
 
 const char* NrpServer::name(State s) {
   switch (s) {
@@ -150,10 +162,22 @@ void NrpServer::listen(const std::string& address, bool insecure) {
 }
 
 void NrpServer::listen_local(const std::string& path) {
+  // The serving thread keeps one Python thread state for its life: without it each call's
+  // GIL acquisition (request()) made and freed a thread state, its frame stack mapped and
+  // unmapped, every step.
+  const auto with_thread_state = [](const std::function<void()>& body) {
+    py::gil_scoped_acquire gil;
+    py::gil_scoped_release release;  // keeps the thread state, frees the GIL between calls
+    body();
+  };
+  // pybind11's state is made on first use: here, by this thread (which holds the GIL), not by
+  // the serving thread racing the first use of this one.
+  py::detail::get_internals();
   try {
     local_ = std::make_unique<transport::LocalRpcServer>(
         path,
-        [this](uint8_t method, const std::string& request) { return local_call(method, request); });
+        [this](uint8_t method, const std::string& request) { return local_call(method, request); },
+        with_thread_state);
   } catch (const std::runtime_error& e) {
     throw UserError(std::string("--local_socket: ") + e.what());
   }
@@ -238,7 +262,7 @@ void NrpServer::run_in_main_thread(const std::function<void()>& job) {
 
 void NrpServer::stop_serving() {
   stop_ = true;
-  local_.reset();
+  stop_local();
   if (server_) server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
 }
 

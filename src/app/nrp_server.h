@@ -87,6 +87,8 @@ class NrpServer final : public NrpCore::NrpCore::Service {
   void run_in_main_thread(const std::function<void()>& job);
   // Throws std::invalid_argument unless the datapack names an engine of the simulation.
   void check_engine(const engine::DataPack& dp) const;
+  // Ends the local socket's serving thread (with or without the GIL held).
+  void stop_local();
 
   const config::SimulationConfig& cfg_;
   std::filesystem::path run_dir_;

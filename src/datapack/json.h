@@ -20,6 +20,14 @@ void write_json(Builder& out, const nlohmann::json& value);
 // Throws std::runtime_error naming the datapack unless it holds a JSON value.
 nlohmann::json read_json(const View& in);
 
+// The JSON text of the datapack's value: read_json(in).dump()'s, written straight from the
+// MessagePack bytes when they hold only what JSON has (msgpack_json.cpp), else that way.
+std::string json_text(const View& in);
+// That text of the MessagePack value `msgpack`; false (and `out` unspecified) when it holds
+// binary or extension values, non-ASCII strings, non-string keys, nesting deeper than 63
+// levels, or is malformed: the cases left to nlohmann.
+bool msgpack_json_text(std::string_view msgpack, std::string* out);
+
 // A numpy array as a JSON value (nlohmann binary with the ext type as subtype): its bytes
 // inline when small, else in a blob of `out`.
 nlohmann::json ndarray_json(Builder& out, std::string_view dtype, std::span<const uint64_t> shape,
