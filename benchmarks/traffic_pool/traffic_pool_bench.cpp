@@ -7,7 +7,10 @@
 //   traffic_pool_bench MAP.xodr [--counts 1000,5000,10000] [--seconds 60] [--dt 0.05]
 //                      [--seed 1] [--walkers W]
 // --walkers W adds W pooled walkers (spawn_walkers, the same seed) and prints their trips,
-// crossings and the vehicle-walker collisions (a vehicle's box beginning to overlap a walker's).
+// crossings, mean speed (at the end and over the run), how many are on the road at the end (and
+// standing there), the vehicle-walker collisions (a vehicle's box beginning to overlap a
+// walker's) and the walker-walker ones (two walkers' boxes, length x width along their yaw as
+// the world engine's pedestrian collision box, beginning to overlap).
 // Last line: `pool step alone at real time: N` (the largest N with a factor >= 1).
 //
 // With --flows FILE the vehicles come from flows instead of a count (flow_run.h; used by
@@ -57,17 +60,22 @@ size_t run_counts(const tp::PoolNetwork& net, const std::string& counts, double 
     tp::VehicleSpec base;
     tp::Pool pool(net, tp::spawn(net, n, seed, base));
     if (walkers > 0) pool.set_walkers(tp::spawn_walkers(net, walkers, seed));
-    std::set<std::pair<uint32_t, uint32_t>> touching, touching_walkers;
-    size_t collisions = 0, walker_collisions = 0;
+    std::set<std::pair<uint32_t, uint32_t>> touching, touching_walkers, touching_ww;
+    size_t collisions = 0, walker_collisions = 0, ww_collisions = 0;
     const int steps = static_cast<int>(seconds / dt + 0.5);
-    double step_wall = 0, check_wall = 0, speed_sum = 0;
+    double step_wall = 0, check_wall = 0, speed_sum = 0, walker_speed_sum = 0, walker_samples = 0;
     for (int k = 0; k < steps; ++k) {
       const auto t0 = Clock::now();
       pool.step(dt);
       const auto t1 = Clock::now();
       collisions += new_contacts(pool.overlaps(), touching);
       walker_collisions += new_contacts(pool.walker_overlaps(), touching_walkers);
+      if (pool.walkers()) ww_collisions += new_contacts(pool.walkers()->overlaps(), touching_ww);
       check_wall += std::chrono::duration<double>(Clock::now() - t1).count();
+      if (const tp::PoolWalkers* w = pool.walkers()) {
+        for (size_t i = 0; i < w->size(); ++i) walker_speed_sum += w->speed(i);
+        walker_samples += static_cast<double>(w->size());
+      }
       step_wall += std::chrono::duration<double>(t1 - t0).count();
     }
     for (size_t i = 0; i < pool.size(); ++i) speed_sum += pool.speed(i);
@@ -83,14 +91,21 @@ size_t run_counts(const tp::PoolNetwork& net, const std::string& counts, double 
         1e3 * check_wall / steps);
     if (const tp::PoolWalkers* w = pool.walkers()) {
       double walked = 0;
-      for (size_t i = 0; i < w->size(); ++i) walked += w->speed(i);
+      size_t on_road = 0, stopped_on_road = 0;
+      for (size_t i = 0; i < w->size(); ++i) {
+        walked += w->speed(i);
+        on_road += w->on_road(i);
+        stopped_on_road += w->on_road(i) && w->speed(i) < 0.05;
+      }
       std::printf(
           "    walkers %zu: trips %llu, crossings %llu, respawns %llu, mean speed at the end "
-          "%.2f m/s; vehicle-walker collisions %zu\n",
+          "%.2f m/s (mean over the run %.2f), on the road at the end %zu (standing %zu); "
+          "vehicle-walker collisions %zu, walker-walker collisions %zu\n",
           w->size(), static_cast<unsigned long long>(w->stats().trips),
           static_cast<unsigned long long>(w->stats().crossings),
           static_cast<unsigned long long>(w->stats().respawns),
-          walked / static_cast<double>(w->size()), walker_collisions);
+          walked / static_cast<double>(w->size()), walker_speed_sum / walker_samples, on_road,
+          stopped_on_road, walker_collisions, ww_collisions);
     }
     std::fflush(stdout);
     if (rtf >= 1.0) best = std::max(best, n);

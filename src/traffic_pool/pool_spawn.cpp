@@ -12,6 +12,7 @@ namespace convoy::traffic_pool {
 
 namespace {
 std::string who(const VehicleSpec& v) { return "road user '" + v.id + "'"; }
+}  // namespace
 
 bool boxes_overlap(double ax, double ay, double ayaw, double al, double aw, double bx, double by,
                    double byaw, double bl, double bw) {
@@ -31,7 +32,6 @@ bool boxes_overlap(double ax, double ay, double ayaw, double al, double aw, doub
   }
   return true;
 }
-}  // namespace
 
 Pool::Pool(const PoolNetwork& net, std::vector<VehicleSpec> specs, double cell_m)
     : net_(net), specs_(std::move(specs)), cell_(cell_m) {

@@ -14,13 +14,10 @@ namespace ru = convoy::road_users;
 
 namespace {
 constexpr double kCell = 5;           // m: the walkers' grid
-constexpr double kFollowGap = 1.0;    // m: closer than this behind a walker, it keeps its pace
 constexpr double kThreatRadius = 70;  // m around a crossing: vehicles that may threaten it
 constexpr double kKeepOff = 8;        // m: no moving vehicle this near when it steps on
 constexpr double kEaseRate = 0.5;     // m its offset from its path turns per m walked
 constexpr double kBodyMargin = 0.3;   // m kept between its body and a vehicle's front
-constexpr double kMoving = 0.3;       // m/s: a walker crossing its path this fast is let pass
-constexpr double kSameWay = 0.5;      // cos of the most a walker followed heads off its way
 const ru::CrossingCaution kCaution{8, 4};
 
 // Distance from vehicle v's box to the segment a-b when the segment's nearest point is not
@@ -72,23 +69,36 @@ bool PoolWalkers::crossing_box(size_t i, Box& box) const {
 double PoolWalkers::keep_right(size_t i) const {
   const Walker& w = w_[i];
   const double h = w.path.at(w.arc).heading;
-  return w.ox * std::sin(h) - w.oy * std::cos(h);
+  return w.ox * std::sin(h) - w.oy * std::cos(h) + w.dodge;
 }
 
-// Its pose at its arc, kKeepRight right of the path: its offset from the path turns towards that
-// by kEaseRate m per m it has `moved` (so a new trip's path does not make it jump).
-void PoolWalkers::place(size_t i, double moved) {
-  Walker& w = w_[i];
-  const odr::Pose2 p = w.path.at(w.arc);
-  const double tx = ru::kKeepRight * std::sin(p.heading),
-               ty = -ru::kKeepRight * std::cos(p.heading);
+// Its pose at `arc`, kKeepRight right of the path and `dodge` further: its offset from the path
+// turns towards kKeepRight by kEaseRate m per m it has `moved` (a new trip's path does not make
+// it jump).
+PoolWalkers::Placed PoolWalkers::placed(size_t i, double arc, double dodge, double moved) const {
+  const Walker& w = w_[i];
+  const odr::Pose2 p = w.path.at(arc);
+  const double sn = std::sin(p.heading), cs = std::cos(p.heading);
+  const double tx = ru::kKeepRight * sn, ty = -ru::kKeepRight * cs;
   const double dx = tx - w.ox, dy = ty - w.oy, d = std::hypot(dx, dy), turn = kEaseRate * moved;
   const double f = d > turn ? turn / d : 1.0;
-  w.ox += f * dx;
-  w.oy += f * dy;
-  w.x = p.x + w.ox;
-  w.y = p.y + w.oy;
-  if (w.path.poses.size() > 1) w.yaw = p.heading;
+  Placed out;
+  out.ox = w.ox + f * dx;
+  out.oy = w.oy + f * dy;
+  out.x = p.x + out.ox + dodge * sn;
+  out.y = p.y + out.oy - dodge * cs;
+  out.yaw = w.path.poses.size() > 1 ? p.heading : w.yaw;
+  return out;
+}
+
+void PoolWalkers::place(size_t i, double moved) {
+  Walker& w = w_[i];
+  const Placed p = placed(i, w.arc, w.dodge, moved);
+  w.ox = p.ox;
+  w.oy = p.oy;
+  w.x = p.x;
+  w.y = p.y;
+  w.yaw = p.yaw;
 }
 
 void PoolWalkers::index_walkers() {
@@ -107,33 +117,6 @@ void PoolWalkers::index_walkers() {
     chain_[i] = head_[c];
     head_[c] = i;
   }
-}
-
-// The pace it may keep behind the walkers in its way going its way (within one cell round it).
-double PoolWalkers::pace_behind_walkers(size_t i, double v) const {
-  const Walker& w = w_[i];
-  const int cx = std::clamp(static_cast<int>((w.x - min_x_) / kCell), 0, gx_ - 1);
-  const int cy = std::clamp(static_cast<int>((w.y - min_y_) / kCell), 0, gy_ - 1);
-  for (int y = std::max(0, cy - 1); y <= std::min(gy_ - 1, cy + 1); ++y) {
-    for (int x = std::max(0, cx - 1); x <= std::min(gx_ - 1, cx + 1); ++x) {
-      for (uint32_t k = head_[static_cast<size_t>(y) * gx_ + x]; k != kNone; k = chain_[k]) {
-        const Walker& o = w_[k];
-        // It follows one going its way, and waits for one crossing its path at a walk; one
-        // facing it, or standing across its path (at a curb, in a queue), is passed, or two
-        // queues would wait for each other.
-        const double c = std::cos(o.yaw - w.yaw);
-        if (k == i || (c < kSameWay && (o.v < kMoving || c < -kSameWay))) continue;
-        const double behind = ru::pace_behind(w.x, w.y, w.yaw, o.x, o.y, o.yaw, o.v, v, kFollowGap);
-        // Two side by side, each in the other's way: the first of them goes.
-        if (behind < v && i < k &&
-            ru::pace_behind(o.x, o.y, o.yaw, w.x, w.y, w.yaw, w.v, 1, kFollowGap) < 1) {
-          continue;
-        }
-        v = behind;
-      }
-    }
-  }
-  return v;
 }
 
 // The vehicles crossing the line it walks on c (road_users::crossing_threat: the leg kept
@@ -193,27 +176,50 @@ void PoolWalkers::step_walker(size_t i, double dt, double t, const VehiclesNear&
       [&](const ru::WalkCrossing& c) { return may_step_on(i, c, t, vehicles); },
       [&](const ru::WalkCrossing& c) { return threats(i, c, vehicles); });
   if (w.committed != was && w.committed != SIZE_MAX) ++stats_.crossings;
+  double target = 0;
   double v = 0;
   if (limit < w.arc - 1e-9) {
     v = -std::min(v_des, (w.arc - limit) / dt);  // stepping back
+    avoid(i, 0, target);
   } else {
-    v = pace_behind_walkers(i, std::min(v_des, (limit - w.arc) / dt));
+    v = avoid(i, std::min(v_des, (limit - w.arc) / dt), target);
   }
-  w.arc = std::max(0.0, w.arc + v * dt);
-  w.walked += std::abs(v) * dt;
-  w.acc = (v - w.v) / dt;
-  w.v = v;
-  place(i, std::abs(v) * dt);
-  if (w.arc >= w.path.length() - 1e-6) {  // the trip's end: the next from the sidewalk here
-    const odr::Pose2 end = w.path.poses.back();
-    const auto at = ru::nearest_sidewalk(net_.graph(), end.x, end.y);
+  move(i, v, target, dt);
+  // The trip's end (its path's, or kOffRoad past the road when its crossing ends the path: it
+  // does not walk across the sidewalk's walkers to its centre): the next from the sidewalk here,
+  // its offset from that path where it stands (eased off as it walks).
+  const bool crossed = w.committed < w.path.road_crossings.size() &&
+                       w.arc >= w.path.road_crossings[w.committed].exit + kOffRoad &&
+                       w.path.road_crossings[w.committed].end >= w.path.length() - 1e-6;
+  if (crossed || w.arc >= w.path.length() - 1e-6) {
+    const double x = w.x, y = w.y;
+    const auto at = ru::nearest_sidewalk(net_.graph(), x, y);
     if (at) {
       plan_trip(i, {at->lane, at->s});
     } else {
-      walk_on(i, w.x, w.y, w.yaw);
+      walk_on(i, x, y, w.yaw);
     }
+    const odr::Pose2 start = w.path.at(0);  // (w.x, w.y: a respawn's spot)
+    w.ox = w.x - start.x;
+    w.oy = w.y - start.y;
+    w.dodge = 0;
     place(i, 0);
   }
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> PoolWalkers::overlaps() const {
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  for (uint32_t i = 0; i < w_.size(); ++i) {
+    for_near(i, 1, [&](uint32_t k) {
+      const WalkerSpec &a = specs_[i], &b = specs_[k];
+      if (k > i && boxes_overlap(w_[i].x, w_[i].y, w_[i].yaw, a.length, a.width, w_[k].x, w_[k].y,
+                                 w_[k].yaw, b.length, b.width)) {
+        out.emplace_back(i, k);
+      }
+    });
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 void PoolWalkers::step(double dt, double t, const VehiclesNear& vehicles) {

@@ -8,8 +8,10 @@
 // sidewalk with no crosswalk on reach: it walks on along the sidewalks (forks drawn). It walks
 // at its own speed (drawn 1.2-1.5 m/s), kept 0.55 m right of its path's centre (turning over
 // to it at a new trip's start), and never closer than 1 m behind a walker in its way going its
-// way (within 60 degrees), nor to one crossing its way at a walk; walkers facing it, or standing
-// across its way, are passed (two side by side, each in the other's way: the first goes). It steps
+// way (within 60 degrees); it sidesteps round walkers facing it, standing or crossing its way
+// and never steps to where its box overlaps another's (walker_avoid.cpp: on a crossing leg it
+// keeps to its right half; from the curb to kOffRoad past the road it has the way over walkers
+// on the sidewalk; blocked, it gives way to one earlier in order or standing). It steps
 // onto the road only at a crosswalk, from the curb, when
 //   - the lights let it: at a junction with lights, the crossed road's approach is red now and
 //     will still be red when it has crossed (the pool's LightCycle); no lights: gap only;
@@ -24,6 +26,7 @@
 // Deterministic: its draws come from its seed only (spawn_walkers: Seed, walker k Seed + k).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -63,6 +66,13 @@ std::vector<WalkerSpec> spawn_walkers(const PoolNetwork& net, size_t count, uint
                                       const std::string& prefix = "walker/",
                                       const std::vector<ClearZone>& keep_clear = {});
 
+// Whether boxes a and b (centre, yaw, length along yaw, width) overlap (separating axes).
+bool boxes_overlap(double ax, double ay, double ayaw, double al, double aw, double bx, double by,
+                   double byaw, double bl, double bw);
+
+// m past the road where a trip over a crosswalk ends (the next starts where it stands).
+inline constexpr double kOffRoad = 0.85;
+
 class PoolWalkers {
  public:
   // Throws PoolError naming the walker: a start off the sidewalks, an id twice, a size, speed
@@ -93,12 +103,16 @@ class PoolWalkers {
   bool crossing_box(size_t i, Box& box) const;
   const road_users::WalkPath& path(size_t i) const { return w_[i].path; }
   const WalkerStats& stats() const { return stats_; }
+  // Pairs of walkers (i < k) whose boxes (length x width, along their yaw) overlap now.
+  std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
 
  private:
   struct Walker {
     road_users::WalkPath path;
     double arc = 0, v = 0, acc = 0, walked = 0, x = 0, y = 0, yaw = 0;
-    double ox = 0, oy = 0;        // its offset from its path's centre
+    double ox = 0, oy = 0;        // its offset from its path's centre (eased to kKeepRight)
+    double dodge = 0;             // m further right: its sidestep round walkers in its way
+    double want = 0;              // m/s: the pace it meant to walk at its last step
     size_t committed = SIZE_MAX;  // the crossing it has stepped onto
     uint64_t rng = 0;
     int last_crosswalk = -1;
@@ -120,10 +134,33 @@ class PoolWalkers {
   std::vector<road_users::CrossingThreat> threats(size_t i, const road_users::WalkCrossing& c,
                                                   const VehiclesNear& vehicles,
                                                   double* nearest_moving = nullptr) const;
-  double pace_behind_walkers(size_t i, double v) const;
   const road_users::WalkCrossing* current_crossing(size_t i) const;
-  double keep_right(size_t i) const;  // m right of its path
+  double keep_right(size_t i) const;  // m right of its path's centre (with its sidestep)
+  // Its pose at `arc` with sidestep `dodge`, its offset turned by `moved` m (place: taken).
+  struct Placed {
+    double ox = 0, oy = 0, x = 0, y = 0, yaw = 0;
+  };
+  Placed placed(size_t i, double arc, double dodge, double moved) const;
   void place(size_t i, double moved);
+  // walker_avoid.cpp: the pace it may keep among the walkers near it, and how far right of its
+  // path it aims to be (`target`); then the step itself, only to where it overlaps no walker.
+  double avoid(size_t i, double v, double& target) const;
+  bool has_way(size_t i) const;
+  bool gives_way_to(size_t i, uint32_t k) const;
+  bool clear_at(size_t i, double x, double y, double yaw, uint32_t* who = nullptr) const;
+  void move(size_t i, double v, double target, double dt);
+  template <class F>
+  void for_near(size_t i, int reach, F&& f) const {
+    const int cx = std::clamp(static_cast<int>((w_[i].x - min_x_) / 5.0), 0, gx_ - 1);
+    const int cy = std::clamp(static_cast<int>((w_[i].y - min_y_) / 5.0), 0, gy_ - 1);
+    for (int y = std::max(0, cy - reach); y <= std::min(gy_ - 1, cy + reach); ++y) {
+      for (int x = std::max(0, cx - reach); x <= std::min(gx_ - 1, cx + reach); ++x) {
+        for (uint32_t k = head_[static_cast<size_t>(y) * gx_ + x]; k != kNone; k = chain_[k]) {
+          if (k != i) f(k);
+        }
+      }
+    }
+  }
 
   const PoolNetwork& net_;
   std::vector<WalkerSpec> specs_;
@@ -131,7 +168,7 @@ class PoolWalkers {
   std::vector<int> component_;             // per graph lane: its sidewalk network, -1 none
   std::vector<CrosswalkInfo> crosswalks_;  // with a sidewalk at both ends
   std::vector<std::vector<int>> reach_;    // per component: crosswalks an end of lies on it
-  // Walkers by 5 m cell (rebuilt each step): cell heads and a chain.
+  // Walkers by 5 m cell (for_near's) (rebuilt each step): cell heads and a chain.
   double min_x_ = 0, min_y_ = 0;
   int gx_ = 1, gy_ = 1;
   std::vector<uint32_t> head_, chain_;

@@ -82,7 +82,7 @@ TEST(PoolWalkers, UnknownConfigKeyIsNamed) {
 }
 
 // 150 vehicles and 80 walkers for 5 simulated minutes: a walker is on a sidewalk lane, or
-// within 2 m of a crosswalk's line; walkers cross, and no vehicle touches one.
+// within 2 m of a crosswalk's line; walkers cross, and no vehicle or walker touches one.
 TEST(PoolWalkers, StayOnSidewalksCrossAtCrosswalks) {
   const PoolNetwork& net = city().pool;
   Pool pool(net, spawn(net, 150, 3, VehicleSpec{}));
@@ -91,7 +91,7 @@ TEST(PoolWalkers, StayOnSidewalksCrossAtCrosswalks) {
   size_t off_sidewalk = 0, outside_crosswalks = 0, touching = 0;
   for (int k = 0; k < 20 * 300; ++k) {
     pool.step(0.05);
-    touching += pool.walker_overlaps().size();
+    touching += pool.walker_overlaps().size() + w.overlaps().size();
     if (k % 10) continue;
     for (size_t i = 0; i < w.size(); ++i) {
       const auto loc = city().graph.locate_if(
@@ -169,6 +169,64 @@ TEST(PoolWalkers, VehicleStopsForACrossingWalker) {
   EXPECT_TRUE(stood) << "min speed while the walker was in its lane " << min_speed;
   EXPECT_TRUE(passed) << "the car never drove on";
   EXPECT_GE(w.stats().crossings, 1u);
+}
+
+// Walkers crossing crosswalk 2 from both sides (no vehicles): `per_side` on each sidewalk, 2.5 m
+// apart along it from 2 m past the crosswalk. Steps `seconds` s; returns the most walkers whose
+// boxes overlapped at once, and how many are on the road at the end.
+std::pair<size_t, size_t> cross_both_ways(int per_side, bool lights, double seconds,
+                                          uint64_t* crossings) {
+  const PoolNetwork& net = city().pool;
+  const odr::LaneGraph& g = city().graph;
+  const odr::Crosswalk& cw = crosswalk("2");
+  std::vector<WalkerSpec> specs;
+  for (int side = 0; side < 2; ++side) {
+    const odr::LaneNode& n = g.lane(cw.ends[side]);
+    for (int k = 0; k < per_side; ++k) {
+      WalkerSpec ws;
+      ws.id = "w" + std::to_string(side) + "_" + std::to_string(k);
+      ws.lane = cw.ends[side];
+      ws.s = std::min(cw.s + 2.0 + 2.5 * k, n.s1 - 0.5);  // (the crosswalk is near s 0)
+      ws.speed = 1.2 + 0.05 * k;
+      ws.gap = 0;
+      ws.crosswalk = "2";
+      ws.obey_lights = lights;
+      ws.seed = 10 * side + k;
+      specs.push_back(ws);
+    }
+  }
+  Pool pool(net, {});
+  pool.set_walkers(specs);
+  const PoolWalkers& w = *pool.walkers();
+  size_t most = 0;
+  for (int k = 0; k < static_cast<int>(20 * seconds); ++k) {
+    pool.step(0.05);
+    most = std::max(most, w.overlaps().size());
+  }
+  size_t on_road = 0;
+  for (size_t i = 0; i < w.size(); ++i) on_road += w.on_road(i);
+  *crossings = w.stats().crossings;
+  return {most, on_road};
+}
+
+// Two walkers meeting head-on on a crosswalk pass each other, clear (their boxes never overlap).
+TEST(PoolWalkers, HeadOnWalkersPassClear) {
+  uint64_t crossings = 0;
+  const auto [most, on_road] = cross_both_ways(1, false, 40, &crossings);
+  EXPECT_EQ(most, 0u);
+  EXPECT_GE(crossings, 2u);
+  EXPECT_EQ(on_road, 0u);
+}
+
+// Six walkers a side walk up to the curb and wait there for the lights (a queue), then cross
+// both ways at once, through the other side's queue: no two boxes ever overlap, all cross, none
+// is left on the road.
+TEST(PoolWalkers, CurbQueueNeverOverlaps) {
+  uint64_t crossings = 0;
+  const auto [most, on_road] = cross_both_ways(6, true, 150, &crossings);
+  EXPECT_EQ(most, 0u);
+  EXPECT_GE(crossings, 12u);
+  EXPECT_EQ(on_road, 0u);
 }
 
 TEST(PoolWalkers, SameSeedSameRun) {
