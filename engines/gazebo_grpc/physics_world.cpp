@@ -127,7 +127,7 @@ void PhysicsWorld::gate_actors() {
   actors_posed_ = false;
   for (auto& a : actors_) {
     if (!a.present) continue;
-    const Eigen::Vector3d p = a.skeleton->getRootBodyNode()->getWorldTransform().translation();
+    const Eigen::Vector3d p = a.pose.translation();
     bool near = false;
     for (const auto& [centre, reach] : reach_) {
       if ((p - centre).norm() <= reach + a.radius) {
@@ -138,9 +138,10 @@ void PhysicsWorld::gate_actors() {
     if (near == a.colliding) continue;
     // Out of the DART world, not only out of collision detection: its constraint solver
     // visits every skeleton of the world at every step.
-    if (near)
+    if (near) {
+      if (a.skeleton_stale) pose_skeleton(a);
       world_->addSkeleton(a.skeleton);
-    else
+    } else
       world_->removeSkeleton(a.skeleton);
     a.colliding = near;
   }
@@ -212,14 +213,22 @@ int PhysicsWorld::add_actor(const std::string& name, const ModelDesc& model) {
   }
   skel->setMobile(false);
   const Eigen::AlignedBox3d box = collision_box(body);
-  actors_.push_back({skel, false, false, box.isEmpty() ? 0.0 : farthest_corner(box)});
+  actors_.push_back({skel, false, false, box.isEmpty() ? 0.0 : farthest_corner(box),
+                     skel->getRootBodyNode()->getWorldTransform(), false});
   return static_cast<int>(actors_.size() - 1);
 }
 
 void PhysicsWorld::set_actor_pose(int actor, const Eigen::Isometry3d& pose) {
-  auto& skel = actors_[actor].skeleton;
-  skel->getRootJoint()->setPositions(dd::FreeJoint::convertToPositions(pose));
+  Actor& a = actors_[actor];
+  a.pose = pose;
+  a.skeleton_stale = true;
+  if (a.colliding) pose_skeleton(a);
   actors_posed_ = true;
+}
+
+void PhysicsWorld::pose_skeleton(Actor& a) {
+  a.skeleton->getRootJoint()->setPositions(dd::FreeJoint::convertToPositions(a.pose));
+  a.skeleton_stale = false;
 }
 
 void PhysicsWorld::set_actor_name(int actor, const std::string& name) {

@@ -174,6 +174,11 @@ class PhysicsWorld {
     bool present = false;
     bool colliding = false;  // in the DART world: present, and near a moving body
     double radius = 0;       // a sphere about its origin holding its collision shapes
+    // Its last pose; given to its skeleton only while it is in the DART world (posing a
+    // DART skeleton costs about 1 us, and most of a city's actors are far from any moving
+    // body).
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    bool skeleton_stale = false;  // pose not yet given to the skeleton
   };
   std::vector<Actor> actors_;
   bool actors_posed_ = false;  // since the last gate_actors()
@@ -181,6 +186,7 @@ class PhysicsWorld {
   void compute_reach();
   // Enters the present actors near a moving body into the DART world, the others out.
   void gate_actors();
+  void pose_skeleton(Actor& a);
   std::unordered_map<std::string, dart::dynamics::SkeletonPtr> skeleton_by_model_;
   std::vector<std::string> link_names_;
   std::unordered_map<std::string, int> link_by_name_;

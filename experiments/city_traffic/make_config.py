@@ -256,7 +256,8 @@ def pooled_config(density=POOLED_DENSITY, large=None):
             {"Name": "state_tf", "FileName": "../autonomous_driving/state_tf.py"},
             {"Name": "motor_tf", "FileName": "../ego_planner/motor_tf.py"},
             {"Name": "camera_tf", "FileName": "../autonomous_driving/camera_tf.py"},
-            {"Name": "truth_tf", "FileName": "../autonomous_driving/truth_tf.py"},
+            # No truth_tf: the detector's "convoy" backend ignores ground-truth boxes, and
+            # asking for them would make the world draw an instance-id pass with every frame.
             {"Name": "pool_tf", "FileName": "pool_tf.py"},
             {"Name": "recorder_tf", "FileName": "recorder_tf.py"},
         ],

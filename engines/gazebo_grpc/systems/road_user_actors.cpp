@@ -205,13 +205,18 @@ void RoadUserActors::pose_actor(const std::string& dp_name, const data::RoadUser
   double offset = u.length() > 0 ? u.length_offset() : a.length_offset;
   Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
   shift.translation().x() = offset;
-  a.pose = road_user_pose(u) * shift;
+  const Eigen::Isometry3d pose = road_user_pose(u) * shift;
+  // A standing road user (most of a jammed city's) keeps its pose: nothing to re-pose.
+  const bool moved = !a.present || pose.matrix() != a.pose.matrix();
+  a.pose = pose;
   a.velocity = (u.vx() != 0 || u.vy() != 0) ? Eigen::Vector3d(u.vx(), u.vy(), 0)
                                             : Eigen::Vector3d(u.speed() * std::cos(u.yaw()),
                                                               u.speed() * std::sin(u.yaw()), 0);
   a.last_seen_ns = now;
-  ctx_->physics->set_actor_pose(a.physics, a.pose);
-  ctx_->cameras->set_actor_pose(a.camera, a.pose);
+  if (moved) {
+    ctx_->physics->set_actor_pose(a.physics, a.pose);
+    ctx_->cameras->set_actor_pose(a.camera, a.pose);
+  }
   if (a.walk_poses > 0) ctx_->cameras->set_actor_shown(a.camera, walker_pose(a, u));
   set_present(a, true);
 }
