@@ -93,7 +93,16 @@ bool Renderer::Impl::render_shadow_map(const Scene& scene, int li, const glm::dm
         std::max({glm::length(glm::dvec3(world[0])), glm::length(glm::dvec3(world[1])),
                   glm::length(glm::dvec3(world[2]))});
     const double r = b.radius * scale;
-    const glm::dvec3 lc(light_view * world * glm::dvec4(b.centre[0], b.centre[1], b.centre[2], 1));
+    const glm::dvec4 centre(b.centre[0], b.centre[1], b.centre[2], 1);
+    // First without the matrix product (most of a city is out of the map), with a margin for
+    // the rounding; what it keeps goes through the exact test below.
+    const glm::dvec3 rough(light_view * (world * centre));
+    const double margin = 1e-6 * (1 + std::abs(rough.x) + std::abs(rough.y) + std::abs(rough.z));
+    if (std::abs(rough.x - c.x) > radius + r + margin ||
+        std::abs(rough.y - c.y) > radius + r + margin ||
+        std::abs(rough.z - c.z) > depth + r + margin)
+      continue;
+    const glm::dvec3 lc(light_view * world * centre);
     if (std::abs(lc.x - c.x) > radius + r || std::abs(lc.y - c.y) > radius + r ||
         std::abs(lc.z - c.z) > depth + r)
       continue;
