@@ -4,7 +4,8 @@
 //
 // Config keys (schema.json): Map, Vehicles (listed), Count or Density + Seed + Policy +
 // DesiredSpeed + KeepClear (spawned), Pedestrians or PedestrianDensity (walkers on the
-// sidewalks, src/traffic_pool/pool_walkers.h), RoadUsersDataPack, ExternalDataPack. In:
+// sidewalks, src/traffic_pool/pool_walkers.h), RoadUsersDataPack, ExternalDataPack,
+// CommandDataPack (JSON {"<road user id>": command}, the agents' command contract). In:
 // <ExternalDataPack> convoy.data.RoadUsers (or one RoadUser), the road users it does not drive (the
 // ego, agents): obstacles its vehicles follow, keep gaps to and yield to, kept until the next one;
 // a malformed one stops the run (exit 2) naming the field. Out: <RoadUsersDataPack>
@@ -21,6 +22,7 @@
 
 #include "convoy/road_users.pb.h"
 #include "core/error.h"
+#include "datapack/json.h"
 #include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "engine/engine.h"
@@ -133,6 +135,7 @@ class RoadUserPoolEngine final : public Engine {
     config_ = config;
     dp_name_ = config.value("RoadUsersDataPack", "road_users");
     ext_name_ = config.value("ExternalDataPack", "external_users");
+    cmd_name_ = config.value("CommandDataPack", "commands");
     try {
       map_ = std::make_unique<opendrive::Network>(opendrive::load(config.at("Map")));
       graph_ = std::make_unique<opendrive::LaneGraph>(*map_);
@@ -150,13 +153,19 @@ class RoadUserPoolEngine final : public Engine {
   }
 
   int64_t step(int64_t duration_ns) override {
-    pool_->step(duration_ns * 1e-9);
+    try {
+      pool_->step(duration_ns * 1e-9);
+    } catch (const tp::PoolError& e) {  // a command's (a route with no path): as set_commands
+      throw std::runtime_error("road_user_pool engine '" + name_ + "': datapack '" + cmd_name_ +
+                               "': " + e.what());
+    }
     time_ns_ += duration_ns;
     publish();
     return time_ns_;
   }
 
   void set_datapack(const datapack::View& dp) override {
+    if (!dp.empty() && dp.id().name() == cmd_name_) return set_commands(dp);
     if (dp.empty() || dp.id().name() != ext_name_) return;
     const std::string where = "road_user_pool engine '" + name_ + "': datapack '" + ext_name_ + "'";
     data::RoadUsers users;
@@ -172,6 +181,18 @@ class RoadUserPoolEngine final : public Engine {
       pool_->set_external(external_users(users));
     } catch (const std::exception& e) {
       throw UserError(where + ": " + e.what());
+    }
+  }
+
+  // <CommandDataPack>: {"<road user id>": command}, the agents' command contract, for the next
+  // step. Bad content stops the run as it does an agent's (exit 3), naming the road user.
+  void set_commands(const datapack::View& dp) {
+    const std::string where = "road_user_pool engine '" + name_ + "': datapack '" + cmd_name_ + "'";
+    if (!dp.is_json()) throw std::runtime_error(where + ": expected a JSON datapack of commands");
+    try {
+      pool_->set_commands(datapack::read_json(dp), where, name_ + "/", 0.5 - kRearAxleFraction);
+    } catch (const tp::PoolError& e) {
+      throw std::runtime_error(e.what());
     }
   }
 
@@ -312,12 +333,18 @@ class RoadUserPoolEngine final : public Engine {
       u->set_vx(v * c);
       u->set_vy(v * sn);
       u->set_lights(pool_->acceleration(i) < -0.5 ? data::RoadUser::BRAKE : 0);
+      u->set_time_ns(time_ns_);
+      if (pool_->standing(i)) {  // put off the lanes by a command
+        u->set_road("");
+        u->set_lane(0);
+        u->set_s(0);
+        continue;
+      }
       const tp::PoolLane& lane = net_->lane(pool_->lane(i));
       const opendrive::LaneNode& node = graph_->lane(lane.graph_lane);
       u->set_road(lane.road_id);
       u->set_lane(lane.lane_id);
       u->set_s(node.forward ? node.s0 + pool_->s(i) : node.s1 - pool_->s(i));
-      u->set_time_ns(time_ns_);
     }
     const tp::PoolWalkers* w = pool_->walkers();
     for (size_t i = 0; w && i < w->size(); ++i) {
@@ -335,7 +362,7 @@ class RoadUserPoolEngine final : public Engine {
     }
   }
 
-  std::string name_, dp_name_, ext_name_;
+  std::string name_, dp_name_, ext_name_, cmd_name_;
   json config_;
   std::unique_ptr<opendrive::Network> map_;
   std::unique_ptr<opendrive::LaneGraph> graph_;

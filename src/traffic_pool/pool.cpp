@@ -307,15 +307,19 @@ void Pool::step(double dt) {
     if (present(i)) acc_[i] = accel_of(i);
   }
   for (size_t i = 0; i < size(); ++i) {
-    if (present(i) && (tick + i) % kMobilEverySteps == 0) consider_lane_change(i);
+    if (present(i) && (tick + i) % kMobilEverySteps == 0 && !commanded_lateral(i))
+      consider_lane_change(i);
   }
+  if (has_commands_) command_before_move(dt);
   for (size_t i = 0; i < size(); ++i) {
     if (!present(i)) continue;
     advance(i, dt);
     if (!present(i)) continue;  // it left the network
     update_pose(i);
   }
+  if (has_commands_) command_after_move(dt);
   step_walkers(dt);
+  if (has_commands_) command_walkers_after(dt);
   t_ += dt;
 }
 

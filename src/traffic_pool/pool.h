@@ -22,14 +22,18 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "road_users/command.h"
 #include "road_users/idm.h"
 #include "road_users/mobil.h"
+#include "road_users/pedestrian_command.h"
 #include "traffic_pool/network.h"
 #include "traffic_pool/pool_walkers.h"
 
@@ -105,6 +109,8 @@ class Pool {
   // absent, instead of starting again at an entry.
   void set_leave_at_exits(bool on) { leave_at_exits_ = on; }
   bool present(size_t i) const { return lane_[i] != kNone; }
+  // Put off the lanes by a command (pool_commands.cpp): not present, standing at x, y.
+  bool standing(size_t i) const { return !stand_.empty() && stand_[i]; }
   // Puts absent vehicle i, standing, at the start of pool lane `lane` (outside junctions), on
   // the route to its spec's `to` when it has one. False, changing nothing, while that start is
   // not free (as for a respawn) or another vehicle entered the lane this step. Throws PoolError
@@ -120,6 +126,13 @@ class Pool {
   const PoolWalkers* walkers() const { return walkers_ ? &*walkers_ : nullptr; }
   // Pairs (pooled vehicle, walker) whose boxes overlap now.
   std::vector<std::pair<uint32_t, uint32_t>> walker_overlaps() const;
+  // Scenario commands for the next step (pool_commands.cpp; docs/road_users.md, "Pooled road
+  // users"): `pack` is {"<id>": command, ...}, ids with or without `prefix`, each command read
+  // by road_users' parser (the agents' contract). A pose's point lies `ref_ahead` x length
+  // behind the box's centre (the published reference point). Throws PoolError naming `where`
+  // and the road user: an unknown id, a bad command, a part the pool does not take yet.
+  void set_commands(const nlohmann::json& pack, const std::string& where, const std::string& prefix,
+                    double ref_ahead);
 
  private:
   void validate();
@@ -147,6 +160,14 @@ class Pool {
   void add_lane_entry(uint32_t e, uint32_t lane, double s_centre, double half_along, double v);
   template <class F>
   void for_near(double x, double y, double r, F&& f) const;
+  // pool_commands.cpp
+  void command_before_move(double dt);
+  void command_after_move(double dt);
+  void command_walkers_after(double dt);
+  void put_at(size_t i, const road_users::CommandPose& p);
+  void command_lane(size_t i, const road_users::VehicleCommand::Lane& want);
+  void command_route(size_t i, const road_users::Points& positions);
+  bool commanded_lateral(size_t i) const;
 
   const PoolNetwork& net_;
   // Entries: 0..n_-1 pooled vehicles, then one grid entry per external road user (lane kNone),
@@ -179,6 +200,16 @@ class Pool {
   std::vector<uint32_t> cell_head_, cell_next_;
   PoolStats stats_;
   bool leave_at_exits_ = false;
+  // Commands (pool_commands.cpp): this step's per vehicle and walker, the last route command's
+  // positions, vehicles standing off the lanes (put 50 m from them: lane kNone).
+  bool has_commands_ = false;
+  double cmd_ref_ahead_ = 0;
+  std::map<std::string, size_t> index_;  // id -> vehicle, or n_ + walker
+  std::vector<std::optional<road_users::VehicleCommand>> cmd_;
+  std::vector<std::optional<road_users::PedestrianCommand>> wcmd_;
+  std::vector<road_users::Points> routed_;
+  std::vector<uint8_t> stand_;
+  std::vector<std::pair<size_t, double>> pace_;  // walkers on a commanded pace: their own
 };
 
 template <class F>

@@ -105,6 +105,10 @@ class PoolWalkers {
   const WalkerStats& stats() const { return stats_; }
   // Pairs of walkers (i < k) whose boxes (length x width, along their yaw) overlap now.
   std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
+  // Scenario commands (pool_commands.cpp): its walking speed from now on (returns the one it
+  // had), and putting it at (x, y, yaw) with speed v, then on from the nearest sidewalk.
+  double set_pace(size_t i, double v);
+  void put_at(size_t i, double x, double y, double yaw, double v, double dt);
 
  private:
   struct Walker {

@@ -3,6 +3,9 @@
 Runs: a pool of spawned and listed vehicles on tests/traffic_pool/data/grid3.xodr publishes one
 convoy.data.RoadUsers datapack with every vehicle each step, which a TF reads; on the city map
 its walkers (Pedestrians) come after the vehicles, category pedestrian, model walker.
+Commands: a TF sends the pool scenario commands (CommandDataPack, the agents' contract): a
+speed command holds a vehicle's speed, a teleport puts it at a pose, then IDM takes over; an
+unknown id stops the run (exit 3).
 BadInput: an unknown policy, two road users on one spot, a count the map cannot hold, a
 destination with no path, and pedestrians the sidewalks cannot hold (Pedestrians,
 PedestrianDensity) each stop the run with one message naming the road user or key and the
@@ -86,6 +89,81 @@ class Runs(E2ETestCase):
         self.assertEqual({w[1] for w in walkers}, {"walker"})
         self.assertTrue(all(0 <= w[2] < 1 for w in walkers))
         self.assertGreater(sum(1 for w in walkers if w[3] > 1.0), 10)  # walking, 1.2-1.5 m/s
+        self.assertNoEngineLeft()
+
+
+COMMAND_TF = textwrap.dedent("""\
+    import json
+    from nrp_core import *
+    from nrp_core.data.nrp_json import JsonDataPack
+
+    _rows = []
+
+
+    @EngineDataPack(keyword="v", id=DataPackIdentifier("road_users", "pool"))
+    @TransceiverFunction("pool")
+    def command(v):
+        if v.isEmpty():
+            return []
+        users = {u.id: u for u in v.data.users}
+        me = users["pool/mine"]
+        _rows.append([v.data.time_ns, me.speed, me.acceleration, me.lights, me.x, me.y])
+        with open(OUT, "w") as f:
+            json.dump(_rows, f)
+        t = v.data.time_ns * 1e-9
+        if t < 1.0:
+            return [JsonDataPack("commands", "pool",
+                                 {KEY: {"speed": {"speed": 2.0, "acceleration": -1.5}}})]
+        if t < 1.04:
+            return [JsonDataPack("commands", "pool",
+                                 {"mine": {"teleport": {"x": 160.0, "y": 48.4, "yaw": 0.0}}})]
+        return []
+    """)
+
+
+class Commands(E2ETestCase):
+    """A TF plays the scenario engine: `mine` is held at 2 m/s (BRAKE on, its acceleration
+    published), then teleported (its published reference point exactly there), then back on
+    IDM; the same commands give the same run; an unknown id stops the run (exit 3)."""
+
+    def run_commands(self, key):
+        out = os.path.join(self.dir, "rows.json")
+        self.write("tf.py", COMMAND_TF.replace("OUT", repr(out)).replace("KEY", repr(key)))
+        cfg = pool_config(Count=10, Seed=3,
+                          Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
+                                     "Speed": 8, "Policy": "idm"}])
+        cfg["DataPackProcessingFunctions"] = [{"Name": "command", "FileName": "tf.py"}]
+        self.write_config(cfg)
+        r = self.run_convoy()
+        if not os.path.exists(out):
+            return r, []
+        with open(out) as f:
+            return r, json.load(f)
+
+    def test_speed_teleport_and_back_to_idm(self):
+        r, rows = self.run_commands("pool/mine")
+        self.assertExit(r, 0)
+        held = [row for row in rows if 0.1 < row[0] * 1e-9 <= 1.0]
+        self.assertGreater(len(held), 15)
+        for _, speed, acc, lights, _, _ in held:
+            self.assertAlmostEqual(speed, 2.0, places=9)
+            self.assertAlmostEqual(acc, -1.5, places=9)
+            self.assertTrue(lights & 2)  # BRAKE
+        put = [row for row in rows if 1.0 < row[0] * 1e-9 < 1.06]
+        self.assertAlmostEqual(put[0][4], 160.0, places=6)
+        self.assertAlmostEqual(put[0][5], 48.4, places=6)
+        after = [row for row in rows if row[0] * 1e-9 > 1.2]
+        self.assertGreater(after[-1][1], 2.5)  # IDM speeds it up again
+        _, r2 = self.run_commands("pool/mine")
+        self.assertEqual(rows, r2)  # same commands, same run
+        self.assertNoEngineLeft()
+
+    def test_unknown_id(self):
+        r, _ = self.run_commands("nobody")
+        self.assertExit(r, 3)  # bad content, as for the agents
+        self.assertOneError(r)
+        self.assertStderrHas(r, "road_user_pool engine 'pool': datapack 'commands': no road "
+                                "user 'nobody' in the pool")
         self.assertNoEngineLeft()
 
 
