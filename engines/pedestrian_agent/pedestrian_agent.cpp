@@ -23,11 +23,10 @@
 // Route.to, or without a Route along the sidewalks onward in the direction it faces (forks
 // chosen by Seed). With no sidewalk within 50 m it stands there until commanded.
 //
-// Its planner (road_users/pedestrian_walks.h), its step (road_users/pedestrian_behaviour.h:
-// its description, its state, the step), the command contract and the crossing's threats, gap
-// acceptance, lights and caution on the road are in src/road_users; this engine reads its
-// config into the description, turns its datapacks into the step's inputs and publishes.#include
-// <algorithm>
+// Its planner (road_users/pedestrian_walks.h), its step (pedestrian_behaviour.h), the command
+// contract, the crossing's threats, gap acceptance, lights and caution on the road are in
+// src/road_users; this engine reads its config, turns its datapacks into inputs and publishes.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -138,6 +137,7 @@ class PedestrianAgent final : public Engine {
   double mid_block_distance_ = 0;
   std::string state_dp_, neighbours_dp_, weather_dp_, command_dp_;
   data::RoadUser state_;
+  data::RoadUsers scratch_;  // the last neighbours datapack, parsed
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
 };
@@ -453,7 +453,8 @@ void PedestrianAgent::set_datapack(const datapack::View& dp) {
   if (dp.empty()) return;
   const std::string& name = dp.id().name();
   if (name == neighbours_dp_) {
-    data::RoadUsers users;
+    data::RoadUsers& users = scratch_;  // reused: Clear keeps its messages for the next parse
+    users.Clear();
     if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
       datapack::read_proto(dp, &users);
     } else if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUser>()) {

@@ -159,6 +159,7 @@ class VehicleAgent final : public Engine {
   ru::VehicleState s_;
   std::string state_dp_, neighbours_dp_, lights_dp_, weather_dp_;
   data::RoadUser state_;
+  data::RoadUsers scratch_;  // the last neighbours datapack, parsed
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
 };
@@ -446,7 +447,8 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
   if (dp.empty()) return;
   const std::string& name = dp.id().name();
   if (name == neighbours_dp_) {
-    data::RoadUsers users;
+    data::RoadUsers& users = scratch_;  // reused: Clear keeps its messages for the next parse
+    users.Clear();
     if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
       datapack::read_proto(dp, &users);
     } else if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUser>()) {

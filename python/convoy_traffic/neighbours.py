@@ -18,6 +18,8 @@ Users are listed sorted by id, so the view does not depend on the order of the i
 
 import math
 
+import numpy as np
+
 from google.protobuf import json_format
 
 from nrp_core.data.nrp_protobuf import RoadUsersDataPack
@@ -64,7 +66,12 @@ def neighbour_view(me, users, radius=100.0):
     return near
 
 
+_ONE_BYTE = [bytes((n,)) for n in range(0x80)]
+
+
 def _varint(n):
+    if n < 0x80:
+        return _ONE_BYTE[n]
     out = bytearray()
     while True:
         b = n & 0x7F
@@ -83,8 +90,9 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
     empty view.
 
     Built for many agents: road users are put in a grid of `radius` cells, so each agent looks
-    at its 3x3 cells only, and each user is serialised once; a view is parsed from the
-    concatenated bytes (field 1 of RoadUsers, repeated) instead of copying messages."""
+    at its 3x3 cells only (a cell's agents against those users in one numpy operation), and
+    each user is serialised once; a view is the concatenated bytes (field 1 of RoadUsers, repeated), sent
+    without being parsed (RoadUsersDataPack.from_bytes)."""
     every = road_users(datapacks)
     users = [u for u in every if not u.absent]
     users.sort(key=lambda u: u.id)  # views sorted by id
@@ -100,24 +108,43 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
         payload = u.SerializeToString()
         frames.append(b"\x0a" + _varint(len(payload)) + payload)
         grid.setdefault((int(xs[i] // radius), int(ys[i] // radius)), []).append(i)
-    r2 = radius * radius
-    out = []
-    for engine in agents:
+    # Each agent's position (its own, or where it says it is when absent), grouped by cell.
+    where = []
+    cells = {}
+    for k, engine in enumerate(agents):
         key = state_id(engine) if state_id else engine
         me = by_id.get(key)
-        dp = RoadUsersDataPack(name, engine)
-        absent = gone.get(key) if me is None else None
-        if me is not None or absent is not None:
-            mx, my = (xs[me], ys[me]) if me is not None else (absent.x, absent.y)
-            cx, cy = int(mx // radius), int(my // radius)
-            near = []
-            for gx in (cx - 1, cx, cx + 1):
-                for gy in (cy - 1, cy, cy + 1):
-                    for j in grid.get((gx, gy), ()):
-                        if j != me and (xs[j] - mx) ** 2 + (ys[j] - my) ** 2 <= r2:
-                            near.append(j)
-            near.sort()
-            dp.data.ParseFromString(b"".join(frames[j] for j in near))
-            dp.data.time_ns = users[me].time_ns if me is not None else absent.time_ns
-        out.append(dp)
+        u = users[me] if me is not None else gone.get(key)
+        where.append(None if u is None else (me, u.time_ns))
+        if u is not None:
+            cells.setdefault((int(u.x // radius), int(u.y // radius)), []).append((k, u.x, u.y))
+    px, py = np.array(xs, dtype=float), np.array(ys, dtype=float)
+    views = [None] * len(agents)
+    for (cx, cy), members in cells.items():
+        near = np.array(sorted(j for gx in (cx - 1, cx, cx + 1) for gy in (cy - 1, cy, cy + 1)
+                               for j in grid.get((gx, gy), ())), dtype=np.intp)
+        mx = np.array([m[1] for m in members])[:, None]
+        my = np.array([m[2] for m in members])[:, None]
+        dx, dy = px[near][None, :] - mx, py[near][None, :] - my
+        inside = dx * dx + dy * dy <= radius * radius
+        for row, (k, _, _) in enumerate(members):
+            views[k] = near[inside[row]].tolist()
+    out = []
+    tails = {}
+    for k, engine in enumerate(agents):
+        if where[k] is None:
+            out.append(RoadUsersDataPack(name, engine))
+            continue
+        me, time_ns = where[k]
+        view = views[k]
+        if me is not None and me in view:
+            view.remove(me)
+        # RoadUsers' bytes: its users (field 1) as they came, then time_ns (field 2, left out
+        # when 0), the same bytes the message would serialize to; sent without parsing them.
+        tail = tails.get(time_ns)
+        if tail is None:
+            tail = tails[time_ns] = (b"\x10" + _varint(time_ns & 0xFFFFFFFFFFFFFFFF)
+                                     if time_ns else b"")
+        out.append(RoadUsersDataPack.from_bytes(
+            name, engine, b"".join([frames[j] for j in view]) + tail))
     return out

@@ -65,6 +65,8 @@ class DataPack:
         if self._data is None:
             raise EmptyDataPackError("datapack '%s' of engine '%s' is empty: check isEmpty() first"
                                      % (self._id.dataPackName, self._id.engineName))
+        if type(self._data) is SerializedMessage:
+            self._data = self._data.parse()
         return self._data
 
     @data.setter
@@ -74,6 +76,20 @@ class DataPack:
     def __repr__(self):
         return "%s(%r, %r%s)" % (type(self).__name__, self.name, self.engine_name,
                                  ", empty" if self._data is None else "")
+
+
+class SerializedMessage:
+    """A protobuf message still in its serialized form (ProtobufDataPack.from_bytes): sent as
+    the bytes it is, parsed only when a function reads the datapack's .data."""
+
+    __slots__ = ("message_class", "payload")
+
+    def __init__(self, message_class, payload):
+        self.message_class = message_class
+        self.payload = payload
+
+    def parse(self):
+        return self.message_class.FromString(self.payload)
 
 
 def _received(cls, name, engine_name, data):

@@ -100,6 +100,15 @@ void write_proto(Builder& out, const google::protobuf::Message& message) {
     message.SerializeToString(payload->mutable_data());
 }
 
+void write_proto_bytes(Builder& out, const std::string& type, std::string_view bytes) {
+  auto* dp = out.message();
+  dp->mutable_id()->set_type(type);
+  auto* payload = dp->mutable_proto();
+  payload->set_type_name(type);
+  payload->clear_blob_fields();
+  payload->set_data(bytes.data(), bytes.size());
+}
+
 void read_proto(const View& in, google::protobuf::Message* message) {
   const std::string& want = message->GetDescriptor()->full_name();
   if (!in.is_proto() || in.proto_type() != want) {

@@ -9,6 +9,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "datapack/datapack.h"
 
@@ -16,6 +17,10 @@ namespace convoy::datapack {
 
 // Sets the payload (and DataPackId.type) to `message`; large bytes values into blobs.
 void write_proto(Builder& out, const google::protobuf::Message& message);
+
+// Sets the payload (and DataPackId.type) to `bytes`, a message of type `type` serialized
+// already (not checked here: the reader's read_proto names the datapack if they do not parse).
+void write_proto_bytes(Builder& out, const std::string& type, std::string_view bytes);
 
 // Parses the payload into `message` (large bytes values copied from their blobs). Throws
 // std::runtime_error naming the datapack when it holds another type, bytes that do not

@@ -1,5 +1,6 @@
 #include "engine/engine_server.h"
 
+#include <google/protobuf/arena.h>
 #include <grpcpp/grpcpp.h>
 
 #include <condition_variable>
@@ -21,6 +22,8 @@
 #include "transport/frame_socket.h"
 
 namespace convoy::engines {
+
+namespace pb = google::protobuf;
 
 namespace {
 std::map<std::string, EngineFactory>& registry() {
@@ -146,8 +149,13 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
   transport::ShmBlobReader reader(shm_in_fd >= 0 ? &in_arena : nullptr);
   blob_reader_ = &reader;
   std::string in, out;
-  engine::Request request;
-  engine::Reply reply;
+  // Each exchange's request and reply live in an arena reset before the next one: a step's
+  // datapacks are not allocated and freed message by message.
+  std::vector<char> first_block(64 * 1024);
+  pb::ArenaOptions arena_options;
+  arena_options.initial_block = first_block.data();
+  arena_options.initial_block_size = first_block.size();
+  pb::Arena messages(arena_options);
   // Running averages of the wait for the next request and of the work on one.
   int64_t usual_gap_ns = -1, usual_work_ns = -1;
   auto follow = [](int64_t& avg, int64_t x) { avg = avg < 0 ? x : (3 * avg + x) / 4; };
@@ -165,8 +173,9 @@ void EngineServer::serve_socket(int fd, int shm_out_fd, int shm_in_fd) {
     if (socket.recv(&in, Deadline::max()) != transport::RecvStatus::kOk) break;
     const int64_t received = now_ns();
     follow(usual_gap_ns, received - waited_from);
-    request.Clear();
-    reply.Clear();
+    messages.Reset();
+    auto& request = *pb::Arena::CreateMessage<engine::Request>(&messages);
+    auto& reply = *pb::Arena::CreateMessage<engine::Reply>(&messages);
     if (!request.ParseFromString(in)) {
       reply.set_error("malformed request frame");
       reply.SerializeToString(&out);

@@ -228,6 +228,25 @@ bool encode_generic(py::handle data, Builder& out) {
   return true;
 }
 
+// nrp_core._datapacks.SerializedMessage (ProtobufDataPack.from_bytes): its bytes as they are.
+bool encode_serialized(py::handle data, Builder& out) {
+  static py::object* serialized =
+      new py::object(py::module_::import("nrp_core._datapacks").attr("SerializedMessage"));
+  if (Py_TYPE(data.ptr()) != reinterpret_cast<PyTypeObject*>(serialized->ptr())) return false;
+  const py::object payload = data.attr("payload");
+  if (!PyBytes_Check(payload.ptr()))
+    throw std::invalid_argument("serialized message: the payload must be bytes, not " +
+                                std::string(Py_TYPE(payload.ptr())->tp_name));
+  const std::string type =
+      data.attr("message_class").attr("DESCRIPTOR").attr("full_name").cast<std::string>();
+  datapack::Registry::global().add_by_name(type);
+  datapack::write_proto_bytes(
+      out, type,
+      std::string_view(PyBytes_AS_STRING(payload.ptr()),
+                       static_cast<size_t>(PyBytes_GET_SIZE(payload.ptr()))));
+  return true;
+}
+
 }  // namespace
 
 py::object message_from_datapack(const View& in, py::handle message_class) {
@@ -309,6 +328,7 @@ void data_from_python(py::handle data, Builder& out) {
   }
   try {
     if (!PyDict_Check(data.ptr())) {
+      if (encode_serialized(data, out)) return;
       if (const Converter* c = converter_for_data(data)) {
         c->from_data(data, out);
         return;

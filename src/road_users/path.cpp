@@ -24,13 +24,32 @@ odr::Pose2 Path::at(double a) const {
 Path::Proj Path::project(double x, double y, size_t lo, size_t hi) const {
   Proj best;
   hi = std::min(hi, poses.size());
-  for (size_t i = lo; i < hi; ++i) {
+  const auto dist2 = [&](size_t i) {
     const double dx = x - poses[i].x, dy = y - poses[i].y;
-    const double d2 = dx * dx + dy * dy;
+    return dx * dx + dy * dy;
+  };
+  // An upper bound of the nearest distance first, from every 8th pose.
+  double bound2 = INFINITY;
+  for (size_t i = lo; i < hi; i += 8) bound2 = std::min(bound2, dist2(i));
+  const double bound = std::sqrt(bound2);
+  // The path from pose i to a later pose j is at least as long as the straight line between
+  // them (arcs are sums of straight steps), so pose j is at least d - (arc[j] - arc[i]) from
+  // (x, y): the poses within d - bound of arc[i] are farther than the nearest one and are
+  // skipped. The margin keeps the result exactly that of trying every pose in order.
+  for (size_t i = lo; i < hi;) {
+    const double d2 = dist2(i);
     if (d2 < best.d2) {
       best.d2 = d2;
       best.index = i;
     }
+    const double reach = std::sqrt(d2) - bound - 1e-6;
+    if (i + 1 >= hi || reach <= arc[i + 1] - arc[i]) {
+      ++i;
+      continue;
+    }
+    const auto from = arc.begin() + static_cast<std::ptrdiff_t>(i + 1);
+    const auto to = arc.begin() + static_cast<std::ptrdiff_t>(hi);
+    i = static_cast<size_t>(std::lower_bound(from, to, arc[i] + reach) - arc.begin());
   }
   if (!std::isfinite(best.d2)) return best;
   const odr::Pose2& p = poses[best.index];

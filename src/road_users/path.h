@@ -20,7 +20,9 @@ using Points = std::vector<std::array<double, 2>>;
 
 struct Path {
   std::vector<opendrive::Pose2> poses;
-  std::vector<double> arc;  // arc length at each pose
+  // Arc length at each pose; each step at least the straight distance between its two poses
+  // (project skips poses on that bound).
+  std::vector<double> arc;
   opendrive::LaneRoute route;
   std::vector<std::pair<double, std::string>> stops;  // (arc of stop line, signal id), by arc
   struct Crossing {

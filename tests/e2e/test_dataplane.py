@@ -203,9 +203,6 @@ class DataPlane(unittest.TestCase):
         self.assertEqual(remote, local)
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 # Any protobuf message the datapack registry knows travels with a Python class of its own,
 # derived from the registration (here protobuf's well-known Timestamp and Duration, which are
@@ -305,3 +302,55 @@ class RegisteredProtobufTypes(unittest.TestCase):
         self.assertIn("tf_unknown", r.stderr)
         self.assertIn("datapack 'stamp_in' of engine 'dst'", r.stderr)
         self.assertIn("xpkg.Foo", r.stderr)
+
+
+# ProtobufDataPack.from_bytes: a message sent as the bytes a function assembled, unparsed.
+BYTES_TF = textwrap.dedent("""\
+    from google.protobuf import timestamp_pb2
+    from nrp_core import *
+    from nrp_core.data.nrp_json import *
+    from nrp_core.data.nrp_protobuf import datapack_class
+
+    Stamp = datapack_class("google.protobuf.Timestamp")
+
+    @EngineDataPack(keyword='stamp', id=DataPackIdentifier('stamp', 'src'))
+    @TransceiverFunction("dst")
+    def relay(stamp):
+        if stamp.isEmpty():
+            return []
+        raw = timestamp_pb2.Timestamp(seconds=stamp.data.seconds + 2,
+                                      nanos=stamp.data.nanos).SerializeToString()
+        out = Stamp.from_bytes("stamp_in", "dst", PAYLOAD(raw))
+        info = {"parsed": out.data.seconds}  # .data parses the bytes on first use
+        return [Stamp.from_bytes("stamp_in", "dst", PAYLOAD(raw)), JsonDataPack("info", "dst", info)]
+    """)
+
+
+class SerializedDataPacks(unittest.TestCase):
+    def test_bytes_travel_as_the_message(self):
+        ex = Experiment(self)
+        ex.engine("src", STAMP_SRC)
+        ex.engine("dst", STAMP_DST)
+        ex.function("tf_bytes", BYTES_TF.replace("PAYLOAD(raw)", "raw"))
+        ex.run(0.05)
+        with open(os.path.join(ex.dir, "stamps.jsonl")) as f:
+            entries = [json.loads(line) for line in f]
+        self.assertGreaterEqual(len(entries), 4)
+        last = entries[-1]
+        self.assertEqual(last["type"], "google.protobuf.Timestamp")
+        self.assertEqual(last["seconds"], 9)
+        self.assertGreater(last["nanos"], 0)
+        self.assertEqual(last["info"], {"parsed": 9})
+
+    def test_a_payload_that_is_not_bytes_is_a_function_error(self):
+        ex = Experiment(self)
+        ex.engine("src", STAMP_SRC)
+        ex.engine("dst", STAMP_DST)
+        ex.function("tf_bytes", BYTES_TF.replace("PAYLOAD(raw)", "raw.decode('latin-1')"))
+        r = ex.run(0.05, expect=4)
+        self.assertIn("tf_bytes", r.stderr)
+        self.assertIn("from_bytes: payload must be bytes, not str", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,35 @@ TEST(Path, ProjectsOntoTheNearestPose) {
   EXPECT_NEAR(far.arc, 1.8, 1e-12);  // the same foot point from another pose on the line
   // An empty range: nothing.
   EXPECT_FALSE(std::isfinite(p.project(3, 0, 5, 5).d2));
+}
+
+// project skips poses it can prove farther than the best one: the same answer as trying
+// every pose, on a path that winds back near itself, for points on, beside and far from it.
+TEST(Path, ProjectionSkipsOnlyFartherPoses) {
+  Points pts;
+  for (int k = 0; k <= 400; ++k) {
+    const double t = 0.05 * k;
+    pts.push_back({30 * std::cos(t) + 2 * t, 20 * std::sin(1.5 * t)});
+  }
+  const Path p = polyline_path(pts, 0.7, 0, 0);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> coord(-80, 80);
+  std::uniform_int_distribution<size_t> index(0, p.poses.size());
+  for (int n = 0; n < 3000; ++n) {
+    const double x = coord(rng), y = coord(rng);
+    size_t lo = index(rng), hi = index(rng);
+    if (n % 3 == 0) lo = 0, hi = SIZE_MAX;
+    size_t want = 0;
+    double want_d2 = INFINITY;
+    for (size_t i = lo; i < std::min(hi, p.poses.size()); ++i) {
+      const double dx = x - p.poses[i].x, dy = y - p.poses[i].y;
+      const double d2 = dx * dx + dy * dy;
+      if (d2 < want_d2) want_d2 = d2, want = i;
+    }
+    const Path::Proj got = p.project(x, y, lo, hi);
+    ASSERT_EQ(got.d2, want_d2) << x << " " << y << " [" << lo << ", " << hi << ")";
+    if (std::isfinite(want_d2)) ASSERT_EQ(got.index, want);
+  }
 }
 
 TEST(Path, HeadingInterpolatesTheShortWayRound) {

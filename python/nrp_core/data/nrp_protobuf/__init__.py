@@ -22,7 +22,8 @@ import importlib
 
 import numpy as np
 
-from nrp_core._datapacks import DataPack, DataPackIdentifier, RawData  # noqa: F401
+from nrp_core._datapacks import (DataPack, DataPackIdentifier, RawData,  # noqa: F401
+                                 SerializedMessage, _received)
 
 
 def _alias(name):
@@ -119,6 +120,18 @@ class ProtobufDataPack(DataPack):
     def __init__(self, name, engine_name):
         DataPack.__init__(self, name, engine_name)
         self._data = self._message()
+
+    @classmethod
+    def from_bytes(cls, name, engine_name, payload):
+        """A datapack of the message serialized as `payload` (bytes), sent as they are: a
+        function that assembles a message from serialized parts (a road user's neighbours from
+        each road user's bytes) skips parsing and serializing it again. Not checked here (the
+        engine reading it names the datapack if the bytes do not parse); .data parses them on
+        first use."""
+        if not isinstance(payload, bytes):
+            raise TypeError("%s.from_bytes: payload must be bytes, not %s"
+                            % (cls.__name__, type(payload).__name__))
+        return _received(cls, name, engine_name, SerializedMessage(cls._message, payload))
 
 
 _classes = {}  # type name -> datapack class
