@@ -18,7 +18,7 @@ Users are listed sorted by id, so the view does not depend on the order of the i
 
 import math
 
-import numpy as np
+import _convoy_datapack  # the Convoy program running this Python
 
 from google.protobuf import json_format
 
@@ -89,10 +89,10 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
     (`state_id(engine)` if given, else the engine's name); an agent with no state yet gets an
     empty view.
 
-    Built for many agents: road users are put in a grid of `radius` cells, so each agent looks
-    at its 3x3 cells only (a cell's agents against those users in one numpy operation), and
-    each user is serialised once; a view is the concatenated bytes (field 1 of RoadUsers, repeated), sent
-    without being parsed (RoadUsersDataPack.from_bytes)."""
+    Built for many agents: each user is serialised once, and the views are put together in
+    C++ (a grid of cells the size of `radius`, each agent looking at its 3x3 cells) as the
+    concatenated bytes (field 1 of RoadUsers, repeated, then time_ns), sent without being
+    parsed (RoadUsersDataPack.from_bytes)."""
     every = road_users(datapacks)
     users = [u for u in every if not u.absent]
     users.sort(key=lambda u: u.id)  # views sorted by id
@@ -103,48 +103,18 @@ def neighbour_datapacks(datapacks, agents, radius=100.0, name="neighbours", stat
     xs = [u.x for u in users]
     ys = [u.y for u in users]
     frames = []
-    grid = {}
-    for i, u in enumerate(users):
+    for u in users:
         payload = u.SerializeToString()
         frames.append(b"\x0a" + _varint(len(payload)) + payload)
-        grid.setdefault((int(xs[i] // radius), int(ys[i] // radius)), []).append(i)
-    # Each agent's position (its own, or where it says it is when absent), grouped by cell.
-    where = []
-    cells = {}
-    for k, engine in enumerate(agents):
+    # Each agent's position: its own, or where it says it is when absent.
+    centres, wanted = [], []
+    for engine in agents:
         key = state_id(engine) if state_id else engine
         me = by_id.get(key)
         u = users[me] if me is not None else gone.get(key)
-        where.append(None if u is None else (me, u.time_ns))
+        wanted.append(u is not None)
         if u is not None:
-            cells.setdefault((int(u.x // radius), int(u.y // radius)), []).append((k, u.x, u.y))
-    px, py = np.array(xs, dtype=float), np.array(ys, dtype=float)
-    views = [None] * len(agents)
-    for (cx, cy), members in cells.items():
-        near = np.array(sorted(j for gx in (cx - 1, cx, cx + 1) for gy in (cy - 1, cy, cy + 1)
-                               for j in grid.get((gx, gy), ())), dtype=np.intp)
-        mx = np.array([m[1] for m in members])[:, None]
-        my = np.array([m[2] for m in members])[:, None]
-        dx, dy = px[near][None, :] - mx, py[near][None, :] - my
-        inside = dx * dx + dy * dy <= radius * radius
-        for row, (k, _, _) in enumerate(members):
-            views[k] = near[inside[row]].tolist()
-    out = []
-    tails = {}
-    for k, engine in enumerate(agents):
-        if where[k] is None:
-            out.append(RoadUsersDataPack(name, engine))
-            continue
-        me, time_ns = where[k]
-        view = views[k]
-        if me is not None and me in view:
-            view.remove(me)
-        # RoadUsers' bytes: its users (field 1) as they came, then time_ns (field 2, left out
-        # when 0), the same bytes the message would serialize to; sent without parsing them.
-        tail = tails.get(time_ns)
-        if tail is None:
-            tail = tails[time_ns] = (b"\x10" + _varint(time_ns & 0xFFFFFFFFFFFFFFFF)
-                                     if time_ns else b"")
-        out.append(RoadUsersDataPack.from_bytes(
-            name, engine, b"".join([frames[j] for j in view]) + tail))
-    return out
+            centres.append((u.x, u.y, -1 if me is None else me, u.time_ns))
+    views = iter(_convoy_datapack.neighbour_views(frames, xs, ys, centres, float(radius)))
+    return [RoadUsersDataPack.from_bytes(name, engine, next(views)) if want
+            else RoadUsersDataPack(name, engine) for engine, want in zip(agents, wanted)]

@@ -15,6 +15,7 @@
 #include "datapack/proto.h"
 #include "datapack/registry.h"
 #include "python/msgpack_codec.h"
+#include "python/neighbour_views.h"
 #include "python/proto_api.h"
 
 // What Python sees of the datapack registry (nrp_core.data.nrp_protobuf builds its classes
@@ -56,6 +57,7 @@ PYBIND11_EMBEDDED_MODULE(_convoy_datapack, m) {
   m.def("file_descriptor_set", [](const std::string& type) {
     return pybind11::bytes(Registry::global().file_descriptor_set(type));
   });
+  convoy::python::add_neighbour_views(m);  // convoy_traffic.neighbours' views
 }
 
 namespace convoy::python {
