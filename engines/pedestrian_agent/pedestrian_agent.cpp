@@ -29,6 +29,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -46,6 +47,7 @@
 #include "engine/engine.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
+#include "road_user_wire/datapack_users.h"
 #include "road_users/agent_config.h"
 #include "road_users/pedestrian_behaviour.h"
 #include "road_users/pedestrian_command.h"
@@ -54,22 +56,10 @@
 namespace convoy::engines::pedestrian_agent {
 namespace odr = convoy::opendrive;
 namespace ru = convoy::road_users;
+namespace wire = convoy::road_user_wire;
 using nlohmann::json;
 
 namespace {
-
-// The present road users of a neighbours datapack but `self`, walkers apart, in the order
-// received.
-ru::WalkerNeighbours neighbours_of(const data::RoadUsers& users, const std::string& self) {
-  ru::WalkerNeighbours out;
-  for (const data::RoadUser& u : users.users()) {
-    if (u.absent() || u.id() == self) continue;
-    (u.category() == "pedestrian" ? out.walkers : out.vehicles)
-        .push_back(
-            {u.id(), u.x(), u.y(), u.yaw(), u.speed(), u.length(), u.width(), u.length_offset()});
-  }
-  return out;
-}
 
 // The signals' states of the lights datapack ({"signals": {id: state}}, or the map itself); a
 // state that is not a string is left out.
@@ -111,6 +101,15 @@ class PedestrianAgent final : public Engine {
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw std::runtime_error("pedestrian_agent '" + d_.name + "': " + key + ": " + what);
   }
+  // The users of a neighbours datapack, read in place (road_user_wire).
+  void read_users(const std::string& key, const datapack::View& dp,
+                  const std::function<void(const wire::UserFields&)>& visit) const {
+    try {
+      wire::for_each_user(dp, visit);
+    } catch (const std::invalid_argument& e) {
+      fail(key, e.what());
+    }
+  }
   void warn_once(const std::string& key, const std::string& text) {
     if (warned_[key]) return;
     warned_[key] = true;
@@ -137,7 +136,6 @@ class PedestrianAgent final : public Engine {
   double mid_block_distance_ = 0;
   std::string state_dp_, neighbours_dp_, weather_dp_, command_dp_;
   data::RoadUser state_;
-  data::RoadUsers scratch_;  // the last neighbours datapack, parsed
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
 };
@@ -453,17 +451,14 @@ void PedestrianAgent::set_datapack(const datapack::View& dp) {
   if (dp.empty()) return;
   const std::string& name = dp.id().name();
   if (name == neighbours_dp_) {
-    data::RoadUsers& users = scratch_;  // reused: Clear keeps its messages for the next parse
-    users.Clear();
-    if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
-      datapack::read_proto(dp, &users);
-    } else if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUser>()) {
-      datapack::read_proto(dp, users.add_users());
-    } else {
-      fail(name, std::string("expected convoy.data.RoadUsers or RoadUser, got ") +
-                     (dp.is_proto() ? dp.proto_type() : std::string("JSON")));
-    }
-    s_.neighbours = std::make_shared<const ru::WalkerNeighbours>(neighbours_of(users, d_.name));
+    auto around = std::make_shared<ru::WalkerNeighbours>();
+    read_users(name, dp, [&](const wire::UserFields& u) {
+      if (u.absent || u.id == d_.name) return;
+      (u.category == "pedestrian" ? around->walkers : around->vehicles)
+          .push_back(
+              {std::string(u.id), u.x, u.y, u.yaw, u.speed, u.length, u.width, u.length_offset});
+    });
+    s_.neighbours = std::move(around);
   } else if (name == d_.lights_key) {
     if (!dp.is_json()) fail(name, "expected a JSON datapack {\"signals\": {id: state}}");
     const json j = datapack::read_json(dp);

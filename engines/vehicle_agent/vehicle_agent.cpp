@@ -47,6 +47,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -63,6 +64,7 @@
 #include "engine/engine.h"
 #include "opendrive/lane_graph.h"
 #include "opendrive/parser.h"
+#include "road_user_wire/datapack_users.h"
 #include "road_users/agent_config.h"
 #include "road_users/command.h"
 #include "road_users/lights.h"
@@ -74,21 +76,10 @@
 namespace convoy::engines::vehicle_agent {
 namespace odr = convoy::opendrive;
 namespace ru = convoy::road_users;
+namespace wire = convoy::road_user_wire;
 using nlohmann::json;
 
 namespace {
-
-// The road users in a neighbours datapack but `self` and the absent, in the order received.
-ru::Neighbours neighbours_of(const data::RoadUsers& users, const std::string& self) {
-  ru::Neighbours out;
-  out.reserve(users.users_size());
-  for (const data::RoadUser& u : users.users()) {
-    if (u.absent() || u.id() == self) continue;
-    out.push_back(
-        {u.id(), u.x(), u.y(), u.yaw(), u.speed(), u.length(), u.width(), u.length_offset()});
-  }
-  return out;
-}
 
 // The signals' states of the lights datapack ({"signals": {id: state}}, or the map itself);
 // a state that is not a string is left out (green).
@@ -133,6 +124,15 @@ class VehicleAgent final : public Engine {
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
     throw std::runtime_error("vehicle_agent '" + d_.name + "': " + key + ": " + what);
   }
+  // The users of a neighbours datapack, read in place (road_user_wire).
+  void read_users(const std::string& key, const datapack::View& dp,
+                  const std::function<void(const wire::UserFields&)>& visit) const {
+    try {
+      wire::for_each_user(dp, visit);
+    } catch (const std::invalid_argument& e) {
+      fail(key, e.what());
+    }
+  }
   void warn_once(const std::string& key, const std::string& text) {
     if (warned_[key]) return;
     warned_[key] = true;
@@ -159,7 +159,6 @@ class VehicleAgent final : public Engine {
   ru::VehicleState s_;
   std::string state_dp_, neighbours_dp_, lights_dp_, weather_dp_;
   data::RoadUser state_;
-  data::RoadUsers scratch_;  // the last neighbours datapack, parsed
   std::map<std::string, bool> warned_;
   std::vector<std::string> warnings_;
 };
@@ -447,18 +446,13 @@ void VehicleAgent::set_datapack(const datapack::View& dp) {
   if (dp.empty()) return;
   const std::string& name = dp.id().name();
   if (name == neighbours_dp_) {
-    data::RoadUsers& users = scratch_;  // reused: Clear keeps its messages for the next parse
-    users.Clear();
-    if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUsers>()) {
-      datapack::read_proto(dp, &users);
-    } else if (dp.is_proto() && dp.proto_type() == datapack::type_name<data::RoadUser>()) {
-      datapack::read_proto(dp, users.add_users());
-    } else {
-      fail(name, std::string("expected convoy.data.RoadUsers or RoadUser, got ") +
-                     (dp.is_proto() ? dp.proto_type() : std::string("JSON")));
-    }
-    ru::perceive(s_, std::make_shared<const ru::Neighbours>(neighbours_of(users, d_.name)),
-                 nullptr);
+    auto around = std::make_shared<ru::Neighbours>();
+    read_users(name, dp, [&](const wire::UserFields& u) {
+      if (u.absent || u.id == d_.name) return;
+      around->push_back(
+          {std::string(u.id), u.x, u.y, u.yaw, u.speed, u.length, u.width, u.length_offset});
+    });
+    ru::perceive(s_, std::move(around), nullptr);
   } else if (name == weather_dp_) {
     if (!dp.is_json()) fail(name, "expected the weather engine's JSON datapack");
     const json w = datapack::read_json(dp);
