@@ -32,10 +32,14 @@ double junction_wait(const opendrive::LaneGraph& graph, const Approach& at, cons
   // Until my rear has left the junction.
   const double my_clear = eta(g + (next->exit - next->enter) + at.length, v, a, v0);
   const size_t lo = at.cursor > 40 ? at.cursor - 40 : 0;
+  const double c = std::cos(me.yaw), s = std::sin(me.yaw);
+  const double my_arc = at.cursor < path.arc.size() ? path.arc[at.cursor] : 0;
   for (const Neighbour& u : around) {
     if (std::hypot(u.x - me.x, u.y - me.y) > me.radius) continue;
-    // On my own path (a leader or follower): IDM's business.
-    const auto pr = path.project(u.x, u.y, lo);
+    // On my own path (a leader or follower): IDM's business. (The hint: where it would be on a
+    // straight path.)
+    const double ahead = (u.x - me.x) * c + (u.y - me.y) * s;
+    const auto pr = path.project(u.x, u.y, lo, SIZE_MAX, path.index_at(my_arc + ahead));
     if (std::isfinite(pr.d2) && std::abs(pr.lateral) < 1.2 &&
         std::abs(std::remainder(u.yaw - path.at(pr.arc).heading, 2 * M_PI)) < 0.5)
       continue;

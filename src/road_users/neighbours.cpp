@@ -9,9 +9,13 @@ LaneNeighbour leader_on(const Path& path, size_t cursor, double front, double po
   LaneNeighbour leader;
   const size_t hi = cursor + static_cast<size_t>(me.radius / pose_spacing) + 2;
   const size_t lo = cursor > 10 ? cursor - 10 : 0;
+  const double c = std::cos(me.yaw), s = std::sin(me.yaw);
   for (const Neighbour& u : around) {
     if (std::hypot(u.x - me.x, u.y - me.y) > me.radius) continue;
-    const auto pr = path.project(u.x, u.y, lo, hi);
+    // Where it would be on a straight path: a hint for the projection.
+    const long ahead = std::lround(((u.x - me.x) * c + (u.y - me.y) * s) / pose_spacing);
+    const long hint = static_cast<long>(cursor) + ahead;
+    const auto pr = path.project(u.x, u.y, lo, hi, hint > 0 ? static_cast<size_t>(hint) : 0);
     if (!std::isfinite(pr.d2)) continue;
     const double half_w = 0.5 * (u.width > 0 ? u.width : 1.8);
     if (std::abs(pr.lateral) > 1.0 + half_w) continue;  // not in my lane

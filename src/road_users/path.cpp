@@ -21,16 +21,24 @@ odr::Pose2 Path::at(double a) const {
   return r;
 }
 
-Path::Proj Path::project(double x, double y, size_t lo, size_t hi) const {
+size_t Path::index_at(double a) const {
+  return static_cast<size_t>(std::lower_bound(arc.begin(), arc.end(), a) - arc.begin());
+}
+
+Path::Proj Path::project(double x, double y, size_t lo, size_t hi, size_t hint) const {
   Proj best;
   hi = std::min(hi, poses.size());
   const auto dist2 = [&](size_t i) {
     const double dx = x - poses[i].x, dy = y - poses[i].y;
     return dx * dx + dy * dy;
   };
-  // An upper bound of the nearest distance first, from every 8th pose.
+  // An upper bound of the nearest distance first: the hinted pose's, else every 8th pose's.
   double bound2 = INFINITY;
-  for (size_t i = lo; i < hi; i += 8) bound2 = std::min(bound2, dist2(i));
+  if (hint >= lo && hint < hi) {
+    bound2 = std::min({dist2(hint), dist2(lo), dist2(hi - 1)});
+  } else {
+    for (size_t i = lo; i < hi; i += 8) bound2 = std::min(bound2, dist2(i));
+  }
   const double bound = std::sqrt(bound2);
   // The path from pose i to a later pose j is at least as long as the straight line between
   // them (arcs are sums of straight steps), so pose j is at least d - (arc[j] - arc[i]) from

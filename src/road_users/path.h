@@ -34,14 +34,18 @@ struct Path {
   double length() const { return arc.empty() ? 0 : arc.back(); }
   // Pose at arc length a, interpolated between the poses (clamped to the ends).
   opendrive::Pose2 at(double a) const;
+  // The first pose at arc length a or beyond (poses.size() past the end).
+  size_t index_at(double a) const;
   // Projection of (x, y) onto the path, by the nearest pose among poses [lo, hi): its index,
   // the arc and the signed lateral offset (left positive) in that pose's frame, and the squared
-  // distance to that pose (+inf, arc 0, when the range is empty).
+  // distance to that pose (+inf, arc 0, when the range is empty). `hint`: a pose likely near
+  // the point (only speed depends on it, not the result).
   struct Proj {
     double arc = 0, lateral = 0, d2 = INFINITY;
     size_t index = 0;
   };
-  Proj project(double x, double y, size_t lo = 0, size_t hi = SIZE_MAX) const;
+  Proj project(double x, double y, size_t lo = 0, size_t hi = SIZE_MAX,
+               size_t hint = SIZE_MAX) const;
   // Appends `more` to the poses, each arc the last one's plus the straight distance to it;
   // a pose within 1e-6 m of the last one is skipped.
   void append(const std::vector<opendrive::Pose2>& more);
