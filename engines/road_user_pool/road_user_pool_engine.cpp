@@ -5,7 +5,13 @@
 // Config keys (schema.json): Map, Vehicles (listed), Count or Density + Seed + Policy +
 // DesiredSpeed + KeepClear (spawned), Pedestrians or PedestrianDensity (walkers on the
 // sidewalks, src/traffic_pool/pool_walkers.h), RoadUsersDataPack, ExternalDataPack,
-// CommandDataPack (JSON {"<road user id>": command}, the agents' command contract). In:
+// CommandDataPack (JSON {"<road user id>": command}, the agents' command contract),
+// TrafficLightsDataPack (the traffic_lights engine's JSON {"signals": {"<OpenDRIVE signal id>":
+// "red"|"yellow"|"green"|"red_yellow"|"off"}}: when set, the lights its vehicles and walkers obey
+// are these signals' states instead of its own cycle; a signal not in it is green, and so is every
+// signal until the first one comes, as for vehicle_agent; a datapack without "signals" or with a
+// state that is not one of those strings stops the run, exit 3, naming the engine, datapack and
+// signal). In:
 // <ExternalDataPack> convoy.data.RoadUsers (or one RoadUser), the road users it does not drive (the
 // ego, agents): obstacles its vehicles follow, keep gaps to and yield to, kept until the next one;
 // a malformed one stops the run (exit 2) naming the field. Out: <RoadUsersDataPack>
@@ -125,6 +131,33 @@ std::vector<tp::ExternalUser> external_users(const data::RoadUsers& users) {
   }
   return out;
 }
+
+// The traffic_lights engine's {"signals": {"<signal id>": state}}; anything else throws naming
+// `where` (and the signal).
+road_users::LightStates light_states(const json& j, const std::string& where) {
+  if (!j.is_object() || !j.contains("signals") || !j.at("signals").is_object()) {
+    throw std::runtime_error(where + ": expected {\"signals\": {\"<signal id>\": state}}, got " +
+                             j.dump().substr(0, 200));
+  }
+  road_users::LightStates out;
+  for (const auto& [id, v] : j.at("signals").items()) {
+    using road_users::Light;
+    const std::string st = v.is_string() ? v.get<std::string>() : "";
+    const Light l = st == "red"          ? Light::kRed
+                    : st == "red_yellow" ? Light::kRedYellow
+                    : st == "yellow"     ? Light::kYellow
+                    : st == "green"      ? Light::kGreen
+                                         : Light::kOff;
+    if (l == Light::kOff && st != "off") {
+      throw std::runtime_error(where + ": signals." + id +
+                               ": expected \"red\", \"yellow\", \"green\", \"red_yellow\" or "
+                               "\"off\", got " +
+                               v.dump());
+    }
+    out.emplace(id, l);
+  }
+  return out;
+}
 }  // namespace
 
 class RoadUserPoolEngine final : public Engine {
@@ -136,6 +169,7 @@ class RoadUserPoolEngine final : public Engine {
     dp_name_ = config.value("RoadUsersDataPack", "road_users");
     ext_name_ = config.value("ExternalDataPack", "external_users");
     cmd_name_ = config.value("CommandDataPack", "commands");
+    lights_name_ = config.value("TrafficLightsDataPack", "");
     try {
       map_ = std::make_unique<opendrive::Network>(opendrive::load(config.at("Map")));
       graph_ = std::make_unique<opendrive::LaneGraph>(*map_);
@@ -166,6 +200,9 @@ class RoadUserPoolEngine final : public Engine {
 
   void set_datapack(const datapack::View& dp) override {
     if (!dp.empty() && dp.id().name() == cmd_name_) return set_commands(dp);
+    if (!dp.empty() && !lights_name_.empty() && dp.id().name() == lights_name_) {
+      return set_lights(dp);
+    }
     if (dp.empty() || dp.id().name() != ext_name_) return;
     const std::string where = "road_user_pool engine '" + name_ + "': datapack '" + ext_name_ + "'";
     data::RoadUsers users;
@@ -196,6 +233,16 @@ class RoadUserPoolEngine final : public Engine {
     }
   }
 
+  // <TrafficLightsDataPack>: the signals' states the pool's lights follow from now on.
+  void set_lights(const datapack::View& dp) {
+    const std::string where =
+        "road_user_pool engine '" + name_ + "': datapack '" + lights_name_ + "'";
+    if (!dp.is_json()) {
+      throw std::runtime_error(where + ": expected the traffic_lights engine's JSON datapack");
+    }
+    pool_->set_light_states(light_states(datapack::read_json(dp), where));
+  }
+
   void get_datapack(const engine::DataPackId& id, datapack::Builder& out) override {
     if (id.name() == dp_name_) datapack::write_proto(out, users_);
   }
@@ -221,6 +268,7 @@ class RoadUserPoolEngine final : public Engine {
       specs.insert(specs.end(), more.begin(), more.end());
     }
     pool_ = std::make_unique<tp::Pool>(*net_, std::move(specs));
+    if (!lights_name_.empty()) pool_->set_light_states({});  // all green until the first states
     const size_t walkers = walker_count(clear);
     if (walkers > 0) {
       pool_->set_walkers(
@@ -362,7 +410,7 @@ class RoadUserPoolEngine final : public Engine {
     }
   }
 
-  std::string name_, dp_name_, ext_name_, cmd_name_;
+  std::string name_, dp_name_, ext_name_, cmd_name_, lights_name_;
   json config_;
   std::unique_ptr<opendrive::Network> map_;
   std::unique_ptr<opendrive::LaneGraph> graph_;

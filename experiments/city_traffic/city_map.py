@@ -102,3 +102,33 @@ class CityMap:
     def on_carriageway(self, road, lane):
         """True when (road, lane) is a driving lane (a pedestrian there is crossing)."""
         return self.lane_type.get((str(road), int(lane))) == "driving"
+
+
+STOP_LOOKAHEAD = 60.0    # m: a light of the ego's approach counts from this far
+YELLOW_STOP_DECEL = 3.0  # m/s^2: on yellow the ego stops if it can with at most this
+
+
+def stop_line_object(stop_lines, ego, signals):
+    """A RoadUser (of ego's message class) standing at the stop line of the ego's approach
+    when its light (`signals`: signal id -> state) says stop, as CARLA's agents treat red
+    lights: red, red-yellow, or yellow when it can stop with YELLOW_STOP_DECEL; else None."""
+    front = ego.length_offset + 0.5 * ego.length
+    fx, fy = ego.x + front * math.cos(ego.yaw), ego.y + front * math.sin(ego.yaw)
+    for line in stop_lines:
+        d = line.ahead(fx, fy, ego.yaw)
+        if d is None or d < -0.5 or d > STOP_LOOKAHEAD:
+            continue
+        state = signals.get(line.id, "off")
+        stop = state in ("red", "red_yellow") or (
+            state == "yellow" and ego.speed * ego.speed <= 2.0 * YELLOW_STOP_DECEL * max(d, 0.0))
+        if not stop:
+            return None
+        u = type(ego)()
+        u.id, u.category, u.model = "stop_line:" + line.id, "car", "stop_line"
+        cx, cy = line.centre()
+        # a 0.2 m deep object whose near edge is on the line
+        u.x, u.y, u.yaw = (cx + 0.1 * math.cos(line.heading), cy + 0.1 * math.sin(line.heading),
+                           line.heading)
+        u.length, u.width, u.length_offset = 0.2, 3.0, 0.0
+        return u
+    return None

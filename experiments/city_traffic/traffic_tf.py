@@ -14,7 +14,6 @@
 The agents' names come from make_config.py, which wrote the config. Without a planner engine
 (the density run) there is no ego: the ego's inputs and outputs are left out."""
 import json
-import math
 import os
 import sys
 
@@ -45,37 +44,8 @@ PEDESTRIANS = ["ped_%d" % i for i in range(len(make_config.PEDESTRIANS))]
 AGENTS = VEHICLES + PEDESTRIANS
 EGO = "smart_car"
 MAP = city_map.CityMap(os.path.join(HERE, make_config.MAP))
-STOP_LOOKAHEAD = 60.0   # m: a light of the ego's approach counts from this far
-YELLOW_STOP_DECEL = 3.0  # m/s^2: on yellow the ego stops if it can with at most this
 
 _in_sumo = set()  # pedestrians currently put into SUMO
-
-
-def _front(u):
-    return (u.x + (u.length_offset + 0.5 * u.length) * math.cos(u.yaw),
-            u.y + (u.length_offset + 0.5 * u.length) * math.sin(u.yaw))
-
-
-def _stop_line_object(ego, signals):
-    """A RoadUser standing at the stop line of the ego's approach when its light says stop."""
-    fx, fy = _front(ego)
-    for line in MAP.stop_lines:
-        d = line.ahead(fx, fy, ego.yaw)
-        if d is None or d < -0.5 or d > STOP_LOOKAHEAD:
-            continue
-        state = signals.get(line.id, "off")
-        stop = state in ("red", "red_yellow") or (
-            state == "yellow" and ego.speed * ego.speed <= 2.0 * YELLOW_STOP_DECEL * max(d, 0.0))
-        if not stop:
-            return None
-        u = type(ego)()
-        u.id, u.category, u.model = "stop_line:" + line.id, "car", "stop_line"
-        cx, cy = line.centre()
-        # a 0.2 m deep object whose near edge is on the line
-        u.x, u.y, u.yaw = cx + 0.1 * math.cos(line.heading), cy + 0.1 * math.sin(line.heading), line.heading
-        u.length, u.width, u.length_offset = 0.2, 3.0, 0.0
-        return u
-    return None
 
 
 def _traffic(**dps):
@@ -144,7 +114,7 @@ def _traffic(**dps):
     if ego_dp is not None:
         ego = ego_dp.data
         objs = list(others)
-        line = _stop_line_object(ego, signals)
+        line = city_map.stop_line_object(MAP.stop_lines, ego, signals)
         if line is not None:
             objs.append(line)
         e = ego_state(ego)

@@ -39,6 +39,7 @@ PoolNetwork::PoolNetwork(const odr::LaneGraph& graph, double ds) : graph_(&graph
   link();
   find_conflicts();
   find_stop_lines();
+  find_signals();
 }
 
 uint32_t PoolNetwork::pool_lane(odr::LaneIndex graph_lane) const {
@@ -50,6 +51,34 @@ Light PoolNetwork::light(uint32_t approach_lane, double t) const {
   if (l.approach < 0 || l.group < 0) return Light::kOff;
   const PoolJunction& j = junctions_[l.approach];
   return cycle_.state(t, j.offset_s, l.group);
+}
+
+namespace {
+int restrictiveness(Light l) {
+  switch (l) {
+    case Light::kRed:
+      return 4;
+    case Light::kRedYellow:
+      return 3;
+    case Light::kYellow:
+      return 2;
+    case Light::kGreen:
+      return 1;
+    default:
+      return 0;
+  }
+}
+}  // namespace
+
+Light stricter(Light a, Light b) { return restrictiveness(b) > restrictiveness(a) ? b : a; }
+
+Light PoolNetwork::signal_light(uint32_t lane, const road_users::LightStates& states) const {
+  Light out = Light::kOff;
+  for (const std::string& id : lanes_[lane].signals) {
+    const auto it = states.find(id);
+    out = stricter(out, it == states.end() ? Light::kGreen : it->second);
+  }
+  return out;
 }
 
 void PoolNetwork::add_lanes(double ds) {
@@ -208,6 +237,38 @@ void PoolNetwork::find_stop_lines() {
       const double to_end = n.forward ? n.s1 - cw.s : cw.s - n.s0;
       if (to_end < 0 || to_end > kReach) continue;
       lanes_[p].stop_back = std::max(lanes_[p].stop_back, to_end + kHalfCrosswalk + kMargin);
+    }
+  }
+}
+
+// The traffic lights of each lane (PoolLane::signals): those the map applies to it
+// (SignalInfo::lanes, as road_users::red_for reads them); an approach's within kSignalReach m
+// of its end, on it or on the lanes before it on its road (a road of several sections).
+void PoolNetwork::find_signals() {
+  std::vector<std::vector<const odr::SignalInfo*>> on(graph_->lanes().size());
+  for (const odr::SignalInfo& s : graph_->signals()) {
+    if (!s.traffic_light || !s.signal) continue;
+    for (odr::LaneIndex l : s.lanes) on[l].push_back(&s);
+  }
+  const auto add = [](PoolLane& l, const odr::SignalInfo* s) {
+    if (std::find(l.signals.begin(), l.signals.end(), s->signal->id) == l.signals.end())
+      l.signals.push_back(s->signal->id);
+  };
+  for (PoolLane& l : lanes_) {
+    if (l.junction >= 0) {
+      for (const odr::SignalInfo* s : on[l.graph_lane]) add(l, s);
+      continue;
+    }
+    if (l.approach < 0 || l.poses.empty()) continue;
+    const odr::Pose2& end = l.poses.back();
+    odr::LaneIndex g = l.graph_lane;
+    for (int back = 0; back < 4 && g != odr::kNoLane; ++back) {
+      for (const odr::SignalInfo* s : on[g]) {
+        if (std::hypot(s->pose.x - end.x, s->pose.y - end.y) <= kSignalReach) add(l, s);
+      }
+      const std::vector<odr::LaneIndex> before = graph_->predecessors(g);
+      g = before.size() == 1 && graph_->lane(before[0]).road->id == l.road_id ? before[0]
+                                                                              : odr::kNoLane;
     }
   }
 }

@@ -9,6 +9,12 @@
 // Lights: a junction has lights when the map gives it signals (LaneGraph::junction_signals).
 // The pool runs them itself on a fixed cycle: approaches heading mostly east-west (group 0) and
 // mostly north-south (group 1) take turns: green, yellow, all red (LightCycle).
+//
+// Lights given from outside (the traffic_lights engine's states, road_users::LightStates): a
+// lane's light is that of the traffic lights (type 1000001) the map puts on it, as
+// road_users::red_for finds them (SignalInfo::lanes). An approach lane takes those within
+// kSignalReach m of its end, on it or on the lanes before it on its road; a junction lane those
+// on it (a turn's own light). PoolLane::signals lists them.
 #pragma once
 
 #include <cstdint>
@@ -22,6 +28,7 @@
 namespace convoy::traffic_pool {
 
 inline constexpr uint32_t kNone = UINT32_MAX;
+inline constexpr double kSignalReach = 50;  // m from an approach's end to its lights
 
 struct PoolLane {
   opendrive::LaneIndex graph_lane = opendrive::kNoLane;
@@ -38,6 +45,7 @@ struct PoolLane {
   double stop_back = 0;                 // m before its end where it stops (before a crosswalk)
   std::vector<uint32_t> conflicts;      // junction lanes: those it crosses or merges with
   bool u_turn = false;                  // turns back (heading change > 150 degrees)
+  std::vector<std::string> signals;     // traffic lights (OpenDRIVE ids) of its stop line
   opendrive::Pose2 at(double s) const;  // s from the lane's start in its driving direction
 };
 
@@ -58,6 +66,9 @@ struct LightCycle {
   road_users::Light state(double t, double offset_s, int group) const;
 };
 
+// The more restrictive of two lights (red, red-yellow, yellow, green, off).
+road_users::Light stricter(road_users::Light a, road_users::Light b);
+
 class PoolNetwork {
  public:
   explicit PoolNetwork(const opendrive::LaneGraph& graph, double ds = 1.0);
@@ -68,6 +79,10 @@ class PoolNetwork {
   uint32_t pool_lane(opendrive::LaneIndex graph_lane) const;  // kNone: not a driving lane
   const LightCycle& cycle() const { return cycle_; }
   road_users::Light light(uint32_t approach_lane, double t) const;
+  // The light of a lane from the signals' states: the most restrictive of its signals' (red or
+  // red-yellow, then yellow, then green; a signal not in `states` is green); kOff when it has
+  // none, or all of them are off.
+  road_users::Light signal_light(uint32_t lane, const road_users::LightStates& states) const;
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;  // bounding box of the lanes
 
  private:
@@ -75,6 +90,7 @@ class PoolNetwork {
   void link();
   void find_conflicts();
   void find_stop_lines();
+  void find_signals();
   const opendrive::LaneGraph* graph_;
   std::vector<PoolLane> lanes_;
   std::vector<uint32_t> by_graph_lane_;

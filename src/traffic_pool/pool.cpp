@@ -135,7 +135,7 @@ double Pool::junction_gap(size_t i) {
   const double brake = v_[i] * v_[i] / (2 * sp.idm.b);
   // Its stop line: before the crosswalk, unless its front is past that already.
   const double line = dist > lane.stop_back ? dist - lane.stop_back : dist;
-  const Light light = net_.light(l, t_);
+  const Light light = this->light(l, j);
   const bool stop_light = light == Light::kRed || light == Light::kRedYellow ||
                           (light == Light::kYellow && line > brake);
   if (stop_light) return line - kStopMargin;

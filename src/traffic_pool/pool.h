@@ -10,6 +10,11 @@
 // so pooled vehicles follow it (IDM leader), keep MOBIL's gaps to it, wait while it occupies a
 // junction lane crossing theirs, and are not respawned onto it.
 //
+// Lights: the pool's own cycle (PoolNetwork::light(lane, t)) until set_light_states gives the
+// signals' states from outside (the traffic_lights engine's); from then on an approach's light
+// is the stricter of its own signals' and those of the junction lane it turns onto
+// (PoolNetwork::signal_light), for the vehicles and the walkers.
+//
 // Walkers (set_walkers, pool_walkers.h) step with the vehicles, after them (seeing the vehicles
 // and externals where they are then). The crossing a walker has stepped onto is an obstacle to
 // the vehicles like an external road user (PoolWalkers::crossing_box: the on-road part of its
@@ -32,6 +37,7 @@
 
 #include "road_users/command.h"
 #include "road_users/idm.h"
+#include "road_users/lights.h"
 #include "road_users/mobil.h"
 #include "road_users/pedestrian_command.h"
 #include "traffic_pool/network.h"
@@ -120,6 +126,12 @@ class Pool {
   std::vector<std::pair<uint32_t, uint32_t>> overlaps() const;
   // Pairs (pooled vehicle, external road user) whose boxes overlap now.
   std::vector<std::pair<uint32_t, uint32_t>> external_overlaps() const;
+  // The signals' states (OpenDRIVE id -> light; one not in them is green), replacing the pool's
+  // own cycle from now on; kept until the next call.
+  void set_light_states(const road_users::LightStates& states);
+  bool external_lights() const { return !lane_light_.empty(); }
+  // The light at approach lane `lane`'s stop line for one going on to junction lane `next`.
+  road_users::Light light(uint32_t lane, uint32_t next) const;
   // Walkers to step with the vehicles, replacing any (placed now). Throws PoolError as
   // PoolWalkers does, and when a walker has a vehicle's id.
   void set_walkers(std::vector<WalkerSpec> specs);
@@ -200,6 +212,7 @@ class Pool {
   std::vector<uint32_t> cell_head_, cell_next_;
   PoolStats stats_;
   bool leave_at_exits_ = false;
+  std::vector<road_users::Light> lane_light_;  // per lane, from set_light_states (empty: own)
   // Commands (pool_commands.cpp): this step's per vehicle and walker, the last route command's
   // positions, vehicles standing off the lanes (put 50 m from them: lane kNone).
   bool has_commands_ = false;

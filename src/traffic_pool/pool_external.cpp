@@ -162,13 +162,25 @@ void Pool::set_walkers(std::vector<WalkerSpec> specs) {
 void Pool::step_walkers(double dt) {
   if (!walkers_) return;
   walkers_->step(
-      dt, t_, [&](double x, double y, double r, std::vector<road_users::CrossingVehicle>& out) {
+      dt, t_,
+      [&](double x, double y, double r, std::vector<road_users::CrossingVehicle>& out) {
         for_near(x, y, r + 3, [&](uint32_t k) {
           if (k < n_ ? !present(k) : ext_of_[k - n_] >= ext_.size()) return;
           if (std::hypot(x_[k] - x, y_[k] - y) > r) return;
           out.push_back({x_[k], y_[k], yaw_[k], v_[k], specs_[k].length, specs_[k].width, 0.0});
         });
-      });
+      },
+      lane_light_.empty() ? nullptr : &lane_light_);
+}
+
+void Pool::set_light_states(const road_users::LightStates& states) {
+  lane_light_.resize(net_.lanes().size());
+  for (uint32_t l = 0; l < lane_light_.size(); ++l) lane_light_[l] = net_.signal_light(l, states);
+}
+
+road_users::Light Pool::light(uint32_t lane, uint32_t next) const {
+  if (lane_light_.empty()) return net_.light(lane, t_);
+  return stricter(lane_light_[lane], next == kNone ? road_users::Light::kOff : lane_light_[next]);
 }
 
 }  // namespace convoy::traffic_pool

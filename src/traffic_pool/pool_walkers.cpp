@@ -154,7 +154,12 @@ bool PoolWalkers::may_step_on(size_t i, const ru::WalkCrossing& c, double t,
   const Walker& w = w_[i];
   if (specs_[i].obey_lights && w.last_crosswalk >= 0 && !c.crosswalk.empty()) {
     const CrosswalkInfo& cw = crosswalks_[w.last_crosswalk];
-    if (cw.group >= 0 && cw.junction >= 0) {
+    if (lights_) {
+      for (uint32_t l : cw.lit) {
+        const road_users::Light now = (*lights_)[l];
+        if (now != road_users::Light::kRed && now != road_users::Light::kOff) return false;
+      }
+    } else if (cw.group >= 0 && cw.junction >= 0) {
       const double need = (c.exit - w.arc) / specs_[i].speed + 1.0;
       const double offset = net_.junctions()[cw.junction].offset_s;
       for (double when : {t, t + need}) {
@@ -222,7 +227,9 @@ std::vector<std::pair<uint32_t, uint32_t>> PoolWalkers::overlaps() const {
   return out;
 }
 
-void PoolWalkers::step(double dt, double t, const VehiclesNear& vehicles) {
+void PoolWalkers::step(double dt, double t, const VehiclesNear& vehicles,
+                       const std::vector<road_users::Light>* lane_lights) {
+  lights_ = lane_lights;
   index_walkers();
   for (size_t i = 0; i < w_.size(); ++i) step_walker(i, dt, t, vehicles);
 }

@@ -14,7 +14,10 @@
 // on the sidewalk; blocked, it gives way to one earlier in order or standing). It steps
 // onto the road only at a crosswalk, from the curb, when
 //   - the lights let it: at a junction with lights, the crossed road's approach is red now and
-//     will still be red when it has crossed (the pool's LightCycle); no lights: gap only;
+//     will still be red when it has crossed (the pool's LightCycle); with lights given from
+//     outside (step's lane_lights: states, no schedule to predict), every lit approach lane of
+//     the crossed road ending within 30 m of the crosswalk is red now (not red-yellow, not
+//     yellow; dark ones do not count); no lights: gap only;
 //   - every vehicle (pooled or external) arrives at the line it walks its critical gap (drawn
 //     3.5-5 s) or more from now (road_users::gap_accepted; a vehicle's box counted longer by
 //     the walker's width + 0.6 m), and no moving vehicle comes within 8 m of the crossing;
@@ -82,8 +85,10 @@ class PoolWalkers {
   // The vehicles within r m of (x, y): appended to `out`.
   using VehiclesNear =
       std::function<void(double x, double y, double r, std::vector<road_users::CrossingVehicle>&)>;
-  // One step of dt s at pool time t (the lights' clock).
-  void step(double dt, double t, const VehiclesNear& vehicles);
+  // One step of dt s at pool time t (the lights' clock); lane_lights: each pool lane's light
+  // given from outside (Pool::set_light_states), else null (the pool's own cycle).
+  void step(double dt, double t, const VehiclesNear& vehicles,
+            const std::vector<road_users::Light>* lane_lights = nullptr);
   size_t size() const { return w_.size(); }
   const WalkerSpec& spec(size_t i) const { return specs_[i]; }
   double x(size_t i) const { return w_[i].x; }
@@ -124,6 +129,7 @@ class PoolWalkers {
   struct CrosswalkInfo {
     size_t graph_index = 0;
     int junction = -1, group = -1;  // the lights of the crossed road's approach (-1: none)
+    std::vector<uint32_t> lit;      // its approach lanes with signals (lights from outside)
     double x = 0, y = 0;            // its centre
   };
   void index_sidewalks();
@@ -177,6 +183,7 @@ class PoolWalkers {
   int gx_ = 1, gy_ = 1;
   std::vector<uint32_t> head_, chain_;
   WalkerStats stats_;
+  const std::vector<road_users::Light>* lights_ = nullptr;  // step's lane_lights
 };
 
 }  // namespace convoy::traffic_pool

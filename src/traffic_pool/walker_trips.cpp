@@ -165,9 +165,12 @@ void PoolWalkers::index_sidewalks() {
     info.x = 0.5 * (a.x + b.x);
     info.y = 0.5 * (a.y + b.y);
     double best = kLightReach;
-    for (const PoolLane& l : net_.lanes()) {
-      if (l.road_id != c.road_id || l.group < 0 || l.poses.empty()) continue;
+    for (uint32_t pl = 0; pl < net_.lanes().size(); ++pl) {
+      const PoolLane& l = net_.lane(pl);
+      if (l.road_id != c.road_id || l.poses.empty()) continue;
       const double d = std::hypot(l.poses.back().x - info.x, l.poses.back().y - info.y);
+      if (l.approach >= 0 && !l.signals.empty() && d < kLightReach) info.lit.push_back(pl);
+      if (l.group < 0) continue;
       if (d < best) {
         best = d;
         info.junction = l.approach;

@@ -6,6 +6,11 @@ its walkers (Pedestrians) come after the vehicles, category pedestrian, model wa
 Commands: a TF sends the pool scenario commands (CommandDataPack, the agents' contract): a
 speed command holds a vehicle's speed, a teleport puts it at a pose, then IDM takes over; an
 unknown id stops the run (exit 3).
+TrafficLightsEngine: the traffic_lights engine's datapack, passed to the pool by a TF
+(TrafficLightsDataPack), holds the main road of junction 100 (signals 1 and 2) red for the whole
+run: no pooled vehicle leaves road 1's approach into the junction while some queue there; with
+that road green they do leave it; a datapack without "signals", or with a state that is not a
+string, stops the run (exit 3) naming the engine, the datapack and the signal.
 BadInput: an unknown policy, two road users on one spot, a count the map cannot hold, a
 destination with no path, and pedestrians the sidewalks cannot hold (Pedestrians,
 PedestrianDensity) each stop the run with one message naming the road user or key and the
@@ -165,6 +170,102 @@ class Commands(E2ETestCase):
         self.assertStderrHas(r, "road_user_pool engine 'pool': datapack 'commands': no road "
                                 "user 'nobody' in the pool")
         self.assertNoEngineLeft()
+
+
+LIGHTS_TF = textwrap.dedent("""\
+    import json
+    from nrp_core import *
+    from nrp_core.data.nrp_json import JsonDataPack
+
+    _out = open(OUT, "w")
+
+
+    @EngineDataPack(keyword="lights", id=DataPackIdentifier("traffic_lights", "lights"))
+    @EngineDataPack(keyword="v", id=DataPackIdentifier("road_users", "pool"))
+    @TransceiverFunction("pool")
+    def lights_to_pool(v, lights):
+        if not v.isEmpty():
+            _out.write(json.dumps([[u.id, u.road, u.lane, u.speed] for u in v.data.users]) + "\\n")
+            _out.flush()
+        if lights.isEmpty():
+            return []
+        return [JsonDataPack("traffic_lights", "pool", SEND)]
+    """)
+
+
+def junction_roads(xodr):
+    """Ids of the roads inside junctions."""
+    import xml.etree.ElementTree as ET
+    return {r.get("id") for r in ET.parse(xodr).getroot().findall("road")
+            if r.get("junction") not in (None, "-1")}
+
+
+class TrafficLightsEngine(E2ETestCase):
+    """A pool on the city map obeying the traffic_lights engine (its program for junction 100:
+    `green` controllers green, the others red, for the whole run)."""
+
+    def run_lights(self, green, send="lights.data", seconds=30.0):
+        out = os.path.join(self.dir, "rows.jsonl")
+        self.write("tf.py", LIGHTS_TF.replace("OUT", repr(out)).replace("SEND", send))
+        cfg = pool_config(Map=CITY, Count=60, Seed=4, TrafficLightsDataPack="traffic_lights")
+        cfg["SimulationTimeout"] = seconds
+        cfg["EngineConfigs"].append(
+            {"EngineType": "traffic_lights", "EngineName": "lights", "EngineTimestep": 0.05,
+             "Map": CITY, "Programs": {"100": [{"Duration": 1000.0, "Green": green}]}})
+        cfg["DataPackProcessingFunctions"] = [{"Name": "lights_to_pool", "FileName": "tf.py"}]
+        self.write_config(cfg)
+        r = self.run_convoy()
+        rows = []
+        if os.path.exists(out):
+            with open(out) as f:
+                rows = [json.loads(line) for line in f]
+        return r, rows
+
+    def left_road_1(self, rows):
+        """How many times a pooled vehicle went from road 1's lanes -1/-2 (signals 1 and 2's
+        approach into junction 100) into the junction, and the most standing there at once
+        after 10 s."""
+        inside = junction_roads(CITY)
+        last, left, queued = {}, 0, 0
+        for k, users in enumerate(rows):
+            standing = 0
+            for uid, road, lane, speed in users:
+                was = last.get(uid)
+                if was and was[0] == "1" and was[1] in (-1, -2) and road in inside:
+                    left += 1
+                if road == "1" and lane in (-1, -2) and speed < 0.1:
+                    standing += 1
+                last[uid] = (road, lane)
+            if k >= 200:
+                queued = max(queued, standing)
+        return left, queued
+
+    def test_red_approach_holds_its_vehicles(self):
+        r, rows = self.run_lights(["1002"])  # the side roads green, the main road red
+        self.assertExit(r, 0)
+        self.assertGreater(len(rows), 550)
+        left, queued = self.left_road_1(rows)
+        self.assertEqual(left, 0)
+        self.assertGreaterEqual(queued, 2)
+        r, rows = self.run_lights(["1001"])  # the main road green: they leave it
+        self.assertExit(r, 0)
+        left, _ = self.left_road_1(rows)
+        self.assertGreater(left, 0)
+        self.assertNoEngineLeft()
+
+    def bad_lights(self, send, *needles):
+        r, _ = self.run_lights(["1001"], send=send, seconds=2.0)
+        self.assertExit(r, 3)  # bad content, as for the agents
+        self.assertOneError(r)
+        self.assertStderrHas(r, "road_user_pool engine 'pool': datapack 'traffic_lights'", *needles)
+        self.assertNoEngineLeft()
+
+    def test_state_that_is_not_a_string(self):
+        self.bad_lights('{"signals": {"1": 5}}', 'signals.1: expected "red", "yellow", "green", '
+                        '"red_yellow" or "off", got 5')
+
+    def test_no_signals(self):
+        self.bad_lights('{"lights": {}}', 'expected {"signals": {"<signal id>": state}}')
 
 
 class BadInput(E2ETestCase):
