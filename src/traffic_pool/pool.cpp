@@ -103,7 +103,7 @@ double Pool::leader_gap(size_t i, double& vl) const {
 
 bool Pool::conflict_free(uint32_t junction_lane, size_t me) const {
   for (uint32_t c : net_.lane(junction_lane).conflicts) {
-    if (claims_[c] > 0) return false;
+    if (claims_[c] > 0 || external_arriving(c)) return false;
     for (uint32_t r = lane_begin_[c]; r < lane_begin_[c + 1]; ++r) {
       if (order_[r] != me) return false;
     }

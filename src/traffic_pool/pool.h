@@ -156,6 +156,7 @@ class Pool {
   double junction_gap(size_t i);
   double grid_gap(size_t i, double& vl) const;
   bool conflict_free(uint32_t junction_lane, size_t me) const;
+  bool external_arriving(uint32_t junction_lane) const;
   bool exit_has_room(uint32_t exit_lane, double need) const;
   void consider_lane_change(size_t i);
   void advance(size_t i, double dt);
@@ -212,7 +213,8 @@ class Pool {
   std::vector<uint32_t> cell_head_, cell_next_;
   PoolStats stats_;
   bool leave_at_exits_ = false;
-  std::vector<road_users::Light> lane_light_;  // per lane, from set_light_states (empty: own)
+  std::vector<road_users::Light> lane_light_;   // per lane, from set_light_states (empty: own)
+  std::vector<std::vector<uint32_t>> feeders_;  // junction lane -> the approaches into it
   // Commands (pool_commands.cpp): this step's per vehicle and walker, the last route command's
   // positions, vehicles standing off the lanes (put 50 m from them: lane kNone).
   bool has_commands_ = false;

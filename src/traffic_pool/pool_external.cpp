@@ -92,6 +92,13 @@ void Pool::place_externals() {
   grid_end_ = lane_.size();
   if (obs_.empty()) return;
   if (point_begin_.empty()) index_lane_points();
+  if (feeders_.empty()) {  // junction lane -> the approaches into it (external_arriving)
+    feeders_.resize(net_.lanes().size());
+    for (uint32_t a = 0; a < net_.lanes().size(); ++a) {
+      if (net_.lane(a).approach < 0) continue;
+      for (uint32_t n : net_.lane(a).next) feeders_[n].push_back(a);
+    }
+  }
   for (uint32_t e = 0; e < obs_.size(); ++e) add_lane_entries(e);
 }
 
@@ -181,6 +188,28 @@ void Pool::set_light_states(const road_users::LightStates& states) {
 road_users::Light Pool::light(uint32_t lane, uint32_t next) const {
   if (lane_light_.empty()) return net_.light(lane, t_);
   return stricter(lane_light_[lane], next == kNone ? road_users::Light::kOff : lane_light_[next]);
+}
+
+// An external road user (the ego, an agent) coming up an approach into `junction_lane`: it
+// neither claims junction lanes nor reads the pool's claims, so a pooled vehicle must not
+// claim a lane crossing its way in front of it. Coming: moving (over 1 m/s) and within 4 s
+// (+5 m) of the line, unless its light is red and it can still stop (3 m/s^2). Where it
+// turns is not known: any lane of its approach counts.
+bool Pool::external_arriving(uint32_t junction_lane) const {
+  if (obs_.empty() || feeders_.empty()) return false;
+  for (uint32_t a : feeders_[junction_lane]) {
+    const road_users::Light light = this->light(a, junction_lane);
+    for (uint32_t r = lane_begin_[a]; r < lane_begin_[a + 1]; ++r) {
+      const uint32_t k = order_[r];
+      if (k < n_ || v_[k] <= 1.0) continue;  // pooled vehicles claim; standing ones wait
+      const double dist = net_.lane(a).length - s_[k];
+      if (dist > 4 * v_[k] + 5) continue;
+      const bool red = light == road_users::Light::kRed || light == road_users::Light::kRedYellow;
+      if (red && dist > v_[k] * v_[k] / (2 * 3.0) + 1) continue;  // it stops there
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace convoy::traffic_pool

@@ -5,6 +5,7 @@
 // are never moved.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "grid_map.h"
@@ -135,6 +136,53 @@ TEST(PoolExternal, WaitsWhileAnExternalCarStandsAcrossItsJunctionPath) {
     }
   }
   FAIL() << "no approach with a crossing junction lane on the grid";
+}
+
+// An external car coming up an approach that crosses the pooled car's junction path (on
+// green, too fast to be sure it stops) keeps the pooled car at its line; a standing one does not.
+TEST(PoolExternal, YieldsToAnExternalCarComingIntoTheJunction) {
+  const PoolNetwork& net = map().pool;
+  const auto green = [&](uint32_t lane) {  // for the test's first 8 s
+    for (double t = 0; t <= 8; t += 0.5) {
+      const road_users::Light l = net.light(lane, t);
+      if (l != road_users::Light::kGreen && l != road_users::Light::kOff) return false;
+    }
+    return true;
+  };
+  for (uint32_t a = 0; a < net.lanes().size(); ++a) {
+    const PoolLane& app = net.lane(a);
+    if (app.approach < 0 || app.length < 40 || app.next.empty() || !green(a)) continue;
+    const uint32_t j = app.next[0];
+    const PoolLane& path = net.lane(j);
+    if (path.next.empty()) continue;
+    for (uint32_t c : path.conflicts) {
+      for (uint32_t b = 0; b < net.lanes().size(); ++b) {
+        const PoolLane& other = net.lane(b);
+        if (b == a || other.approach < 0 || other.length < 40 || !green(b)) continue;
+        if (std::find(other.next.begin(), other.next.end(), c) == other.next.end()) continue;
+        const PoolLane& exit = net.lane(path.next[0]);
+        VehicleSpec car = at("car", app, app.length - 15);
+        car.policy = "idm";
+        car.speed = 5;
+        car.to = std::make_pair(exit.road_id, exit.lane_id);
+        Pool pool(net, {car});
+        const ExternalUser coming = car_on("ego", other, other.length - 20, 10);
+        for (int k = 0; k < 3 * 20; ++k) {
+          pool.set_external({coming});
+          pool.step(0.05);
+        }
+        EXPECT_EQ(pool.lane(0), a) << "entered the junction in front of the external car";
+        ExternalUser standing = car_on("ego", other, other.length - 40, 0);
+        for (int k = 0; k < 10 * 20 && pool.lane(0) == a; ++k) {
+          pool.set_external({standing});
+          pool.step(0.05);
+        }
+        EXPECT_NE(pool.lane(0), a) << "kept waiting for a standing external car";
+        return;
+      }
+    }
+  }
+  FAIL() << "no two green approaches into crossing junction lanes on the grid";
 }
 
 }  // namespace
