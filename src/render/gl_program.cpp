@@ -410,7 +410,7 @@ void main() {
 )";
 
 const char* kSkyShader = R"(#version 300 es
-precision mediump float;
+precision highp float;
 uniform vec3 u_horizon;
 uniform vec3 u_zenith;
 in vec3 v_ray;
@@ -436,7 +436,7 @@ void main() {
 )";
 
 const char* kPrecipitationShader = R"(#version 300 es
-precision mediump float;
+precision highp float;
 uniform bool u_snow;
 in vec3 v_local;
 out vec4 out_color;
