@@ -450,12 +450,7 @@ void CameraSensors::convert(const Camera& cam, std::span<uint8_t> dst) const {
       pixels,
       [&](size_t begin, size_t end) {
         render::rgba_to_rgb(src + 4 * begin, dst.data() + 3 * begin, end - begin);
-        if (!noise) return;
-        uint8_t* px = dst.data();
-        for (size_t i = 3 * begin; i < 3 * end; ++i) {
-          const int v = px[i] + noise[i];
-          px[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
-        }
+        if (noise) render::add_noise(dst.data() + 3 * begin, noise + 3 * begin, 3 * (end - begin));
       },
       64);
 }

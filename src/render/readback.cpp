@@ -25,6 +25,15 @@ void rgba_to_rgb(const uint8_t* src, uint8_t* dst, size_t pixels) {
   for (; i < pixels; ++i) std::memcpy(dst + 3 * i, src + 4 * i, 3);
 }
 
+void add_noise(uint8_t* __restrict bytes, const int16_t* __restrict noise, size_t count) {
+  // Restricted locals: the compiler vectorises this (16-bit lanes); through pointers it had to
+  // reload, it added byte by byte.
+  for (size_t i = 0; i < count; ++i) {
+    const int v = bytes[i] + noise[i];
+    bytes[i] = static_cast<uint8_t>(v < 0 ? 0 : v > 255 ? 255 : v);
+  }
+}
+
 void boxes_from_ids(const uint32_t* ids, int width, int height, const Scene& scene,
                     std::vector<BoundingBox>* boxes, const float* instance_distance) {
   struct Extent {
