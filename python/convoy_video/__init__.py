@@ -31,6 +31,9 @@ import sys
 
 PRESET = "veryfast"
 CRF = 23
+# One encoder thread: the co-simulation's engines keep the cores busy, and x264's frame threads
+# cost 18 % more CPU for the same video (a 736x480 camera: 4.0 -> 3.3 s for 750 frames).
+THREADS = 1
 _F_SETPIPE_SZ = 1031  # fcntl.F_SETPIPE_SZ (Linux), not in Python 3.11's fcntl
 
 
@@ -80,7 +83,8 @@ class VideoWriter:
                "-framerate", str(self.fps), "-i", "pipe:0", "-an"]
         if width % 2 or height % 2:  # yuv420p halves both: pad to even sizes
             cmd += ["-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2"]
-        cmd += ["-c:v", "libx264", "-preset", PRESET, "-crf", str(CRF), "-pix_fmt", "yuv420p",
+        cmd += ["-c:v", "libx264", "-preset", PRESET, "-crf", str(CRF), "-threads", str(THREADS),
+                "-pix_fmt", "yuv420p",
                 # Fragmented (a fragment per key frame, 250 frames): the muxer keeps no index of
                 # the whole video (an hour's grew ffmpeg by 12 MiB, and +faststart rewrote the
                 # file at the end), browsers stream it (the moov box comes first), and a
