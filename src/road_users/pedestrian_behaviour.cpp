@@ -154,37 +154,15 @@ void Stepper::place(const PedestrianCommand& cmd, double dt) {
 
 // Towards a point 0.5 m ahead on the commanded polyline (its end at the last), at its speed.
 void Stepper::walk_polyline(const PedestrianCommand& cmd, double v_des, double dt) {
-  const WalkPath& t = s.traj_path;
-  size_t best = 0;
-  double d2 = INFINITY;
-  for (size_t i = 0; i < t.poses.size(); ++i) {
-    const double dx = t.poses[i].x - s.x, dy = t.poses[i].y - s.y;
-    if (dx * dx + dy * dy < d2) {
-      d2 = dx * dx + dy * dy;
-      best = i;
-    }
-  }
-  const odr::Pose2& end = t.poses.back();
-  const double ahead = t.arc[best] + 0.5;
-  const odr::Pose2 target = ahead >= t.length() ? end : t.at(ahead);
-  const double dx = target.x - s.x, dy = target.y - s.y;
-  const double dist = std::hypot(dx, dy);
-  double v = cmd.speed ? v_des : walker_ahead_speed(v_des);
-  double step = v * dt;
-  if (ahead >= t.length()) step = std::min(step, dist);  // stops at its end
-  if (dist > 1e-9 && step > 0) {
-    const double yaw = std::atan2(dy, dx);
-    s.x += step * dx / dist;
-    s.y += step * dy / dist;
-    s.yaw_rate = std::remainder(yaw - s.yaw, 2 * M_PI) / dt;
-    s.yaw = yaw;
-  } else {
-    step = 0;
-    s.yaw_rate = 0;
-  }
-  s.walked += step;
-  s.acc = (step / dt - s.v) / dt;
-  s.v = step / dt;
+  const double v = cmd.speed ? v_des : walker_ahead_speed(v_des);
+  const WalkStep m = step_along(s.traj_path, s.x, s.y, s.yaw, v, dt);
+  s.yaw_rate = std::remainder(m.yaw - s.yaw, 2 * M_PI) / dt;
+  s.x = m.x;
+  s.y = m.y;
+  s.yaw = m.yaw;
+  s.walked += m.moved;
+  s.acc = (m.moved / dt - s.v) / dt;
+  s.v = m.moved / dt;
 }
 
 // The farthest arc it may be at: its path's end, or where the next crossing lets it go (the
@@ -295,13 +273,8 @@ std::vector<CrossingThreat> Stepper::threats(const WalkCrossing& c) const {
 
 void Stepper::replan(const Points& via) {
   WalkPath path;
-  path.append({odr::Pose2{s.x, s.y, s.yaw}});
-  for (const auto& [px, py] : via)
-    append_leg(*d.graph, path, path.poses.back().x, path.poses.back().y, px, py);
-  const double yaw = path.poses.size() > 1 ? path.poses.back().heading : s.yaw;
   s.kr_from = INFINITY;
-  s.stand_at_end = !walk_path_from(*d.graph, path, path.poses.back().x, path.poses.back().y, yaw,
-                                   d.dest, s.rng, &s.kr_from);
+  s.stand_at_end = !walk_through(*d.graph, path, s.x, s.y, s.yaw, via, d.dest, s.rng, &s.kr_from);
   if (s.stand_at_end && via.empty()) {
     char where[96];
     std::snprintf(where, sizeof where, "(%.2f, %.2f)", s.x, s.y);
@@ -323,25 +296,7 @@ void Stepper::replan(const Points& via) {
 void Stepper::set_polyline(const Points& points) {
   if (points == s.polyline) return;
   s.polyline = points;
-  s.traj_path = WalkPath{};
-  std::vector<odr::Pose2> poses;
-  for (size_t i = 0; i < points.size(); ++i) {
-    const size_t j = i + 1 < points.size() ? i + 1 : i;
-    const double h = j != i ? std::atan2(points[j][1] - points[i][1], points[j][0] - points[i][0])
-                            : (poses.empty() ? s.yaw : poses.back().heading);
-    if (i + 1 < points.size()) {
-      const double len = std::hypot(points[j][0] - points[i][0], points[j][1] - points[i][1]);
-      const int n = std::max(1, static_cast<int>(std::ceil(len / kWalkSampleDs)));
-      for (int k = 0; k < n; ++k) {
-        const double f = static_cast<double>(k) / n;
-        poses.push_back(odr::Pose2{points[i][0] + f * (points[j][0] - points[i][0]),
-                                   points[i][1] + f * (points[j][1] - points[i][1]), h});
-      }
-    } else {
-      poses.push_back(odr::Pose2{points[i][0], points[i][1], h});
-    }
-  }
-  s.traj_path.append(poses);
+  s.traj_path = polyline_walk(points, s.yaw);
 }
 
 }  // namespace

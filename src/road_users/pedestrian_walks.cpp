@@ -210,4 +210,58 @@ bool walk_path_from(const odr::LaneGraph& graph, WalkPath& path, double x, doubl
   return true;
 }
 
+bool walk_through(const odr::LaneGraph& graph, WalkPath& path, double x, double y, double yaw,
+                  const Points& via, const std::optional<Spot>& dest, std::mt19937_64& rng,
+                  double* join) {
+  path.append({odr::Pose2{x, y, yaw}});
+  for (const auto& [px, py] : via)
+    append_leg(graph, path, path.poses.back().x, path.poses.back().y, px, py);
+  const double h = path.poses.size() > 1 ? path.poses.back().heading : yaw;
+  return walk_path_from(graph, path, path.poses.back().x, path.poses.back().y, h, dest, rng, join);
+}
+
+WalkPath polyline_walk(const Points& points, double yaw) {
+  std::vector<odr::Pose2> poses;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const size_t j = i + 1 < points.size() ? i + 1 : i;
+    const double h = j != i ? std::atan2(points[j][1] - points[i][1], points[j][0] - points[i][0])
+                            : (poses.empty() ? yaw : poses.back().heading);
+    if (i + 1 < points.size()) {
+      const double len = std::hypot(points[j][0] - points[i][0], points[j][1] - points[i][1]);
+      const int n = std::max(1, static_cast<int>(std::ceil(len / kWalkSampleDs)));
+      for (int k = 0; k < n; ++k) {
+        const double f = static_cast<double>(k) / n;
+        poses.push_back(odr::Pose2{points[i][0] + f * (points[j][0] - points[i][0]),
+                                   points[i][1] + f * (points[j][1] - points[i][1]), h});
+      }
+    } else {
+      poses.push_back(odr::Pose2{points[i][0], points[i][1], h});
+    }
+  }
+  WalkPath t;
+  t.append(poses);
+  return t;
+}
+
+WalkStep step_along(const WalkPath& t, double x, double y, double yaw, double v, double dt) {
+  size_t best = 0;
+  double d2 = INFINITY;
+  for (size_t i = 0; i < t.poses.size(); ++i) {
+    const double dx = t.poses[i].x - x, dy = t.poses[i].y - y;
+    if (dx * dx + dy * dy < d2) {
+      d2 = dx * dx + dy * dy;
+      best = i;
+    }
+  }
+  const odr::Pose2& end = t.poses.back();
+  const double ahead = t.arc[best] + 0.5;
+  const odr::Pose2 target = ahead >= t.length() ? end : t.at(ahead);
+  const double dx = target.x - x, dy = target.y - y;
+  const double dist = std::hypot(dx, dy);
+  double step = v * dt;
+  if (ahead >= t.length()) step = std::min(step, dist);  // stops at its end
+  if (dist <= 1e-9 || step <= 0) return {x, y, yaw, 0};
+  return {x + step * dx / dist, y + step * dy / dist, std::atan2(dy, dx), step};
+}
+
 }  // namespace convoy::road_users

@@ -75,5 +75,23 @@ void append_leg(const opendrive::LaneGraph& graph, WalkPath& path, double ax, do
 bool walk_path_from(const opendrive::LaneGraph& graph, WalkPath& path, double x, double y,
                     double yaw, const std::optional<Spot>& dest, std::mt19937_64& rng,
                     double* join = nullptr);
+// A commanded route's walk, appended to `path`: from (x, y) facing `yaw`, straight legs through
+// `via` in order (append_leg: their parts off the sidewalks are crossings), then walk_path_from
+// the last point (facing along the last leg) to `dest` or onward; false, the path ending at the
+// last point, without a sidewalk near it. The pedestrian_agent's and the pooled walkers' rule.
+bool walk_through(const opendrive::LaneGraph& graph, WalkPath& path, double x, double y, double yaw,
+                  const Points& via, const std::optional<Spot>& dest, std::mt19937_64& rng,
+                  double* join = nullptr);
+
+// A commanded polyline's walk: poses about kWalkSampleDs apart through `points`, each heading
+// along its segment (the last point's as the segment before it; `yaw` for a single point).
+WalkPath polyline_walk(const Points& points, double yaw);
+// One step along a polyline walk `t` from (x, y) facing `yaw`, at v m/s for dt s: towards the
+// point 0.5 m ahead of its pose nearest (x, y) (its end when that is past it), stopping at its
+// end. Where it gets to, its heading (`yaw` when it does not move) and how far it moved.
+struct WalkStep {
+  double x = 0, y = 0, yaw = 0, moved = 0;
+};
+WalkStep step_along(const WalkPath& t, double x, double y, double yaw, double v, double dt);
 
 }  // namespace convoy::road_users

@@ -312,7 +312,7 @@ void Pool::step(double dt) {
   }
   if (has_commands_) command_before_move(dt);
   for (size_t i = 0; i < size(); ++i) {
-    if (!present(i)) continue;
+    if (!present(i) || on_polyline(i)) continue;  // (driven along it by the command)
     advance(i, dt);
     if (!present(i)) continue;  // it left the network
     update_pose(i);

@@ -142,7 +142,7 @@ class Pool {
   // users"): `pack` is {"<id>": command, ...}, ids with or without `prefix`, each command read
   // by road_users' parser (the agents' contract). A pose's point lies `ref_ahead` x length
   // behind the box's centre (the published reference point). Throws PoolError naming `where`
-  // and the road user: an unknown id, a bad command, a part the pool does not take yet.
+  // and the road user: an unknown id, a bad command.
   void set_commands(const nlohmann::json& pack, const std::string& where, const std::string& prefix,
                     double ref_ahead);
 
@@ -181,6 +181,11 @@ class Pool {
   void command_lane(size_t i, const road_users::VehicleCommand::Lane& want);
   void command_route(size_t i, const road_users::Points& positions);
   bool commanded_lateral(size_t i) const;
+  // pool_paths.cpp: an untimed trajectory (polyline) driven this step, and the walkers' paths.
+  bool on_polyline(size_t i) const;
+  void drive_polyline(size_t i, const road_users::VehicleCommand& c, double dt);
+  double polyline_accel(size_t i, const road_users::Path& path, double v0);
+  void command_walker_paths();
 
   const PoolNetwork& net_;
   // Entries: 0..n_-1 pooled vehicles, then one grid entry per external road user (lane kNone),
@@ -223,6 +228,8 @@ class Pool {
   std::vector<std::optional<road_users::VehicleCommand>> cmd_;
   std::vector<std::optional<road_users::PedestrianCommand>> wcmd_;
   std::vector<road_users::Points> routed_;
+  std::vector<road_users::Points> polyline_;  // the last polyline driven, and its path
+  std::vector<road_users::Path> poly_path_;
   std::vector<uint8_t> stand_;
   std::vector<std::pair<size_t, double>> pace_;  // walkers on a commanded pace: their own
 };

@@ -1,7 +1,7 @@
 // Scenario commands for pooled road users (pool.h, set_commands; docs/road_users.md, "Pooled
 // road users", Commands). Each command is read by src/road_users' parser, the one the agents
-// use, so the pool takes exactly their contract; this file only applies the parts the pool
-// implements to its arrays and refuses the others by name. A command holds for the next step.
+// use, so the pool takes exactly their contract; this file applies it to the pool's arrays
+// (untimed trajectories and walkers' routes: pool_paths.cpp). A command holds for the next step.
 #include <algorithm>
 #include <cmath>
 
@@ -16,13 +16,8 @@ namespace {
 constexpr double kLocateRadius = 50;         // m: farther from every driving lane, it stands
 constexpr double kLocateHeading = M_PI / 3;  // its yaw within 60 degrees of the lane's
 constexpr double kRouteRadius = 20;          // m: a route position's lane (the parser's)
-constexpr int kLaneSearch = 6;
-constexpr double kMinPace = 1e-3;  // m/s: a walker commanded to stand (its rules divide by it) //
-                                   // lanes to either side a lane command looks at
-
-[[noreturn]] void not_yet(const std::string& key) {
-  throw ru::CommandError(key, "not supported by the pooled host yet");
-}
+constexpr int kLaneSearch = 6;               // lanes to either side a lane command looks at
+constexpr double kMinPace = 1e-3;  // m/s: a walker commanded to stand (its rules divide by it)
 }  // namespace
 
 void Pool::set_commands(const json& pack, const std::string& where, const std::string& prefix,
@@ -35,6 +30,8 @@ void Pool::set_commands(const json& pack, const std::string& where, const std::s
     cmd_.assign(n_, std::nullopt);
     routed_.assign(n_, {});
     stand_.assign(n_, 0);
+    polyline_.assign(n_, {});
+    poly_path_.assign(n_, {});
   }
   cmd_ref_ahead_ = ref_ahead;
   if (walkers_ && wcmd_.size() != walkers_->size()) wcmd_.assign(walkers_->size(), std::nullopt);
@@ -56,14 +53,9 @@ void Pool::set_commands(const json& pack, const std::string& where, const std::s
     const std::string name = where + ": road user '" + key + "'";
     try {
       if (it->second < n_) {
-        ru::VehicleCommand c = ru::parse_vehicle_command(value, "command", net_.graph());
-        if (c.polyline) not_yet("command.trajectory.polyline");
-        cmd_[it->second] = std::move(c);
+        cmd_[it->second] = ru::parse_vehicle_command(value, "command", net_.graph());
       } else {
-        ru::PedestrianCommand c = ru::parse_pedestrian_command(value, "command", net_.graph());
-        if (c.route) not_yet("command.route");
-        if (c.polyline) not_yet("command.trajectory.polyline");
-        wcmd_[it->second - n_] = std::move(c);
+        wcmd_[it->second - n_] = ru::parse_pedestrian_command(value, "command", net_.graph());
       }
     } catch (const ru::CommandError& e) {
       throw PoolError(name + ": " + e.what());
@@ -74,11 +66,22 @@ void Pool::set_commands(const json& pack, const std::string& where, const std::s
 
 // Before the vehicles move (after their IDM accelerations and MOBIL's changes): a speed command
 // sets the acceleration that reaches its speed this step, a lane command changes lanes, a
-// vehicle standing off the lanes stays.
+// polyline drives it along (a route with it waits until it comes alone), a vehicle standing off
+// the lanes stays (one whose polyline has stopped there stops).
 void Pool::command_before_move(double dt) {
   for (size_t i = 0; i < n_; ++i) {
-    if (!present(i) || !cmd_[i]) continue;
+    if (!polyline_[i].empty() && !on_polyline(i)) {
+      polyline_[i].clear();
+      poly_path_[i] = {};
+      if (stand_[i]) v_[i] = acc_[i] = 0;
+    }
+    if ((!present(i) && !stand_[i]) || !cmd_[i]) continue;
     const ru::VehicleCommand& c = *cmd_[i];
+    if (c.polyline) {
+      drive_polyline(i, c, dt);
+      continue;
+    }
+    if (!present(i)) continue;
     if (c.route) command_route(i, *c.route);
     if (c.lane) command_lane(i, *c.lane);
     if (c.speed) acc_[i] = (c.speed->speed - v_[i]) / dt;
@@ -86,7 +89,8 @@ void Pool::command_before_move(double dt) {
 }
 
 // After they moved: the speed command's speed exactly and its acceleration published; a
-// teleport or a timed trajectory puts it at its pose (localised on the pool's lanes).
+// teleport or a timed trajectory puts it at its pose, a polyline's step where it has driven it
+// (localised on the pool's lanes).
 void Pool::command_after_move(double dt) {
   for (size_t i = 0; i < n_; ++i) {
     if ((!present(i) && !stand_[i]) || !cmd_[i]) continue;
@@ -103,6 +107,11 @@ void Pool::command_after_move(double dt) {
       v_[i] = stand_[i] ? 0.0 : v;
       acc_[i] = c.speed ? acc_[i] : (v_[i] - v0) / dt;
     }
+    if (c.polyline) {  // its reference point, at the speed it drove
+      const double back = cmd_ref_ahead_ * specs_[i].length;
+      put_at(i, {x_[i] - back * std::cos(yaw_[i]), y_[i] - back * std::sin(yaw_[i]), yaw_[i],
+                 std::nullopt});
+    }
   }
   for (auto& c : cmd_) c.reset();
   // The walkers step next: a speed command's pace for that step.
@@ -110,6 +119,7 @@ void Pool::command_after_move(double dt) {
     const auto& c = wcmd_[k];
     if (c && c->speed) pace_.emplace_back(k, walkers_->set_pace(k, std::max(*c->speed, kMinPace)));
   }
+  command_walker_paths();
 }
 
 // After the walkers' step: their own pace again; a teleport or a timed trajectory puts the
@@ -268,7 +278,7 @@ void Pool::command_route(size_t i, const ru::Points& positions) {
 }
 
 bool Pool::commanded_lateral(size_t i) const {
-  return has_commands_ && cmd_[i] && (cmd_[i]->lane || cmd_[i]->route);
+  return has_commands_ && cmd_[i] && (cmd_[i]->lane || cmd_[i]->route || cmd_[i]->polyline);
 }
 
 }  // namespace convoy::traffic_pool

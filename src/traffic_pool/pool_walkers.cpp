@@ -53,6 +53,10 @@ bool PoolWalkers::on_road(size_t i) const {
 
 bool PoolWalkers::crossing_box(size_t i, Box& box) const {
   const Walker& w = w_[i];
+  if (!commanded_.empty() && on_polyline(i)) {  // off its path: its body, wherever it walks
+    box = {w.x, w.y, w.yaw, specs_[i].length + 2 * kBodyMargin, specs_[i].width + 2 * kBodyMargin};
+    return true;
+  }
   if (w.committed >= w.path.road_crossings.size()) return false;
   const ru::WalkCrossing& c = w.path.road_crossings[w.committed];
   if (w.arc >= c.exit) return false;
@@ -231,7 +235,10 @@ void PoolWalkers::step(double dt, double t, const VehiclesNear& vehicles,
                        const std::vector<road_users::Light>* lane_lights) {
   lights_ = lane_lights;
   index_walkers();
-  for (size_t i = 0; i < w_.size(); ++i) step_walker(i, dt, t, vehicles);
+  for (size_t i = 0; i < w_.size(); ++i) {
+    if (!commanded_.empty() && step_commanded(i, dt)) continue;
+    step_walker(i, dt, t, vehicles);
+  }
 }
 
 }  // namespace convoy::traffic_pool

@@ -32,6 +32,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -102,6 +103,7 @@ class PoolWalkers {
   bool on_road(size_t i) const;
   // While it has stepped onto a crossing and not yet left the road: the box vehicles keep out
   // of, the part of its crossing line on the road, as wide as the walkers on it keep right.
+  // While it walks a commanded polyline: its body (with a margin), wherever it is.
   struct Box {
     double x = 0, y = 0, yaw = 0, length = 0, width = 0;
   };
@@ -114,6 +116,13 @@ class PoolWalkers {
   // had), and putting it at (x, y, yaw) with speed v, then on from the nearest sidewalk.
   double set_pace(size_t i, double v);
   void put_at(size_t i, double x, double y, double yaw, double v, double dt);
+  // (pool_paths.cpp) A route: from where it is straight through the points, then to the nearest
+  // sidewalk and on (road_users::walk_through); the same points again do not re-plan. A
+  // polyline for the next step (road_users::step_along; `paced`: at a commanded speed, not
+  // behind the walkers ahead); without one after it, it walks on from where it stands.
+  void walk_route(size_t i, const road_users::Points& via);
+  void follow_polyline(size_t i, const road_users::Points& points, bool paced);
+  bool on_polyline(size_t i) const;
 
  private:
   struct Walker {
@@ -159,6 +168,8 @@ class PoolWalkers {
   bool gives_way_to(size_t i, uint32_t k) const;
   bool clear_at(size_t i, double x, double y, double yaw, uint32_t* who = nullptr) const;
   void move(size_t i, double v, double target, double dt);
+  // pool_paths.cpp: the step of a walker with a commanded path (false: its own step).
+  bool step_commanded(size_t i, double dt);
   template <class F>
   void for_near(size_t i, int reach, F&& f) const {
     const int cx = std::clamp(static_cast<int>((w_[i].x - min_x_) / 5.0), 0, gx_ - 1);
@@ -184,6 +195,14 @@ class PoolWalkers {
   std::vector<uint32_t> head_, chain_;
   WalkerStats stats_;
   const std::vector<road_users::Light>* lights_ = nullptr;  // step's lane_lights
+  // Commanded paths (pool_paths.cpp), by walker: its last route and polyline, the polyline's
+  // walk, and whether it follows it this step (and at a commanded speed).
+  struct Commanded {
+    road_users::Points route, polyline;
+    road_users::WalkPath walk;
+    bool now = false, paced = false;
+  };
+  std::map<size_t, Commanded> commanded_;
 };
 
 }  // namespace convoy::traffic_pool
