@@ -18,6 +18,7 @@ capacity, and leave no engine process behind.
 """
 
 import json
+import math
 import os
 import textwrap
 import unittest
@@ -126,6 +127,42 @@ COMMAND_TF = textwrap.dedent("""\
     """)
 
 
+POLYLINE_TF = textwrap.dedent("""\
+    import json, math
+    from nrp_core import *
+    from nrp_core.data.nrp_json import JsonDataPack
+
+    _rows = []
+    _line = []
+
+
+    @EngineDataPack(keyword="v", id=DataPackIdentifier("road_users", "pool"))
+    @TransceiverFunction("pool")
+    def command(v):
+        if v.isEmpty():
+            return []
+        me = {u.id: u for u in v.data.users}["pool/mine"]
+        if not _line:  # a line from where it stands, 1.5 m to its left from 10 m on
+            c, s = math.cos(me.yaw), math.sin(me.yaw)
+            _line.extend([[me.x + d * c - 1.5 * s * (d >= 10), me.y + d * s + 1.5 * c * (d >= 10)]
+                          for d in (0.0, 5.0, 10.0, 20.0, 40.0, 60.0)])
+        _rows.append([v.data.time_ns, me.x, me.y, me.speed])
+        with open(OUT, "w") as f:
+            json.dump({"line": _line, "rows": _rows}, f)
+        return [JsonDataPack("commands", "pool",
+                             {"mine": {"trajectory": {"polyline": _line}}})]
+    """)
+
+
+def distance_to_polyline(p, line):
+    best = float("inf")
+    for (ax, ay), (bx, by) in zip(line, line[1:]):
+        dx, dy = bx - ax, by - ay
+        t = max(0.0, min(1.0, ((p[0] - ax) * dx + (p[1] - ay) * dy) / (dx * dx + dy * dy)))
+        best = min(best, math.hypot(p[0] - ax - t * dx, p[1] - ay - t * dy))
+    return best
+
+
 class Commands(E2ETestCase):
     """A TF plays the scenario engine: `mine` is held at 2 m/s (BRAKE on, its acceleration
     published), then teleported (its published reference point exactly there), then back on
@@ -161,6 +198,29 @@ class Commands(E2ETestCase):
         self.assertGreater(after[-1][1], 2.5)  # IDM speeds it up again
         _, r2 = self.run_commands("pool/mine")
         self.assertEqual(rows, r2)  # same commands, same run
+        self.assertNoEngineLeft()
+
+    def test_untimed_trajectory(self):
+        """An untimed trajectory through the engine: `mine` follows a polyline that shifts
+        1.5 m to its left, and keeps to it."""
+        out = os.path.join(self.dir, "line.json")
+        self.write("tf.py", POLYLINE_TF.replace("OUT", repr(out)))
+        cfg = pool_config(Count=10, Seed=3,
+                          Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
+                                     "Speed": 8, "Policy": "idm"}])
+        cfg["DataPackProcessingFunctions"] = [{"Name": "command", "FileName": "tf.py"}]
+        self.write_config(cfg)
+        r = self.run_convoy()
+        self.assertExit(r, 0)
+        with open(out) as f:
+            seen = json.load(f)
+        line, rows = seen["line"], seen["rows"]
+        self.assertGreater(len(rows), 40)
+        late = [row for row in rows if row[0] * 1e-9 > 2.0]
+        for _, x, y, _ in late:
+            self.assertLess(distance_to_polyline((x, y), line), 0.5)
+        start, end = rows[0], rows[-1]
+        self.assertGreater(math.hypot(end[1] - start[1], end[2] - start[2]), 15.0)
         self.assertNoEngineLeft()
 
     def test_unknown_id(self):
