@@ -12,8 +12,10 @@
 #include "transport/grpc_security.h"
 
 namespace convoy::app {
-
 namespace {
+
+// Shutdown deadlines (EngineSet::shut_down).
+constexpr double kCleanShutdownS = 60.0, kFailedShutdownS = 3.0;
 
 // Engines whose next request usually comes within this time wait for it by yielding the CPU
 // rather than sleeping (EngineServer::set_spin_us): the slowest engine of a lock-step loop
@@ -165,7 +167,10 @@ void EngineSet::initialize(RunLog& log, std::vector<EngineStartup>* startup) {
 std::string EngineSet::shut_down(bool clean, RunLog& log) {
   std::string first;
   for (auto& e : engines_) {
-    std::string err = e->shutdown(clean ? 10.0 : 3.0);
+    // A clean shutdown is when engines write their outputs (a video's last frames, a score
+    // over a whole lap: 10 s was too little for the autonomous-driving evaluator on 2 busy
+    // cores), so it gets a minute, as Initialize does; after a failure, 3 s.
+    std::string err = e->shutdown(clean ? kCleanShutdownS : kFailedShutdownS);
     if (err.empty()) continue;
     log.error(err + "\n--- " + e->log_file().string() + " (last lines) ---\n" + e->log_tail());
     if (first.empty()) first = err;
