@@ -98,36 +98,8 @@ class Runs(E2ETestCase):
         self.assertNoEngineLeft()
 
 
-COMMAND_TF = textwrap.dedent("""\
-    import json
-    from nrp_core import *
-    from nrp_core.data.nrp_json import JsonDataPack
-
-    _rows = []
-
-
-    @EngineDataPack(keyword="v", id=DataPackIdentifier("road_users", "pool"))
-    @TransceiverFunction("pool")
-    def command(v):
-        if v.isEmpty():
-            return []
-        users = {u.id: u for u in v.data.users}
-        me = users["pool/mine"]
-        _rows.append([v.data.time_ns, me.speed, me.acceleration, me.lights, me.x, me.y])
-        with open(OUT, "w") as f:
-            json.dump(_rows, f)
-        t = v.data.time_ns * 1e-9
-        if t < 1.0:
-            return [JsonDataPack("commands", "pool",
-                                 {KEY: {"speed": {"speed": 2.0, "acceleration": -1.5}}})]
-        if t < 1.04:
-            return [JsonDataPack("commands", "pool",
-                                 {"mine": {"teleport": {"x": 160.0, "y": 48.4, "yaw": 0.0}}})]
-        return []
-    """)
-
-
-POLYLINE_TF = textwrap.dedent("""\
+# The head of the command TFs: `me` is the pool's road user `mine`; each TF adds the rest.
+COMMAND_TF_HEAD = """\
     import json, math
     from nrp_core import *
     from nrp_core.data.nrp_json import JsonDataPack
@@ -142,6 +114,24 @@ POLYLINE_TF = textwrap.dedent("""\
         if v.isEmpty():
             return []
         me = {u.id: u for u in v.data.users}["pool/mine"]
+"""
+
+COMMAND_TF = textwrap.dedent(COMMAND_TF_HEAD + """\
+        _rows.append([v.data.time_ns, me.speed, me.acceleration, me.lights, me.x, me.y])
+        with open(OUT, "w") as f:
+            json.dump(_rows, f)
+        t = v.data.time_ns * 1e-9
+        if t < 1.0:
+            return [JsonDataPack("commands", "pool",
+                                 {KEY: {"speed": {"speed": 2.0, "acceleration": -1.5}}})]
+        if t < 1.04:
+            return [JsonDataPack("commands", "pool",
+                                 {"mine": {"teleport": {"x": 160.0, "y": 48.4, "yaw": 0.0}}})]
+        return []
+    """)
+
+
+POLYLINE_TF = textwrap.dedent(COMMAND_TF_HEAD + """\
         if not _line:  # a line from where it stands, 1.5 m to its left from 10 m on
             c, s = math.cos(me.yaw), math.sin(me.yaw)
             _line.extend([[me.x + d * c - 1.5 * s * (d >= 10), me.y + d * s + 1.5 * c * (d >= 10)]
