@@ -158,9 +158,10 @@ class Commands(E2ETestCase):
     published), then teleported (its published reference point exactly there), then back on
     IDM; the same commands give the same run; an unknown id stops the run (exit 3)."""
 
-    def run_commands(self, key):
+    def run_commands(self, key, tf=COMMAND_TF):
+        """The pool with `mine` on road 90 and the command TF `tf`; its exit and what it wrote."""
         out = os.path.join(self.dir, "rows.json")
-        self.write("tf.py", COMMAND_TF.replace("OUT", repr(out)).replace("KEY", repr(key)))
+        self.write("tf.py", tf.replace("OUT", repr(out)).replace("KEY", repr(key)))
         cfg = pool_config(Count=10, Seed=3,
                           Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
                                      "Speed": 8, "Policy": "idm"}])
@@ -193,17 +194,8 @@ class Commands(E2ETestCase):
     def test_untimed_trajectory(self):
         """An untimed trajectory through the engine: `mine` follows a polyline that shifts
         1.5 m to its left, and keeps to it."""
-        out = os.path.join(self.dir, "line.json")
-        self.write("tf.py", POLYLINE_TF.replace("OUT", repr(out)))
-        cfg = pool_config(Count=10, Seed=3,
-                          Vehicles=[{"Id": "mine", "Road": "90", "Lane": -1, "S": 20,
-                                     "Speed": 8, "Policy": "idm"}])
-        cfg["DataPackProcessingFunctions"] = [{"Name": "command", "FileName": "tf.py"}]
-        self.write_config(cfg)
-        r = self.run_convoy()
+        r, seen = self.run_commands("pool/mine", POLYLINE_TF)
         self.assertExit(r, 0)
-        with open(out) as f:
-            seen = json.load(f)
         line, rows = seen["line"], seen["rows"]
         self.assertGreater(len(rows), 40)
         late = [row for row in rows if row[0] * 1e-9 > 2.0]
