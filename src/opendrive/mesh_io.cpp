@@ -68,6 +68,7 @@ void write_road_sdf(const std::filesystem::path& sdf, const std::string& mesh_ur
                "</geometry>\n"
                "      </collision>\n"
                "      <visual name=\"road\">\n"
+               "        <cast_shadows>false</cast_shadows>\n"
                "        <geometry><mesh><uri>%s</uri></mesh></geometry>\n"
                "      </visual>\n"
                "    </link>\n"

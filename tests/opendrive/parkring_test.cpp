@@ -220,6 +220,7 @@ TEST(RoadMesh, LanesFileKindsAndFiles) {
   const std::string text((std::istreambuf_iterator<char>(sdf)), {});
   EXPECT_NE(text.find("<model name=\"road\">"), std::string::npos);
   EXPECT_NE(text.find("<plane>"), std::string::npos);
+  EXPECT_NE(text.find("<cast_shadows>false</cast_shadows>"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
 
