@@ -1,13 +1,13 @@
 #!/usr/bin/python3
 """convoy_gym benchmark (issue 28): DrivingEnv.step() calls per second, 1 process, without and
 with an 84 x 84 camera, and VectorDrivingEnv(2)'s total steps per second against one
-environment's (the parallel speed-up).
+environment's (the parallel speed-up), without and with the camera.
 
   /usr/bin/python3 benchmarks/rl_bench.py [--steps 3000] [--runs 3] [--camera 84x84]
                                           [--envs 2] [--baseline] [--physics-step S]
 
 Each figure is DrivingEnv's defaults (experiments/rl_parkring/gym_config.json: the smart car
-in the world engine only, the client setting its joint targets; 5 ms physics step; 0.05 s
+in the world engine only, the client setting its joint targets; 10 ms physics step; 0.05 s
 per step). A run resets with a new seed and times --steps step() calls of a heading-error
 policy at 6 m/s, resetting when an episode ends (resets are timed too); the figure is the
 median of --runs runs.
@@ -16,10 +16,13 @@ median of --runs runs.
   it), whose every step also brings the ego camera's H x W frame rendered by the world engine
   (with the sun's shadows, through a shadow map sized to the camera); also timed, and printed
   on its own line: DrivingEnv(camera=(H, W), shadows=False).
-- parallel speed-up: VectorDrivingEnv(N) (--envs, default 2; 1 skips it) runs the same policy
-  in each of its N environments for --steps vector steps; its total environment steps per
-  second over the single environment's, the two timed in alternation (single, vector, single,
-  ...) so that a machine busy with something else slows both alike.
+- parallel speed-up: VectorDrivingEnv(N) (--envs, default 2; 1 skips it; its defaults: each
+  environment's processes pinned to one core, round-robin; no spinning waits) runs the same
+  policy in each of its N environments for --steps vector steps; its total environment steps
+  per second over the single environment's, the two timed in alternation (single, vector,
+  single, ...) so that a machine busy with something else slows both alike.
+- parallel speed-up with camera: the same with VectorDrivingEnv(N, camera=(H, W)) against
+  DrivingEnv(camera=(H, W)) (with shadows), timed in alternation with the camera figures.
 - --baseline also times, alternating with the figures above, the environment as it was
   before (rl_parkring's simulation_config.json: the python_json agent engine, drive_tf and the
   weather engine, at the world's own 1 ms physics step; with the camera, its 1024-texel
@@ -28,7 +31,8 @@ median of --runs runs.
 
 Each run's line says when another NRPCoreSim was running meanwhile (its figures are then
 contended). The last lines are the CPU model and `env steps/s without camera: N`, `env steps/s
-with camera: N`, `parallel speed-up: R`. Targets (issue 28): 2,000, 300, 1.6 on 2 cores.
+with camera: N`, `parallel speed-up: R`, `parallel speed-up with camera: R`. Targets (issue
+28): 2,000, 300, and 1.6 for 2 environments on 2 cores.
 """
 import argparse
 import os
@@ -90,7 +94,7 @@ def time_vector(envs, steps, seed):
     speed = np.full(envs.num_envs, 6.0)
     t0 = time.perf_counter()
     for _ in range(steps):
-        actions = np.stack([np.clip(0.8 * obs[:, 4], -0.55, 0.55), speed], axis=1)
+        actions = np.stack([np.clip(0.8 * state(obs)[:, 4], -0.55, 0.55), speed], axis=1)
         obs, _, _, _, _ = envs.step(actions)
     return steps * envs.num_envs / (time.perf_counter() - t0)
 
@@ -166,7 +170,12 @@ def main():
                     **base)) as old:
                 if old is not None:
                     timers.append(("baseline " + size, old, single))
-                results.update(alternate(timers, args.runs))
+                with _maybe(args.envs > 1, lambda: VectorDrivingEnv(
+                        args.envs, camera=args.camera, **kw)) as envs:
+                    if envs is not None:
+                        timers.append(("VectorDrivingEnv(%d) total, %s" % (args.envs, size),
+                                       envs, vector))
+                    results.update(alternate(timers, args.runs))
 
     print("CPU: %s (%d cores)" % (cpu_model(), os.cpu_count()))
     for name, rate in results.items():
@@ -177,6 +186,9 @@ def main():
     if args.envs > 1:
         total = results["VectorDrivingEnv(%d) total" % args.envs]
         print("parallel speed-up: %.2f" % (total / results["no camera"]))
+        if args.camera:
+            total = results["VectorDrivingEnv(%d) total, %s" % (args.envs, size)]
+            print("parallel speed-up with camera: %.2f" % (total / results[size]))
 
 
 class _maybe:

@@ -9,6 +9,8 @@
             actions = np.stack([steer, np.full(2, 6.0)], axis=1)   # (2, 2)
             obs, rewards, terminations, truncations, infos = envs.step(actions)
 
+    VectorDrivingEnv(2, camera=(84, 84))   # obs: {"state": (2, 16), "camera": (2, 84, 84, 3)}
+
 Each sub-environment is a DrivingEnv, i.e. its own NRPCoreSim server process (and its
 engines' processes) on its own port: the simulations already run in parallel processes. This
 class only drives them at the same time, from one thread: a step sends every environment its
@@ -16,7 +18,15 @@ action (DrivingEnv.step_begin, over each server's local socket) before it waits 
 (step_finish), so the servers step together while this process waits; resets run on a thread
 per environment. Their servers and engines wait without spinning (DrivingEnv's spin=False),
 since the environments share the cores (see docs/gym.md, "Parallel environments", for the
-measured speed-up).
+measured speed-up). With 2 or more environments, each one's server and engines run on a core
+of their own (cpu_affinity="auto", affinity.py): environment i's on core i (round-robin over
+the cores this process may use), so that two environments' pipelined processes do not take
+each other's cores. With a camera, an environment pinned to one core renders with 2
+llvmpipe threads (LP_NUM_THREADS=2 unless set; Mesa would use none there: measured slower).
+
+Camera: with camera=(H, W) (DrivingEnv's), observations are batched as gymnasium batches a
+Dict space: {"state": (num_envs, 16) float32, "camera": (num_envs, H, W, 3) uint8};
+observation_space is that batched Dict, single_observation_space the DrivingEnv's Dict.
 
 Autoreset: gymnasium's default for AsyncVectorEnv (gymnasium >= 1.0, AutoresetMode.NEXT_STEP).
 When a sub-environment's episode ends at step t, step t returns its last observation with
@@ -43,8 +53,10 @@ import threading
 import numpy as np
 
 from convoy_gym import spaces
+from convoy_gym.affinity import core_sets, pinned, render_threads
 from convoy_gym.closing import ClosesOnExit
 from convoy_gym.driving_env import DrivingEnv
+from convoy_gym.world_variant import check_camera
 
 __all__ = ["VectorDrivingEnv", "AUTORESET_MODES"]
 
@@ -66,16 +78,23 @@ class VectorDrivingEnv(ClosesOnExit):
     The gymnasium vector API: reset(seed=None, options=None) -> (obs [num_envs, 16], infos),
     step(actions [num_envs, 2]) -> (obs, rewards, terminations, truncations, infos), close(),
     num_envs, single_observation_space, single_action_space, observation_space and
-    action_space (batched Boxes), and a `with` block."""
+    action_space (batched spaces), and a `with` block. With camera=(H, W), obs is a dict
+    {"state": [num_envs, 16], "camera": [num_envs, H, W, 3] uint8}."""
 
     metadata = {"render_modes": [], "autoreset_mode": "next_step"}
     render_mode = None
 
-    def __init__(self, num_envs, autoreset_mode="next_step", env_fns=None, **env_kwargs):
+    def __init__(self, num_envs, autoreset_mode="next_step", env_fns=None, cpu_affinity="auto",
+                 **env_kwargs):
         """:param num_envs: number of sub-environments (processes), >= 1
         :param autoreset_mode: "next_step" (gymnasium's default), "same_step" or "disabled"
         :param env_fns: optional list of num_envs callables returning a DrivingEnv-like
             environment (instead of DrivingEnv(**env_kwargs))
+        :param cpu_affinity: the cores of each environment's server and engines (they inherit
+            them from the thread that starts the server; this process is not pinned):
+            "auto" (default): one core each, round-robin over os.sched_getaffinity(0), when
+            num_envs >= 2, none when 1; True: one core each, also for 1; None / False: not
+            pinned; or a list of num_envs entries, each a core, a set of cores or None
         :param env_kwargs: DrivingEnv's arguments, the same for every sub-environment
             (address must not be given: each gets a free port); spin defaults to False here:
             the environments' processes share the cores, and a process spinning while it
@@ -92,10 +111,16 @@ class VectorDrivingEnv(ClosesOnExit):
             raise ValueError("VectorDrivingEnv: every sub-environment needs its own address; "
                              "do not pass address=")
         if env_kwargs.get("camera") is not None:
-            raise ValueError("VectorDrivingEnv: camera observations are not batched yet; "
-                             "use DrivingEnv(camera=...)")
+            try:
+                env_kwargs["camera"] = check_camera(env_kwargs["camera"])
+            except ValueError as e:
+                raise ValueError("VectorDrivingEnv: %s" % e) from None
         if env_fns is not None and len(env_fns) != num_envs:
             raise ValueError("VectorDrivingEnv: %d env_fns for %d envs" % (len(env_fns), num_envs))
+        try:
+            self.cpu_sets = core_sets(cpu_affinity, num_envs)
+        except ValueError as e:
+            raise ValueError("VectorDrivingEnv: %s" % e) from None
         self.num_envs = num_envs
         self.autoreset_mode = autoreset_mode
         self.metadata = dict(self.metadata, autoreset_mode=autoreset_mode)
@@ -105,21 +130,25 @@ class VectorDrivingEnv(ClosesOnExit):
         env_kwargs.setdefault("spin", False)  # the environments share the cores
         make = env_fns or [lambda: DrivingEnv(**env_kwargs)] * num_envs
         # start the servers at the same time; if one fails, close the others
-        futures = [self._pool.submit(fn) for fn in make]
+        # (a camera pinned to one core: llvmpipe's threads as measured, affinity.py)
         errors = []
-        for i, f in enumerate(futures):
-            try:
-                self.envs.append(f.result())
-            except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
-                errors.append((i, e))
+        with render_threads(env_kwargs.get("camera") is not None and any(
+                cores is not None and len(cores) == 1 for cores in self.cpu_sets)):
+            futures = [self._pool.submit(_started_on, fn, cores)
+                       for fn, cores in zip(make, self.cpu_sets)]
+            for i, f in enumerate(futures):
+                try:
+                    self.envs.append(f.result())
+                except BaseException as e:  # noqa: BLE001 - re-raised below, after cleanup
+                    errors.append((i, e))
         if errors:
             self.close()
             i, e = errors[0]
             raise SubEnvError(i, e) from e
         self.single_observation_space = self.envs[0].observation_space
         self.single_action_space = self.envs[0].action_space
-        self.observation_space = _batch_box(self.single_observation_space, num_envs)
-        self.action_space = _batch_box(self.single_action_space, num_envs)
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
         self._autoreset = np.zeros(num_envs, dtype=bool)
         self._started = False
 
@@ -147,14 +176,14 @@ class VectorDrivingEnv(ClosesOnExit):
                 for i, e in enumerate(self.envs) if mask[i]}
         results = self._run(jobs)
         if not self._started:
-            self._obs = np.zeros(self.observation_space.shape, self.observation_space.dtype)
+            self._obs = empty_batch(self.observation_space)
             self._started = True
         infos = {}
         for i, (obs, info) in results.items():
-            self._obs[i] = obs
+            set_row(self._obs, i, obs)
             self._autoreset[i] = False
             _add_info(infos, info, i, self.num_envs)
-        return self._obs.copy(), infos
+        return copy_batch(self._obs), infos
 
     def step(self, actions):
         """Steps every sub-environment with its row of `actions` ([num_envs, 2]); a
@@ -183,16 +212,17 @@ class VectorDrivingEnv(ClosesOnExit):
         for i in range(n):
             r = results[i]
             if r[0] == "reset":
-                obs[i], info = r[1], r[2]
+                row, info = r[1], r[2]
             else:
-                obs[i], rewards[i], terminations[i], truncations[i], info = r[1:6]
+                row, rewards[i], terminations[i], truncations[i], info = r[1:6]
                 if len(r) > 6:  # same_step: reset in this step, the last one in final_*
-                    _add_info(infos, {"final_obs": r[1], "final_info": info}, i, n)
-                    obs[i], info = r[6], r[7]
+                    _add_final(infos, row, info, i, n)
+                    row, info = r[6], r[7]
+            set_row(obs, i, row)
             _add_info(infos, info, i, n)
         if self.autoreset_mode == "next_step":
             self._autoreset = terminations | truncations
-        return obs.copy(), rewards, terminations, truncations, infos
+        return copy_batch(obs), rewards, terminations, truncations, infos
 
     def close(self):
         """Closes every sub-environment (their servers and engines). Safe to call twice."""
@@ -337,9 +367,52 @@ class VectorDrivingEnv(ClosesOnExit):
             raise SubEnvError(i, e) from e
 
 
-def _batch_box(space, n):
+def _started_on(make, cores):
+    """make() on this thread, with the processes it starts pinned to `cores` (None: not)."""
+    with pinned(cores):
+        return make()
+
+
+def batch_space(space, n):
+    """gymnasium's batch_space for a Box or a Dict of Boxes: n rows of `space`."""
+    if isinstance(space, spaces.Dict):
+        return spaces.Dict({k: batch_space(s, n) for k, s in space.spaces.items()})
     return spaces.Box(low=np.stack([space.low] * n), high=np.stack([space.high] * n),
                       dtype=space.dtype)
+
+
+def empty_batch(space):
+    """Zeros of a batched space: an array, or a dict of arrays for a Dict."""
+    if isinstance(space, spaces.Dict):
+        return {k: empty_batch(s) for k, s in space.spaces.items()}
+    return np.zeros(space.shape, space.dtype)
+
+
+def set_row(batch, i, obs):
+    """batch[i] = obs, key by key for a dict observation."""
+    if isinstance(batch, dict):
+        for key, array in batch.items():
+            array[i] = obs[key]
+    else:
+        batch[i] = obs
+
+
+def copy_batch(batch):
+    if isinstance(batch, dict):
+        return {k: v.copy() for k, v in batch.items()}
+    return batch.copy()
+
+
+def _add_final(infos, obs, info, i, n):
+    """same_step's infos["final_obs"][i] (an object array of the environments' last
+    observations, arrays or dicts) and infos["final_info"] (vector layout), with their masks."""
+    final = infos.get("final_obs")
+    if final is None:
+        final = infos["final_obs"] = np.full(n, None, dtype=object)
+        infos["_final_obs"] = np.zeros(n, dtype=bool)
+    final[i] = obs
+    infos["_final_obs"][i] = True
+    _add_info(infos, {"final_info": info}, i, n)
 
 
 def _add_info(infos, info, i, n):
