@@ -62,6 +62,11 @@ VARIANTS = {
                    (1, "grey", "lightblue", "navy", "brown")],
 }
 
+# Proportions as seen in the street: clothes make limbs and trunk fuller than the body's
+# measures (girth factor), and a head a little larger reads as a head a few pixels tall.
+CLOTHES = 1.14
+HEAD = 1.06
+
 DEFAULT_WALKER = "walker_man_1"
 DEFAULT_PEDESTRIAN = "pedestrian_woman_1"
 DEFAULT_CYCLIST = "cyclist_1"
@@ -147,8 +152,8 @@ def limb(m, a, b, radii, slices=8, materials=None, dome=(0.5, 0.5), flatten=1.0,
 def build_figure(f):
     """The rest-pose figure: a Mesh whose parts are the bones (materials = slots)."""
     j = skeleton(f)
-    H, g = f["h"], f["build"]
-    s = H / 1.75
+    H, g = f["h"], f["build"] * CLOTHES
+    s = s0 = H / 1.75
     m = Mesh()
     top, bottom = "top", "bottom"
     # pelvis (hips to waist); a coat covers it
@@ -176,7 +181,8 @@ def build_figure(f):
     limb(m, j["neck_base"], j["head_base"], [(-0.3, 0.052 * s, 0.052 * s), (1.2, 0.048 * s, 0.048 * s)],
          slices=8, dome=(0, 0))
     m.begin("head", "skin").smooth(70)
-    hc = (0.012 * s, 0.0, 0.935 * H)
+    s = s0 * HEAD  # the head a little larger than life, its top where it was
+    hc = (0.012 * s, 0.0, 0.935 * H + 0.118 * (s0 - s))
     m.ellipsoid(hc, (0.098 * s, 0.077 * s, 0.118 * s), stacks=7, slices=10)
     # a nose, so that the face has a front
     m.begin("head", "skin").flat()
@@ -186,6 +192,7 @@ def build_figure(f):
     m.tri(tip, p3, p1)
     m.tri(tip, p2, p3)
     m.tri(tip, p1, p2)
+    brows(m, hc, s)
     # hair (or a helmet)
     m.begin("hair", "hair").smooth(60)
     hs = f["hair"]
@@ -199,6 +206,7 @@ def build_figure(f):
         m.ellipsoid((hc[0] - 0.055 * s, 0.0, hc[2] - 0.085 * s), (0.06 * s, 0.088 * s, 0.13 * s), stacks=4, slices=8)
     elif hs == "bun":
         m.ellipsoid((hc[0] - 0.1 * s, 0.0, hc[2] + 0.03 * s), (0.045 * s, 0.045 * s, 0.045 * s), stacks=4, slices=8)
+    s = s0
     # arms
     for k in ("l", "r"):
         lower_arm = top if f["sleeves"] == "long" else "skin"
@@ -236,6 +244,22 @@ def build_figure(f):
         m.begin("foot_" + k, "shoes").smooth(50)
         foot(m, j["ankle_" + k], j["toe_" + k], s)
     return m, j
+
+
+def brows(m, hc, s):
+    """Eyebrows in the hair's colour and the eyes' shadow under them: thin dark wedges on the
+    face's front, so that a face reads as a face from a few metres."""
+    m.begin("hair", "hair").flat()
+    rx, ry, rz = 0.098 * s, 0.077 * s, 0.118 * s
+    for side in (1, -1):
+        for y0, y1, z0, z1 in ((0.012, 0.05, 0.036, 0.046), (0.018, 0.044, 0.012, 0.022)):
+            pts = []
+            for y, z in ((y0, z0), (y1, z0), (y1, z1), (y0, z1)):
+                u = 1 - (y / ry) ** 2 - (z / rz) ** 2
+                pts.append((hc[0] + rx * math.sqrt(max(u, 0.0)) + 0.002 * s, side * y, hc[2] + z))
+            if cross(sub(pts[1], pts[0]), sub(pts[2], pts[0]))[0] < 0:  # facing forward
+                pts = pts[::-1]
+            m.quad(*pts)
 
 
 def foot(m, ankle, toe, s):
