@@ -37,7 +37,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(REPO, "python"))
 
 import export as onnx_export  # noqa: E402
-from model import STRIDES, Detector  # noqa: E402
+from model import NECKS, STRIDES, Detector  # noqa: E402
 
 CLASSES = ["car", "truck", "bus", "pedestrian", "cyclist"]
 LEVEL_RANGES = ((0, 64), (64, 128), (128, 1e9))
@@ -267,6 +267,8 @@ def main():
     ap.add_argument("--lr", type=float, default=2e-3)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--neck", choices=sorted(NECKS), default="separable",
+                    help="the fusions' and heads' convolutions (tools/detector/model.py)")
     args = ap.parse_args()
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)
@@ -274,7 +276,7 @@ def main():
     items = load_coco(args.data)
     if not items:
         sys.exit("train: no images in %s" % args.data)
-    model = Detector(len(CLASSES), input_size=args.input)
+    model = Detector(len(CLASSES), input_size=args.input, neck=args.neck)
     grid = cell_grid(args.input)
     steps_per_epoch = max(1, len(items) // args.batch)
     total = steps_per_epoch * args.epochs if not args.iterations else args.iterations
