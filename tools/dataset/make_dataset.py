@@ -12,7 +12,9 @@ Writes DIR/annotations.json (all runs, COCO; each image's record has its seed, w
 time), DIR/images/*.jpg, DIR/depth/*.png (mm, uint16), DIR/runs.json (what each run drew).
 The experiment needs a world engine with the camera and a `weather` engine (every driving
 experiment has one). What it adds to the run: the dataset_writer engine and its TF
-(tools/dataset/). docs/perception.md has the details.
+(tools/dataset/). What it takes away: an engine named `recorder` (the run's video) steps only
+once, at the start (the dataset has the frames; about a quarter of a core's time in ffmpeg).
+docs/perception.md has the details.
 """
 import argparse
 import json
@@ -181,6 +183,8 @@ def main():
             if e["EngineName"] == "weather":
                 e["Seed"] = seed
                 e.update(weather)
+            if e["EngineName"] == "recorder":
+                e["EngineTimestep"] = args.seconds
         models = vary_models(cfg, seed, shares) if shares else {}
         for item in args.set:
             key, _, value = item.partition("=")
