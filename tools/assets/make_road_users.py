@@ -24,6 +24,7 @@ sys.path.insert(0, HERE)
 sys.dont_write_bytecode = True
 
 import make_people  # noqa: E402
+import make_truck  # noqa: E402
 import make_vehicles  # noqa: E402
 
 ACTORS = os.path.normpath(os.path.join(HERE, "..", "..", "engines", "gazebo_grpc", "actors"))
@@ -91,7 +92,7 @@ class Writer:
 
     def vehicles(self):
         for kind in ["hatchback", "sedan", "suv", "van", "bus", "truck"]:
-            m, t = make_vehicles.build_truck() if kind == "truck" else make_vehicles.build_vehicle(kind)
+            m, t = make_truck.build_truck() if kind == "truck" else make_vehicles.build_vehicle(kind)
             size = m.fit(t["size"], select=lambda p, mat: p != "mirrors")
             header = "%s: %s, %.2f x %.2f x %.2f m. %s" % (kind, t["cls"], size[0], size[1], size[2], HEADER)
             recolour = ("paint", "cargo")
