@@ -7,6 +7,7 @@ Deterministic; stdlib only.
 
   /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py
   /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py --train
+  /usr/bin/python3 benchmarks/worlds/make_busy_scenarios.py --heldout
 
 --train writes the detector's training scenes instead (tools/detector/reproduce.sh renders
 them): train/train_<scene>.xosc, busy scenes on esmini maps with sidewalks (fabriksgatan's
@@ -14,7 +15,14 @@ streets in both directions, fabriksgatan_traffic_lights, soderleden, parking_dem
 and varied road users (cars, vans, buses, trucks, adults and children, their places and
 speeds drawn per scene). multi_intersections is never among them: busy_multi_intersections
 measures the detector on a map it was not trained on. No scene starts where
-busy_fabriksgatan does (road 2, s 20, lane -1), but fabriksgatan's world is in training."""
+busy_fabriksgatan does (road 2, s 20, lane -1), but fabriksgatan's world is in training.
+
+--heldout writes the detector's held-out pedestrian scenes (heldout/heldout_<scene>.xosc;
+tools/detector/reproduce.sh renders each in six weathers): new compositions with eight to ten
+people on the sidewalks (walking, a third standing) among traffic, on the project's city map
+(roads 3 and 4, which no training scene has; the city's traffic experiment's paths in
+training pass them with other road users) and on multi_intersections (a map never trained
+on)."""
 import os
 import random
 import sys
@@ -156,5 +164,63 @@ def train():
         print("train/train_%s.xosc" % name)
 
 
+# The held-out pedestrian scenes: name -> (map file relative to this folder, road, ego lane,
+# ego's s, lanes along, oncoming lanes, sidewalks).
+HELDOUT = {
+    "city_r3": ("../../experiments/city_traffic/city.xodr", "3", -1, 30.0, [-1, -2], [1, 2], [-3, 3]),
+    "city_r4": ("../../experiments/city_traffic/city.xodr", "4", 1, 140.0, [1], [-1], [2, -2]),
+    "multi_r281": (ESMINI + "multi_intersections.xodr", "281", -1, 15.0, [-1], [1], [-3, 3]),
+}
+
+
+def scene(rng, road, lane, s, length, along, oncoming, walks, walkers):
+    """(entities, inits) of a scene: the ego, a lead car, traffic both ways, `walkers` people
+    on the sidewalks ahead (a third of them standing)."""
+    on_road = lambda ss: 2.0 <= ss <= length - 2.0  # noqa: E731
+    ahead = 1 if lane < 0 else -1
+    entities, inits = [VEHICLE.format(name="Ego", model="smart_car")], []
+    inits.append(INIT.format(name="Ego", road=road, lane=lane, s=s, v=0))
+    cars = [("Lead", rng.choice(VEHICLE_MODELS[:5]), lane, s + ahead * rng.uniform(25, 35), rng.uniform(4, 6))]
+    for j in range(rng.randint(1, 2)):
+        ln = rng.choice(along)
+        cars.append(("Along%d" % j, rng.choice(VEHICLE_MODELS), ln, s + ahead * rng.uniform(45, 100), rng.uniform(3, 6)))
+    for j in range(rng.randint(2, 3)):
+        cars.append(("Oncoming%d" % j, rng.choice(VEHICLE_MODELS), rng.choice(oncoming),
+                     s + ahead * (45 + 30 * j + rng.uniform(0, 15)), rng.uniform(5, 8)))
+    placed = []
+    for n, m, ln, ss, v in cars:
+        if on_road(ss) and all(l != ln or abs(ss - p) >= 15.0 for l, p in placed):
+            placed.append((ln, ss))
+            entities.append(VEHICLE.format(name=n, model=m))
+            inits.append(INIT.format(name=n, road=road, lane=ln, s="%.1f" % ss, v="%.1f" % v))
+    for j in range(walkers):
+        ss = s + ahead * (8 + 9 * j + rng.uniform(0, 6))
+        v = 0.0 if j % 3 == 2 else rng.uniform(0.8, 1.6)
+        if on_road(ss):
+            entities.append(TRAIN_PEDESTRIAN.format(name="Walker%d" % j, model=rng.choice(WALKER_MODELS)))
+            inits.append(INIT.format(name="Walker%d" % j, road=road, lane=walks[j % len(walks)],
+                                     s="%.1f" % ss, v="%.1f" % v))
+    return entities, inits
+
+
+def heldout():
+    """Writes heldout/heldout_<scene>.xosc (the paths in them relative to heldout/)."""
+    out = os.path.join(HERE, "heldout")
+    os.makedirs(out, exist_ok=True)
+    for k, (name, (xodr, road, lane, s, along, oncoming, walks)) in enumerate(sorted(HELDOUT.items())):
+        rng = random.Random(7301 + k)
+        length = float(ET.parse(os.path.join(HERE, xodr)).getroot().find("road[@id='%s']" % road).get("length"))
+        entities, inits = scene(rng, road, lane, s, length, along, oncoming, walks, rng.randint(8, 10))
+        with open(os.path.join(out, "heldout_%s.xosc" % name), "w") as f:
+            f.write(DOC.format(name=name, xodr="../" + xodr, entities="".join(entities),
+                               inits="".join(inits), end=story_end(5, 30))
+                    .replace("busy_%s: the ego" % name, "heldout_%s: a detector held-out scene, the ego" % name)
+                    .replace("make_busy_scenarios.py. -->", "make_busy_scenarios.py, its held-out scenes. -->")
+                    .replace('path="../suite/catalogs"', 'path="../../suite/catalogs"')
+                    .replace('description="busy %s"' % name, 'description="detector held-out %s"' % name))
+        print("heldout/heldout_%s.xosc" % name)
+
+
 if __name__ == "__main__":
-    train() if "--train" in sys.argv[1:] else main()
+    args = sys.argv[1:]
+    train() if "--train" in args else heldout() if "--heldout" in args else main()
