@@ -6,7 +6,8 @@
       [--skip-speed] [--skip-loop]
 
   - Convoy's detector (models/detector) on a held-out render set (--heldout, a COCO folder
-    from tools/dataset/make_dataset.py whose seeds and camera paths training never saw):
+    from tools/dataset/make_dataset.py whose seeds and camera paths training never saw, or
+    several folders joined by commas, scored as one set):
     mAP@0.5 and mAP@0.5:0.95 per class, by convoy_perception.evaluation (target mAP@0.5 >= 0.8
     over car, bus, pedestrian); with several --heldout sets (e.g. one per weather) and several
     --model folders (e.g. trained on clear weather only and on all weathers), a table of mAP@0.5
@@ -38,6 +39,8 @@ REPO = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(REPO, "python"))
 sys.path.insert(0, os.path.join(REPO, "tools", "detector"))
 MODEL_DIR = os.path.join(REPO, "models", "detector")
+
+from gain import brighten, from_meta  # noqa: E402 (tools/detector, on the path above)
 BOTH = os.path.join(REPO, "experiments", "autonomous_driving", "simulation_config_both.json")
 
 
@@ -49,14 +52,17 @@ def load_model(model_dir):
 
 
 def detect(net, meta, image_rgb, conf=0.001, nms=0.6):
-    """The detector engine's steps in Python: letterbox (pad 114), forward, per-class NMS."""
+    """The detector engine's steps in Python: letterbox (pad 114; the model's gain, if any, on
+    the resized image), forward, per-class NMS."""
     sw, sh = meta["input_width"], meta["input_height"]
     h, w = image_rgb.shape[:2]
     s = min(sw / w, sh / h)
     nw, nh = int(round(w * s)), int(round(h * s))
     ox, oy = (sw - nw) // 2, (sh - nh) // 2
     canvas = np.full((sh, sw, 3), 114, np.uint8)
-    canvas[oy:oy + nh, ox:ox + nw] = cv2.resize(image_rgb, (nw, nh), interpolation=cv2.INTER_LINEAR)
+    resized = cv2.resize(image_rgb, (nw, nh), interpolation=cv2.INTER_LINEAR)
+    gain = from_meta(meta)
+    canvas[oy:oy + nh, ox:ox + nw] = brighten(resized, *gain) if gain else resized
     net.setInput(cv2.dnn.blobFromImage(canvas, 1 / 255.0))
     out = net.forward()[0]
     boxes, scores = out[:4].T, out[4:].T
@@ -75,15 +81,18 @@ def detect(net, meta, image_rgb, conf=0.001, nms=0.6):
 
 
 def heldout_map(model_dir, folder, classes=("car", "bus", "pedestrian")):
+    """The model's evaluation on a COCO folder, or on several scored as one set (their paths
+    joined by commas); returns (result, frames)."""
     from convoy_perception.evaluation import evaluate
     net, meta = load_model(model_dir)
     from train import read_ground_truth
-    doc, gts = read_ground_truth(folder)
     frames = []
-    for img in doc["images"]:
-        image = cv2.imread(os.path.join(folder, img["file_name"]))[:, :, ::-1]
-        frames.append({"gt": [g for g in gts[img["id"]] if g["class"] in classes],
-                       "detections": detect(net, meta, np.ascontiguousarray(image))})
+    for one in folder.split(","):
+        doc, gts = read_ground_truth(one)
+        for img in doc["images"]:
+            image = cv2.imread(os.path.join(one, img["file_name"]))[:, :, ::-1]
+            frames.append({"gt": [g for g in gts[img["id"]] if g["class"] in classes],
+                           "detections": detect(net, meta, np.ascontiguousarray(image))})
     present = [c for c in classes if any(g["class"] == c for f in frames for g in f["gt"])]
     return evaluate(frames, classes=present), len(frames)
 
@@ -119,8 +128,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--seconds", type=float, default=60.0)
-    ap.add_argument("--heldout", action="append", default=[], metavar="[LABEL=]DIR",
-                    help="COCO folder of held-out renders (repeat for a table by set)")
+    ap.add_argument("--heldout", action="append", default=[], metavar="[LABEL=]DIR[,DIR...]",
+                    help="COCO folder of held-out renders, or several scored as one set (repeat "
+                         "for a table by set)")
     ap.add_argument("--stock", help="the stock COCO detector's ONNX (shared/tools/stock_detector)")
     ap.add_argument("--stock-seconds", type=float, default=185.0)
     ap.add_argument("--model", action="append", default=[], metavar="[LABEL=]DIR",

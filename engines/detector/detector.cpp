@@ -80,7 +80,8 @@ Letterbox compute_letterbox(int width, int height, int size, int size_h) {
   return lb;
 }
 
-cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_h) {
+cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_h,
+                        const std::optional<InputGain>& gain) {
   *lb = compute_letterbox(image.cols, image.rows, size, size_h);
   int new_w = static_cast<int>(std::lround(image.cols * lb->scale));
   int new_h = static_cast<int>(std::lround(image.rows * lb->scale));
@@ -89,6 +90,7 @@ cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_
     resized = image;
   else
     cv::resize(image, resized, cv::Size(new_w, new_h), 0, 0, cv::INTER_LINEAR);
+  if (gain) resized = brighten_image(resized, *gain);
   cv::Mat out;
   cv::copyMakeBorder(resized, out, lb->pad_y, lb->size_h - new_h - lb->pad_y, lb->pad_x,
                      size - new_w - lb->pad_x, cv::BORDER_CONSTANT, cv::Scalar::all(114));
@@ -227,7 +229,8 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& image) {
   cv::Mat rgb = image;
   if (image.channels() == 1) cv::cvtColor(image, rgb, cv::COLOR_GRAY2RGB);
   Letterbox lb;
-  cv::Mat input = letterbox_image(rgb, options_.input_size, &lb, options_.input_height);
+  cv::Mat input =
+      letterbox_image(rgb, options_.input_size, &lb, options_.input_height, options_.gain);
   cv::Mat blob =
       cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), false, false, CV_32F);
   net_.setInput(blob);
@@ -414,6 +417,7 @@ const std::map<std::string, BackendFactory>& backends() {
            if (o.input_size <= 0 || o.input_size % 32 || o.input_height <= 0 || o.input_height % 32)
              throw std::runtime_error(
                  "input_width and input_height must be positive multiples of 32");
+           o.gain = input_gain_from_meta(meta);
          } catch (const std::exception& e) {
            throw std::runtime_error("Backend convoy: " + (dir / "model.json").string() + ": " +
                                     e.what());

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "datapack/datapack.h"
+#include "input_gain.h"
 
 namespace convoy::detector {
 
@@ -43,8 +44,10 @@ std::vector<std::string> read_class_names(const std::string& path);
 // Letterbox transform for an image of `width` x `height` into a `size` square, or a
 // `size` x `size_h` network input (keeps the aspect ratio, centres the image).
 Letterbox compute_letterbox(int width, int height, int size, int size_h = 0);
-// Resizes and pads `image` (pad value 114) per compute_letterbox.
-cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_h = 0);
+// Resizes and pads `image` (pad value 114) per compute_letterbox; with `gain`, the resized
+// image brightened (brighten_image) before the padding.
+cv::Mat letterbox_image(const cv::Mat& image, int size, Letterbox* lb, int size_h = 0,
+                        const std::optional<InputGain>& gain = std::nullopt);
 // Maps a box in network coordinates back to the original image, clipped to it.
 cv::Rect2f unletterbox(const cv::Rect2f& box, const Letterbox& lb, int width, int height);
 
@@ -68,6 +71,7 @@ struct YoloOptions {
   float conf_threshold = 0.25f;
   float nms_threshold = 0.45f;
   YoloVersion version = YoloVersion::kAuto;
+  std::optional<InputGain> gain;  // Convoy's models: model.json's "brighten"
 };
 
 // What a detector backend detects from.

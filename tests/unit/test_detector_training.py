@@ -1,5 +1,5 @@
-"""Unit tests of the detector's training code (tools/detector): the necks and the synthetic
-fog and darkness of train.weather_augment."""
+"""Unit tests of the detector's training code (tools/detector): the necks, the synthetic fog
+and darkness of train.weather_augment and the input's gain (gain.py)."""
 import os
 import random
 import sys
@@ -13,6 +13,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(REPO, "tools", "detector"))
 
 import torch  # noqa: E402
+import gain  # noqa: E402
 import model  # noqa: E402
 import train  # noqa: E402
 
@@ -85,6 +86,42 @@ class WeatherAugment(unittest.TestCase):
         train.FOG_SHARE, train.DARK_SHARE = 1.0, 0.0
         os.remove(os.path.join(self.dir, "depth", "f.png"))
         self.assertIs(train.weather_augment(self.image, self.path, random.Random(1)), self.image)
+
+
+class Gain(unittest.TestCase):
+    def test_a_bright_image_is_left_as_it_is(self):
+        day = np.full((20, 30, 3), 120, np.uint8)
+        self.assertIs(gain.brighten(day, 90.0, 8.0), day)
+
+    def test_a_dark_image_is_brought_to_the_target_mean(self):
+        dusk = np.full((20, 30, 3), 30, np.uint8)
+        dusk[0, 0] = 250
+        out = gain.brighten(dusk, 90.0, 8.0)
+        self.assertAlmostEqual(out.astype(float).mean(), 90.0, delta=1.5)
+        self.assertEqual(out[0, 0, 0], 255)  # saturated
+
+    def test_the_gain_stops_at_its_most(self):
+        night = np.full((20, 30, 3), 5, np.uint8)
+        self.assertEqual(int(gain.brighten(night, 90.0, 8.0)[3, 3, 1]), 40)
+        black = np.zeros((4, 4, 3), np.uint8)
+        self.assertEqual(int(gain.brighten(black, 90.0, 8.0).max()), 0)
+
+    def test_model_json_gives_the_gain_or_none(self):
+        self.assertEqual(gain.from_meta({"brighten": {"target_mean": 90, "max_gain": 8}}), (90.0, 8.0))
+        self.assertIsNone(gain.from_meta({"input_width": 448}))
+
+    def test_bad_brighten_arguments_are_named(self):
+        import argparse
+        ap = argparse.ArgumentParser()
+        self.assertIsNone(train.parse_brighten("none", ap))
+        self.assertEqual(train.parse_brighten("80,4", ap), (80.0, 4.0))
+        for bad in ("80", "x,4", "300,4", "80,0.5"):
+            with self.assertRaises(SystemExit), open(os.devnull, "w") as null:
+                stderr, sys.stderr = sys.stderr, null
+                try:
+                    train.parse_brighten(bad, ap)
+                finally:
+                    sys.stderr = stderr
 
 
 if __name__ == "__main__":

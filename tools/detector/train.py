@@ -37,6 +37,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(REPO, "python"))
 
 import export as onnx_export  # noqa: E402
+from gain import brighten  # noqa: E402
 from model import NECKS, STRIDES, Detector  # noqa: E402
 
 CLASSES = ["car", "truck", "bus", "pedestrian", "cyclist"]
@@ -83,6 +84,24 @@ def load_coco(folders, min_height=8):
     return items
 
 
+def brighten_meta():
+    """model.json's "brighten" entry ({} when the input is not brightened)."""
+    return {"brighten": {"target_mean": BRIGHTEN[0], "max_gain": BRIGHTEN[1]}} if BRIGHTEN else {}
+
+
+def parse_brighten(text, ap):
+    """'TARGET,MAX_GAIN' -> (target, max_gain); 'none' -> None."""
+    if text == "none":
+        return None
+    try:
+        target, gain = (float(v) for v in text.split(","))
+    except ValueError:
+        ap.error("--brighten: '%s': expected TARGET,MAX_GAIN or none" % text)
+    if not (0 < target < 255 and gain >= 1):
+        ap.error("--brighten: '%s': TARGET in (0, 255), MAX_GAIN >= 1" % text)
+    return target, gain
+
+
 def parse_size(text):
     """'320' (square) or '448x288' (width x height), multiples of 32."""
     w, _, h = text.partition("x")
@@ -95,14 +114,20 @@ def parse_size(text):
     return size
 
 
-def letterbox(image, size, scale_jitter=1.0, rng=None):
+BRIGHTEN = (90.0, 8.0)  # the shipped model's input gain: (target mean, most gain); model.json's
+
+
+def letterbox(image, size, scale_jitter=1.0, rng=None, gain=None):
     """Resizes into a size = (width, height) canvas (pad 114): returns the canvas, the scale
-    and the offsets, with a random zoom and placement when rng is given."""
+    and the offsets, with a random zoom and placement when rng is given; the resized image
+    brightened by `gain` (target mean, most gain; None: as it is)."""
     h, w = image.shape[:2]
     sw, sh = size
     scale = min(sw / w, sh / h) * scale_jitter
     nw, nh = max(1, int(round(w * scale))), max(1, int(round(h * scale)))
     resized = cv2.resize(image, (nw, nh), interpolation=cv2.INTER_LINEAR)
+    if gain:
+        resized = brighten(resized, *gain)
     canvas = np.full((sh, sw, 3), PAD, np.uint8)
     if rng is None:
         ox, oy = (sw - nw) // 2, (sh - nh) // 2
@@ -160,9 +185,9 @@ def sample(item, size, rng, augment):
     if augment:
         image = weather_augment(image, path, rng)
         jitter = math.exp(rng.uniform(math.log(0.75), math.log(2.0)))
-        canvas, s, ox, oy = letterbox(image, size, jitter, rng)
+        canvas, s, ox, oy = letterbox(image, size, jitter, rng, BRIGHTEN)
     else:
-        canvas, s, ox, oy = letterbox(image, size)
+        canvas, s, ox, oy = letterbox(image, size, gain=BRIGHTEN)
     b = boxes * s + np.array([ox, oy, ox, oy], np.float32)
     b = np.clip(b, 0, np.array([size[0], size[1], size[0], size[1]], np.float32))
     keep = ((b[:, 2] - b[:, 0]) >= 2) & ((b[:, 3] - b[:, 1]) >= 2)
@@ -283,7 +308,7 @@ def evaluate_folder(model, folder, size):
     frames = []
     for img in doc["images"]:
         image = cv2.imread(os.path.join(folder, img["file_name"]))[:, :, ::-1]
-        canvas, s, ox, oy = letterbox(image, size)
+        canvas, s, ox, oy = letterbox(image, size, gain=BRIGHTEN)
         x = torch.from_numpy(np.ascontiguousarray(canvas, dtype=np.float32).transpose(2, 0, 1)[None] / 255.0)
         dets = []
         for x0, y0, x1, y1, score, c in detect(model, x)[0]:
@@ -309,7 +334,12 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--neck", choices=sorted(NECKS), default="separable",
                     help="the fusions' and heads' convolutions (tools/detector/model.py)")
+    ap.add_argument("--brighten", default="%g,%g" % BRIGHTEN, metavar="TARGET,MAX_GAIN|none",
+                    help="the input's gain, as the detector engine applies it (model.json's "
+                         "\"brighten\"): dark images scaled towards a mean of TARGET, by at most "
+                         "MAX_GAIN (default %(default)s)")
     args = ap.parse_args()
+    globals()["BRIGHTEN"] = parse_brighten(args.brighten, ap)  # (what letterbox gets from now on)
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)
     rng = random.Random(args.seed)
@@ -371,7 +401,9 @@ def main():
     with open(os.path.join(args.out, "model.json"), "w") as f:
         json.dump({"input_width": args.input[0], "input_height": args.input[1], "classes": CLASSES,
                    "layout": "yolov8: 1 x (4 + C) x N, cx cy w h in input pixels, class scores",
-                   "letterbox_pad": PAD, "onnx_opset": 12, "onnx_ops": ops}, f, indent=1)
+                   "letterbox_pad": PAD, "onnx_opset": 12, "onnx_ops": ops,
+                   **brighten_meta()},
+                  f, indent=1)
     with open(os.path.join(args.out, "training.json"), "w") as f:
         json.dump({"command": " ".join(sys.argv), "args": vars(args), "images": len(items),
                    "history": history, "validation": val, "torch": torch.__version__}, f, indent=1)
