@@ -120,6 +120,30 @@ TRAIN_PEDESTRIAN = """    <ScenarioObject name="{name}">
 """
 
 
+def place_cars(cars, road, on_road, entities, inits):
+    """Adds the cars (name, model, lane, s, speed) to entities and inits, but those off the road
+    (on_road(s) false) or within 15 m of one placed before on their lane."""
+    placed = []
+    for n, m, ln, ss, v in cars:
+        if on_road(ss) and all(l != ln or abs(ss - p) >= 15.0 for l, p in placed):
+            placed.append((ln, ss))
+            entities.append(VEHICLE.format(name=n, model=m))
+            inits.append(INIT.format(name=n, road=road, lane=ln, s="%.1f" % ss, v="%.1f" % v))
+
+
+def write_scene(path, name, xodr, entities, inits, words):
+    """Writes a scene one folder below this one (train/, heldout/): xodr relative to this
+    folder; words: (file prefix, what it is, which set, its description's prefix)."""
+    prefix, what, which, description = words
+    with open(path, "w") as f:
+        f.write(DOC.format(name=name, xodr="../" + xodr, entities="".join(entities),
+                           inits="".join(inits), end=story_end(5, 30))
+                .replace("busy_%s: the ego" % name, "%s_%s: %s, the ego" % (prefix, name, what))
+                .replace("make_busy_scenarios.py. -->", "make_busy_scenarios.py, %s. -->" % which)
+                .replace('path="../suite/catalogs"', 'path="../../suite/catalogs"')
+                .replace('description="busy %s"' % name, 'description="%s %s"' % (description, name)))
+
+
 def train():
     """Writes train/train_<scene>.xosc (the paths in them relative to train/)."""
     out = os.path.join(HERE, "train")
@@ -141,26 +165,15 @@ def train():
         for j, ln in enumerate(rng.choice(oncoming) for _ in range(rng.randint(3, 4)) if oncoming):
             cars.append(("Oncoming%d" % j, rng.choice(VEHICLE_MODELS), ln, s + ahead * (40 + 30 * j + rng.uniform(0, 15)),
                          rng.uniform(5, 8)))
-        placed = []
-        for n, m, ln, ss, v in cars:
-            # off the road, or within 15 m of one placed before on its lane: left out
-            if on_road(ss) and all(l != ln or abs(ss - p) >= 15.0 for l, p in placed):
-                placed.append((ln, ss))
-                entities.append(VEHICLE.format(name=n, model=m))
-                inits.append(INIT.format(name=n, road=road, lane=ln, s="%.1f" % ss, v="%.1f" % v))
+        place_cars(cars, road, on_road, entities, inits)
         for j in range(rng.randint(4, 6)):
             n, model = "Walker%d" % j, rng.choice(WALKER_MODELS)
             ss, v = s + ahead * (10 + 14 * j + rng.uniform(0, 8)), rng.uniform(0.9, 1.6)
             if on_road(ss):
                 entities.append(TRAIN_PEDESTRIAN.format(name=n, model=model))
                 inits.append(INIT.format(name=n, road=road, lane=walks[j % len(walks)], s="%.1f" % ss, v="%.1f" % v))
-        with open(os.path.join(out, "train_%s.xosc" % name), "w") as f:
-            f.write(DOC.format(name=name, xodr="../" + ESMINI + mp + ".xodr", entities="".join(entities),
-                               inits="".join(inits), end=story_end(5, 30))
-                    .replace("busy_%s: the ego" % name, "train_%s: a detector training scene, the ego" % name)
-                    .replace("make_busy_scenarios.py. -->", "make_busy_scenarios.py, its training set. -->")
-                    .replace('path="../suite/catalogs"', 'path="../../suite/catalogs"')
-                    .replace('description="busy %s"' % name, 'description="detector training %s"' % name))
+        write_scene(os.path.join(out, "train_%s.xosc" % name), name, ESMINI + mp + ".xodr", entities, inits,
+                    ("train", "a detector training scene", "its training set", "detector training"))
         print("train/train_%s.xosc" % name)
 
 
@@ -187,12 +200,7 @@ def scene(rng, road, lane, s, length, along, oncoming, walks, walkers):
     for j in range(rng.randint(2, 3)):
         cars.append(("Oncoming%d" % j, rng.choice(VEHICLE_MODELS), rng.choice(oncoming),
                      s + ahead * (45 + 30 * j + rng.uniform(0, 15)), rng.uniform(5, 8)))
-    placed = []
-    for n, m, ln, ss, v in cars:
-        if on_road(ss) and all(l != ln or abs(ss - p) >= 15.0 for l, p in placed):
-            placed.append((ln, ss))
-            entities.append(VEHICLE.format(name=n, model=m))
-            inits.append(INIT.format(name=n, road=road, lane=ln, s="%.1f" % ss, v="%.1f" % v))
+    place_cars(cars, road, on_road, entities, inits)
     for j in range(walkers):
         ss = s + ahead * (8 + 9 * j + rng.uniform(0, 6))
         v = 0.0 if j % 3 == 2 else rng.uniform(0.8, 1.6)
@@ -211,13 +219,8 @@ def heldout():
         rng = random.Random(7301 + k)
         length = float(ET.parse(os.path.join(HERE, xodr)).getroot().find("road[@id='%s']" % road).get("length"))
         entities, inits = scene(rng, road, lane, s, length, along, oncoming, walks, rng.randint(8, 10))
-        with open(os.path.join(out, "heldout_%s.xosc" % name), "w") as f:
-            f.write(DOC.format(name=name, xodr="../" + xodr, entities="".join(entities),
-                               inits="".join(inits), end=story_end(5, 30))
-                    .replace("busy_%s: the ego" % name, "heldout_%s: a detector held-out scene, the ego" % name)
-                    .replace("make_busy_scenarios.py. -->", "make_busy_scenarios.py, its held-out scenes. -->")
-                    .replace('path="../suite/catalogs"', 'path="../../suite/catalogs"')
-                    .replace('description="busy %s"' % name, 'description="detector held-out %s"' % name))
+        write_scene(os.path.join(out, "heldout_%s.xosc" % name), name, xodr, entities, inits,
+                    ("heldout", "a detector held-out scene", "its held-out scenes", "detector held-out"))
         print("heldout/heldout_%s.xosc" % name)
 
 
