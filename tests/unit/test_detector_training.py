@@ -74,7 +74,13 @@ class WeatherAugment(unittest.TestCase):
         out = train.weather_augment(self.image, self.path, random.Random(2)).astype(float)
         self.assertLess(out.mean(), 0.5 * self.image.mean() + 3)
 
+    def test_none_by_default_and_no_draw_then(self):
+        rng = random.Random(5)
+        self.assertIs(train.weather_augment(self.image, self.path, rng), self.image)
+        self.assertEqual(rng.random(), random.Random(5).random())
+
     def test_the_same_seed_gives_the_same_image_and_most_samples_stay(self):
+        train.FOG_SHARE, train.DARK_SHARE = 0.2, 0.15
         a = train.weather_augment(self.image, self.path, random.Random(7))
         b = train.weather_augment(self.image, self.path, random.Random(7))
         self.assertTrue(np.array_equal(a, b))

@@ -3,18 +3,15 @@ bus and truck. Each body is a loft of cross-sections along x (rear to front) who
 profile (bonnet, windscreen, roof, rear window, boot) and plan (rounded nose and tail) come
 from a few key points; glass, pillars and the underbody are bands of that loft, wheel arches
 are the underbody rising over the wheels. Lights, number plates, grille, mirrors and door
-seams are thin shapes on the surface (the bus's details: make_bus.py; the truck:
-make_truck.py). Frame: x forward, y left, z up; the origin at the centre of the bounding
-box's base.
+seams are thin shapes on the surface (the truck: make_truck.py). Frame: x forward, y left,
+z up; the origin at the centre of the bounding box's base.
 
 Two meshes per type: <type>_paint.obj (the body colour; its colour comes from the SDF so
 that colour variants share it; the truck's box body likewise truck_cargo.obj) and <type>.obj +
 .mtl (glass, tyres, rims, lights, plate...).
 """
 import math
-import sys
 
-import make_bus
 from meshkit import Mesh, cross, dot, interp, sub
 
 # The materials of the detail meshes (Kd, Ks, Ns, Ke: the renderer adds Ke unlit).
@@ -34,7 +31,6 @@ MATERIALS = {
     "sign": {"kd": (0.1, 0.08, 0.02), "ks": (0.1, 0.1, 0.1), "ns": 10, "ke": (0.85, 0.55, 0.05)},
     "metal": {"kd": (0.5, 0.51, 0.53), "ks": (0.4, 0.4, 0.4), "ns": 40},
 }
-MATERIALS.update(make_bus.MATERIALS)  # the bus's inside and display (make_bus.py)
 
 # Body colours (diffuse RGB) of the colour variants; specular comes with the paint.
 PAINTS = {
@@ -79,7 +75,7 @@ TYPES = {
         belt=1.2, zb=0.32, roof_h=0.1, tumble=0.1, windscreen=(1.12, 1.78),
         rear_window=None, side_glass=(0.72, 1.78), pillars=[],
         plan=((0.35, 0.07), (0.1, 0.03)), lights=dict(head_z=(0.84, 0.98), tail_z=(0.7, 1.1), tail_w=0.14),
-        rear_glass=(1.2, 1.96), bumper=0.2, colours=["white", "silver", "blue", "red"], cls="car"),
+        rear_glass=(1.32, 1.85), colours=["white", "silver", "blue", "red"], cls="car"),
     "bus": dict(
         size=(12.0, 2.55, 3.1), mirror=0.0, wheel=(0.5, 0.34), axles=(3.35, -2.45),
         top=[(-6.0, 2.86), (-5.96, 2.96), (-5.85, 3.0), (5.85, 3.0), (5.96, 2.96), (6.0, 2.86)],
@@ -348,7 +344,7 @@ def car_details(m, t, xs, secs):
         a, b = sorted((side * hwr * (1 - lights.get("tail_w", 0.38)), side * hwr))
         face_rect(m, xr - 0.004, a, b, z0, z1, -1, "taillight")
     plate(m, xr, 0.0, z0 - 0.12, -1)
-    face_rect(m, xr - 0.003, -hwr * 0.9, hwr * 0.9, sr[2][1] + 0.02, sr[2][1] + t.get("bumper", 0.08) + 0.02, -1, "trim")
+    face_rect(m, xr - 0.003, -hwr * 0.9, hwr * 0.9, sr[2][1] + 0.02, sr[2][1] + 0.1, -1, "trim")
     if t.get("rear_glass"):
         g0, g1 = t["rear_glass"]
         hwg = cap_half_width(sr, g0) - 0.06
@@ -380,6 +376,44 @@ def car_details(m, t, xs, secs):
             side_rect(m, t, fx, fx + 0.07, belt - 0.1, belt - 0.07, side, "indicator", rows=1)
 
 
+def bus_details(m, t, xs, secs):
+    L, W, H = t["size"]
+    xf, xr = xs[-1], xs[0]
+    hw = cap_half_width(secs[-1], 1.5)
+    # windscreen, destination sign, headlights, plate; rear window, lights, plate
+    face_rect(m, xf + 0.004, -hw + 0.09, hw - 0.09, 0.95, 2.62, 1, "glass")
+    face_rect(m, xf + 0.006, -0.012, 0.012, 0.95, 2.62, 1, "trim")
+    face_rect(m, xf + 0.004, -hw + 0.2, hw - 0.2, 2.68, 2.9, 1, "sign")
+    for side in (1, -1):
+        a, b = sorted((side * (hw - 0.08), side * (hw - 0.42)))
+        face_rect(m, xf + 0.004, a, b, 0.55, 0.72, 1, "headlight")
+        a, b = sorted((side * (hw - 0.08), side * (hw - 0.2)))
+        face_rect(m, xf + 0.004, a, b, 0.76, 0.84, 1, "indicator")
+        a, b = sorted((side * (hw - 0.06), side * (hw - 0.22)))
+        face_rect(m, xr - 0.004, a, b, 0.55, 1.2, -1, "taillight")
+        face_rect(m, xr - 0.004, a, b, 1.23, 1.36, -1, "indicator")
+    face_rect(m, xf + 0.003, -hw + 0.05, hw - 0.05, 0.36, 0.5, 1, "trim")
+    plate(m, xf, 0.0, 0.62, 1)
+    face_rect(m, xr - 0.004, -hw + 0.2, hw - 0.2, 1.9, 2.62, -1, "glass")
+    face_rect(m, xr - 0.004, -0.45, 0.45, 2.68, 2.86, -1, "sign")  # the route number
+    for k in range(6):  # the engine compartment's louvres
+        z = 0.75 + 0.12 * k
+        face_rect(m, xr - 0.004, -hw + 0.45, hw - 0.45, z, z + 0.05, -1, "trim")
+    face_rect(m, xr - 0.004, -hw + 0.25, hw - 0.25, 1.62, 1.68, -1, "trim")
+    plate(m, xr, 0.0, 0.45, -1)
+    face_rect(m, xr - 0.003, -hw + 0.05, hw - 0.05, 0.34, 0.4, -1, "trim")
+    # doors on the right (-y): front (ahead of the front axle), middle, rear
+    for x0, x1 in ((L / 2 - 1.45, L / 2 - 0.3), (-0.75, 0.55), (-4.85, -3.7)):
+        side_rect(m, t, x0, x1, 0.38, 2.68, -1, "trim", out=0.004, rows=2)
+        side_rect(m, t, x0 + 0.06, 0.5 * (x0 + x1) - 0.02, 0.45, 2.6, -1, "glass", out=0.007, rows=2)
+        side_rect(m, t, 0.5 * (x0 + x1) + 0.02, x1 - 0.06, 0.45, 2.6, -1, "glass", out=0.007, rows=2)
+    # a black band under the windows, the roof's air-conditioning pod
+    for side in (1, -1):
+        side_rect(m, t, -L / 2 + 0.3, L / 2 - 0.3, 0.36, 0.44, side, "trim", out=0.003, rows=1)
+    m.begin("roof", "paint").smooth(40)
+    m.box((-1.0, 0.0, 3.05), (3.2, 1.7, 0.1))
+
+
 def build_vehicle(name):
     t = dict(TYPES[name])
     t["axles_all"] = list(t["axles"])
@@ -391,7 +425,7 @@ def build_vehicle(name):
             yo = half_width_at(t, ax, t["zb"] + 0.1) - 0.012
             wheel(m, ax, side * yo, r, r, w, side, n=16 if r > 0.4 else 14)
     if name == "bus":
-        make_bus.details(sys.modules[__name__], m, t, xs, secs)
+        bus_details(m, t, xs, secs)
     else:
         car_details(m, t, xs, secs)
         mirrors(m, t)

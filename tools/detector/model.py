@@ -1,10 +1,11 @@
 """Convoy's detector: a small single-stage, anchor-free network (three levels, strides 8, 16
 and 32; an FPN neck; one shared-shape head per level) whose ONNX form OpenCV 4.6 DNN loads.
 
-The neck's fusions and the heads' convolutions are depthwise separable by default
-(neck="separable": a 3x3 depthwise convolution, then a 1x1 one): the same receptive field as
-dense 3x3 ones (neck="dense", the models shipped before session 25) at about half the
-inference time in OpenCV (26-31 against 48-56 ms a 448x288 frame on one core).
+The neck's fusions and the heads' convolutions are dense 3x3 ones (neck="dense", the shipped
+model's) or depthwise separable (neck="separable": a 3x3 depthwise convolution, then a 1x1
+one): the same receptive field at about half the inference time in OpenCV (26-31 against
+48-56 ms a 448x288 frame on one core), but a model trained so in session 25 found fewer
+pedestrians (docs/perception.md, "Session 25").
 
 Output, YOLOv8 layout: 1 x (4 + C) x N, N = the cells of the three levels; per cell cx, cy, w,
 h in input pixels and C class scores (sigmoid). Boxes are decoded inside the network from
@@ -46,7 +47,7 @@ class Residual(nn.Module):
 
 
 class Detector(nn.Module):
-    def __init__(self, num_classes, width=(16, 32, 64, 96, 128), input_size=320, neck="separable"):
+    def __init__(self, num_classes, width=(16, 32, 64, 96, 128), input_size=320, neck="dense"):
         """input_size: a side (square) or (width, height), multiples of 32; neck: a key of NECKS
         (the fusions' and heads' 3x3 convolutions)."""
         super().__init__()

@@ -114,7 +114,7 @@ def parse_size(text):
     return size
 
 
-BRIGHTEN = (90.0, 8.0)  # the shipped model's input gain: (target mean, most gain); model.json's
+BRIGHTEN = None  # the input's gain, (target mean, most gain) (--brighten; model.json's); none
 
 
 def letterbox(image, size, scale_jitter=1.0, rng=None, gain=None):
@@ -140,7 +140,8 @@ def letterbox(image, size, scale_jitter=1.0, rng=None, gain=None):
     return canvas, scale, ox, oy
 
 
-FOG_SHARE, DARK_SHARE = 0.2, 0.15  # of the training samples given synthetic fog / darkness
+FOG_SHARE, DARK_SHARE = 0.0, 0.0  # of the training samples given synthetic fog / darkness
+#                                   (--synthetic-weather; session 25 tried 0.2 and 0.15)
 FOG_RGB = np.array([0.75, 0.77, 0.8], np.float32) * 255  # the world engine's fog colour by day
 
 
@@ -162,6 +163,8 @@ def weather_augment(image, path, rng):
     engine fogs (Koschmieder: transmission exp(-3.912 d / V), V 60-400 m, towards the fog's
     colour, dimmed by 0-40 %) from the image's depth, another darkened (a gain of 0.15-0.5 after
     a gamma of 1-1.6, with sensor noise). The rest is left as rendered."""
+    if FOG_SHARE + DARK_SHARE <= 0:
+        return image  # (no draw: the shipped model's samples as they were)
     r = rng.random()
     if r >= FOG_SHARE + DARK_SHARE:
         return image
@@ -332,14 +335,24 @@ def main():
     ap.add_argument("--lr", type=float, default=2e-3)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--neck", choices=sorted(NECKS), default="separable",
+    ap.add_argument("--neck", choices=sorted(NECKS), default="dense",
                     help="the fusions' and heads' convolutions (tools/detector/model.py)")
-    ap.add_argument("--brighten", default="%g,%g" % BRIGHTEN, metavar="TARGET,MAX_GAIN|none",
+    ap.add_argument("--brighten", default="none", metavar="TARGET,MAX_GAIN|none",
                     help="the input's gain, as the detector engine applies it (model.json's "
                          "\"brighten\"): dark images scaled towards a mean of TARGET, by at most "
-                         "MAX_GAIN (default %(default)s)")
+                         "MAX_GAIN, e.g. 90,8 (default none, as the shipped model)")
+    ap.add_argument("--synthetic-weather", default="0,0", metavar="FOG,DARK",
+                    help="shares of the training samples given synthetic fog and darkness "
+                         "(weather_augment; default 0,0, as the shipped model)")
     args = ap.parse_args()
     globals()["BRIGHTEN"] = parse_brighten(args.brighten, ap)  # (what letterbox gets from now on)
+    try:
+        fog, dark = (float(v) for v in args.synthetic_weather.split(","))
+    except ValueError:
+        ap.error("--synthetic-weather: '%s': expected FOG,DARK" % args.synthetic_weather)
+    if not (fog >= 0 and dark >= 0 and fog + dark <= 1):
+        ap.error("--synthetic-weather: '%s': shares >= 0 summing to at most 1" % args.synthetic_weather)
+    globals().update(FOG_SHARE=fog, DARK_SHARE=dark)
     torch.manual_seed(args.seed)
     torch.set_num_threads(args.threads)
     rng = random.Random(args.seed)
